@@ -1,0 +1,53 @@
+// tessera info SCENE: what the loader made of a scene file.
+#include <cstdio>
+#include <map>
+
+#include "app/commands.h"
+#include "app/scene_loading.h"
+#include "kernels/effects.h"
+#include "scene/scene_effects.h"
+#include "worker/scene_data.h"
+
+namespace tessera {
+namespace {
+
+int run_info(const std::string& path) {
+  SceneDesc desc = load_scene_or_builtin(path);
+  const size_t materials = desc.materials.size(), textures = desc.textures.size(), meshes = desc.meshes.size();
+  std::map<std::string, int> light_kinds;
+  for (const Light& l : desc.lights) {
+    static const char* names[] = {"area", "point", "spot", "distant", "infinite"};
+    ++light_kinds[names[static_cast<int>(l.type)]];
+  }
+  SceneData scene(std::move(desc));
+  const SceneView& v = scene.view();
+  std::printf("scene:          %s\n", scene.desc().source.c_str());
+  std::printf("resolution:     %dx%d, %d spp, max depth %d\n", v.camera.width, v.camera.height, scene.desc().spp,
+              scene.desc().max_depth);
+  std::printf("shapes:         %zu meshes, %zu triangles\n", meshes, scene.num_triangles());
+  std::printf("materials:      %zu\n", materials);
+  std::printf("textures:       %zu (%zu images)\n", textures, scene.desc().images.size());
+  uint32_t area = 0;
+  for (uint32_t i = 0; i < v.num_lights; ++i) area += v.lights[i].type == LightType::Area;
+  std::printf("lights:         %u (%u emissive triangles", v.num_lights, area);
+  for (auto& [k, n] : light_kinds) std::printf(", %d %s", n, k.c_str());
+  std::printf(")\n");
+  const Bounds& b = scene.bounds();
+  if (scene.num_triangles() > 0)
+    std::printf("bounds:         (%g, %g, %g) - (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+  std::printf("effects:        %s\n", describe_effects(scene.effects()).c_str());
+  std::printf("specialisation: %s\n", describe_specialisation(specialisation_for(scene.effects())).c_str());
+  std::printf("warnings:       %zu\n", scene.desc().warnings.size());
+  return 0;
+}
+
+}  // namespace
+
+CommandRunner add_info_command(CLI::App& app) {
+  auto path = std::make_shared<std::string>();
+  CLI::App* c = app.add_subcommand("info", "Print counts, bounds and the effects set of a scene");
+  c->add_option("scene", *path, "Scene file in pbrt-v4 syntax (omit for the built-in Cornell box)");
+  return [path] { return run_info(*path); };
+}
+
+}  // namespace tessera

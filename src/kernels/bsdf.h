@@ -1,0 +1,59 @@
+// BSDFs evaluated in the local shading frame (z = shading normal), pbrt-v4
+// conventions: wo and wi both point away from the surface, f() excludes the
+// cosine, pdfs are per unit solid angle, transmission is scaled for radiance
+// transport (divided by eta^2). Dispatch is an enum switch: no virtual calls.
+#pragma once
+
+#include "vecmath.h"
+
+namespace tessera {
+
+enum class BsdfType : uint32_t { Diffuse = 0, Conductor, Dielectric, CoatedDiffuse };
+
+// Lobe flags, combinable.
+enum BsdfLobe : uint32_t {
+  kLobeNone = 0,
+  kLobeReflection = 1u << 0,
+  kLobeTransmission = 1u << 1,
+  kLobeDiffuse = 1u << 2,
+  kLobeGlossy = 1u << 3,
+  kLobeSpecular = 1u << 4,
+};
+
+// A BSDF with every texture already evaluated at the hit point.
+struct BsdfParams {
+  BsdfType type = BsdfType::Diffuse;
+  Rgb reflectance{0.5f};  // Diffuse and CoatedDiffuse albedo, in [0,1]
+  Rgb eta{1.f};           // Conductor: real part of the complex IOR, per channel
+  Rgb k{0.f};             // Conductor: imaginary part
+  Float ior = 1.5f;       // Dielectric / CoatedDiffuse coating: n_inside / n_outside
+  Float alpha_x = 0.f;    // GGX (Trowbridge-Reitz) roughness, already remapped;
+  Float alpha_y = 0.f;    // both below kSmoothAlpha means perfectly smooth
+};
+
+// pbrt-v4 treats microfacet distributions with alpha below this as specular.
+constexpr Float kSmoothAlpha = 1e-3f;
+
+struct BsdfSample {
+  Rgb f{0.f};        // BSDF value (for specular lobes: the delta's weight / pdf convention as in pbrt)
+  Vec3 wi{0.f};      // sampled incident direction, local frame
+  Float pdf = 0.f;   // solid-angle pdf (for specular lobes: the discrete lobe probability)
+  uint32_t lobe = kLobeNone;  // exactly one of reflection/transmission plus one of diffuse/glossy/specular
+  Float eta = 1.f;   // relative IOR crossed (1 for reflection), for Russian roulette's eta scale
+};
+
+TESSERA_HOST_DEVICE Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, const Vec3& wi);
+TESSERA_HOST_DEVICE Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi);
+// uc picks among lobes, u samples within the lobe. Returns false when no
+// direction could be produced (e.g. a grazing wo or a sample below the horizon).
+TESSERA_HOST_DEVICE bool bsdf_sample(const BsdfParams& b, const Vec3& wo, Float uc, Vec2 u, BsdfSample* out);
+// Union of the lobes this BSDF can produce.
+TESSERA_HOST_DEVICE uint32_t bsdf_lobes(const BsdfParams& b);
+
+TESSERA_HOST_DEVICE inline bool lobes_have_non_specular(uint32_t lobes) {
+  return (lobes & (kLobeDiffuse | kLobeGlossy)) != 0;
+}
+
+}  // namespace tessera
+
+#include "bsdf_impl.h"

@@ -1,0 +1,35 @@
+// pbrt-v4 perspective camera: raster (0,0) is the top-left corner, the fov
+// spans the shorter image axis, camera space is x right, y up, z forward.
+#pragma once
+
+#include "scene_view.h"
+
+namespace tessera {
+
+struct Ray {
+  Vec3 o, d;
+};
+
+TESSERA_HOST_DEVICE inline Ray generate_camera_ray(const CameraView& c, Vec2 p_film) {
+  Float sx = c.screen_min.x + (p_film.x / c.width) * (c.screen_max.x - c.screen_min.x);
+  Float sy = c.screen_max.y - (p_film.y / c.height) * (c.screen_max.y - c.screen_min.y);
+  Vec3 d_cam(sx * c.tan_half_fov, sy * c.tan_half_fov, 1.f);
+  Ray r;
+  r.o = c.origin;
+  r.d = glm::normalize(c.world_from_camera_linear * d_cam);
+  return r;
+}
+
+// Offset within the pixel drawn from the filter (filter importance sampling:
+// every sample lands in its own pixel with weight 1, so tiles never overlap).
+TESSERA_HOST_DEVICE inline Float sample_filter_axis(const FilterView& f, Float u) {
+  Float x = u * static_cast<Float>(f.n - 1);
+  uint32_t i = glm::min(static_cast<uint32_t>(x), f.n - 2);
+  Float t = x - static_cast<Float>(i);
+  return (1.f - t) * f.inverse_cdf[i] + t * f.inverse_cdf[i + 1];
+}
+TESSERA_HOST_DEVICE inline Vec2 sample_filter_offset(const FilterView& f, Vec2 u) {
+  return Vec2(sample_filter_axis(f, u.x), sample_filter_axis(f, u.y));
+}
+
+}  // namespace tessera

@@ -1,0 +1,44 @@
+// The one place that knows whether code is being compiled for the GPU.
+// Everything in src/kernels/ marks shared functions with TESSERA_HOST_DEVICE
+// and includes nothing that nvcc cannot compile (no std containers, no
+// exceptions, no Embree/OpenEXR/MPI/cereal).
+#pragma once
+
+#if defined(__CUDACC__)
+#define TESSERA_HOST_DEVICE __host__ __device__
+#define TESSERA_INLINE __forceinline__
+#else
+#define TESSERA_HOST_DEVICE
+#define TESSERA_INLINE inline __attribute__((always_inline))
+#endif
+
+#if defined(__CUDA_ARCH__)
+#define TESSERA_IS_GPU_CODE 1
+#else
+#define TESSERA_IS_GPU_CODE 0
+#endif
+
+#define GLM_FORCE_XYZW_ONLY
+#include <glm/glm.hpp>
+
+#include <cstdint>
+
+namespace tessera {
+
+// float is deliberate for everything that travels along a path: it is what
+// Embree traces with and what the GPU is fast at. Pixel accumulation uses double
+// (see src/master/film.h).
+using Float = float;
+using Vec2 = glm::vec2;
+using Vec3 = glm::vec3;
+using Vec4 = glm::vec4;
+using Mat3 = glm::mat3;
+using Mat4 = glm::mat4;
+using Rgb = glm::vec3;  // linear sRGB radiance / reflectance
+
+constexpr Float kPi = 3.14159265358979323846f;
+constexpr Float kInvPi = 0.31830988618379067154f;
+constexpr Float kInv2Pi = 0.15915494309189533577f;
+constexpr Float kInv4Pi = 0.07957747154594766788f;
+
+}  // namespace tessera

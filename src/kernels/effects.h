@@ -1,0 +1,45 @@
+// The set of effects a scene uses, and the subset of it that the integrator
+// is specialised on (resolved once per tile, outside the inner loop).
+#pragma once
+
+#include "device.h"
+
+namespace tessera {
+
+// What the scene contains (reported by the log, `tessera info` and stats).
+enum Effect : uint32_t {
+  kEffectDiffuse = 1u << 0,
+  kEffectGlossy = 1u << 1,        // rough conductors/dielectrics, coated
+  kEffectSpecular = 1u << 2,      // smooth conductors/dielectrics/coatings
+  kEffectTransmission = 1u << 3,  // dielectrics
+  kEffectTextures = 1u << 4,
+  kEffectAreaLights = 1u << 5,
+  kEffectDeltaLights = 1u << 6,   // point, spot, distant
+  kEffectEnvironment = 1u << 7,   // infinite lights
+  kEffectMix = 1u << 8,
+  kEffectInterface = 1u << 9,
+  kEffectShadingNormals = 1u << 10,
+};
+
+// What the integrator template is specialised on: each bit removes work from
+// the inner loop when clear.
+enum Specialisation : uint32_t {
+  kSpecNonDiffuse = 1u << 0,   // any BSDF other than Lambertian (incl. mix/interface)
+  kSpecTextures = 1u << 1,
+  kSpecAreaLights = 1u << 2,
+  kSpecPointLights = 1u << 3,  // delta lights
+  kSpecEnvironment = 1u << 4,
+  kSpecAll = (1u << 5) - 1,
+};
+
+TESSERA_HOST_DEVICE inline uint32_t specialisation_for(uint32_t effects) {
+  uint32_t s = 0;
+  if (effects & (kEffectGlossy | kEffectSpecular | kEffectTransmission | kEffectMix | kEffectInterface)) s |= kSpecNonDiffuse;
+  if (effects & kEffectTextures) s |= kSpecTextures;
+  if (effects & kEffectAreaLights) s |= kSpecAreaLights;
+  if (effects & kEffectDeltaLights) s |= kSpecPointLights;
+  if (effects & kEffectEnvironment) s |= kSpecEnvironment;
+  return s;
+}
+
+}  // namespace tessera

@@ -1,0 +1,45 @@
+// Clarberg's equal-area mapping between the unit square and the sphere
+// (octahedral layout), as pbrt-v4 uses for environment maps. Because the map
+// preserves area, a density p(u,v) on the square is p / (4 pi) per steradian.
+#pragma once
+
+#include "vecmath.h"
+
+namespace tessera {
+
+TESSERA_HOST_DEVICE inline Vec3 equal_area_square_to_sphere(Vec2 p) {
+  Float u = 2.f * p.x - 1.f, v = 2.f * p.y - 1.f;
+  Float up = glm::abs(u), vp = glm::abs(v);
+  Float signed_distance = 1.f - (up + vp);
+  Float d = glm::abs(signed_distance);
+  Float r = 1.f - d;
+  Float phi = (r == 0.f ? 1.f : (vp - up) / r + 1.f) * kPi / 4.f;
+  Float z = glm::sign(signed_distance) * (1.f - r * r);
+  if (signed_distance == 0.f) z = 0.f;
+  Float cos_phi = glm::abs(glm::cos(phi)) * (u < 0.f ? -1.f : 1.f);
+  Float sin_phi = glm::abs(glm::sin(phi)) * (v < 0.f ? -1.f : 1.f);
+  Float s = r * safe_sqrt(2.f - r * r);
+  return Vec3(cos_phi * s, sin_phi * s, z);
+}
+
+TESSERA_HOST_DEVICE inline Vec2 equal_area_sphere_to_square(Vec3 d) {
+  Float x = glm::abs(d.x), y = glm::abs(d.y), z = glm::abs(d.z);
+  Float r = safe_sqrt(1.f - z);
+  Float a = glm::max(x, y), b = glm::min(x, y);
+  b = a == 0.f ? 0.f : b / a;
+  // atan(b) * 2/pi for b in [0,1]
+  Float phi = glm::atan(b) * (2.f / kPi);
+  if (x < y) phi = 1.f - phi;
+  Float v = phi * r;
+  Float u = r - v;
+  if (d.z < 0.f) {
+    Float t = u;
+    u = 1.f - v;
+    v = 1.f - t;
+  }
+  u = d.x < 0.f ? -u : u;
+  v = d.y < 0.f ? -v : v;
+  return Vec2(0.5f * (u + 1.f), 0.5f * (v + 1.f));
+}
+
+}  // namespace tessera

@@ -1,0 +1,32 @@
+// Compiles the device-agnostic kernels with nvcc, so that every change to
+// src/kernels/ is checked against the CUDA compiler whenever nvcc exists.
+// The GPU backend (a later issue) provides a real ray-query type in place of
+// NoGeometryTracer; the integrator code is the same.
+#include "kernels/integrator.h"
+
+namespace tessera {
+
+// Ray queries against an empty scene: enough to instantiate the integrator.
+struct NoGeometryTracer {
+  __device__ bool intersect(const Vec3&, const Vec3&, Float, TraceHit*) const { return false; }
+  __device__ bool occluded(const Vec3&, const Vec3&, Float) const { return false; }
+};
+
+template <uint32_t Spec>
+__global__ void trace_pixels_kernel(SceneView scene, PathSettings settings, uint64_t seed, Rgb* out) {
+  const int32_t x = blockIdx.x * blockDim.x + threadIdx.x;
+  const int32_t y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x >= scene.camera.width || y >= scene.camera.height) return;
+  const uint64_t pixel = static_cast<uint64_t>(y) * scene.camera.width + x;
+  Rng rng = Rng::for_sample(seed, pixel, 0);
+  Vec2 offset = sample_filter_offset(scene.filter, rng.uniform2());
+  Ray ray = generate_camera_ray(scene.camera, Vec2(x + 0.5f + offset.x, y + 0.5f + offset.y));
+  PathCounters counters;
+  out[pixel] = trace_path<Spec>(scene, NoGeometryTracer{}, ray, rng, settings, counters);
+}
+
+// Instantiate the lean and the full specialisation.
+template __global__ void trace_pixels_kernel<0u>(SceneView, PathSettings, uint64_t, Rgb*);
+template __global__ void trace_pixels_kernel<kSpecAll>(SceneView, PathSettings, uint64_t, Rgb*);
+
+}  // namespace tessera

@@ -1,0 +1,27 @@
+// Light sources as one tagged struct. Area lights are one Light per emitting
+// triangle so that light selection and pdfs stay simple.
+#pragma once
+
+#include "device.h"
+
+namespace tessera {
+
+enum class LightType : uint32_t { Area = 0, Point, Spot, Distant, Infinite };
+
+struct Light {
+  LightType type = LightType::Point;
+  // Area / Distant / Infinite: emitted radiance. Point / Spot: radiant intensity.
+  // pbrt's "scale" (and "power" where given) is already folded in.
+  Rgb L{1.f};
+  Vec3 position{0.f};          // Point / Spot
+  Vec3 direction{0.f, 0.f, 1.f};  // Spot: unit cone axis. Distant: unit direction *towards* the light
+  Float cos_falloff_start = 1.f;  // Spot: cos(coneangle - conedelta)
+  Float cos_falloff_end = 0.f;    // Spot: cos(coneangle)
+  uint32_t triangle = 0;       // Area: global triangle index in the scene
+  Float area = 0.f;            // Area: triangle area (precomputed: used by every pdf)
+  bool two_sided = false;      // Area
+  int32_t image = -1;          // Infinite: index into the scene's images (equal-area octahedral), -1 = constant L
+  Mat3 light_from_world{1.f};  // Infinite: rotation into the light's frame
+};
+
+}  // namespace tessera

@@ -1,0 +1,124 @@
+// Sampling incident radiance from one light (next-event estimation) and the
+// matching solid-angle pdfs for MIS when a BSDF-sampled ray finds a light.
+#pragma once
+
+#include "equal_area.h"
+#include "sampling.h"
+#include "surface.h"
+#include "texture_eval.h"
+
+namespace tessera {
+
+struct LightSample {
+  Rgb L{0.f};        // radiance (or intensity / r^2 for point-like lights) arriving at the reference point
+  Vec3 wi{0.f};      // unit direction from the reference point to the light
+  Vec3 p_light{0.f}; // point on the light (finite lights) for the shadow ray
+  Float pdf = 0.f;   // solid-angle pdf of wi (1 for delta lights)
+  bool delta = false;
+  bool infinite = false;  // shadow ray runs to infinity
+};
+
+TESSERA_HOST_DEVICE inline Rgb environment_radiance(const SceneView& s, const Light& l, const Vec3& dir_world) {
+  if (l.image < 0) return l.L;
+  Vec3 wl = glm::normalize(l.light_from_world * dir_world);
+  return l.L * image_lookup_nearest_equal_area(s.images[l.image], equal_area_sphere_to_square(wl));
+}
+
+TESSERA_HOST_DEVICE inline Float environment_pdf(const SceneView& s, uint32_t light_index, const Vec3& dir_world) {
+  const Light& l = s.lights[light_index];
+  if (l.image < 0) return kUniformSpherePdf;
+  Vec3 wl = glm::normalize(l.light_from_world * dir_world);
+  return s.env_distributions[light_index].pdf(equal_area_sphere_to_square(wl)) * kInv4Pi;
+}
+
+// Spot falloff, pbrt-v4: smoothstep between the cone's outer and inner cosines.
+TESSERA_HOST_DEVICE inline Float spot_falloff(const Light& l, Float cos_theta) {
+  Float e = l.cos_falloff_end, st = l.cos_falloff_start;
+  if (st <= e) return cos_theta >= e ? 1.f : 0.f;
+  Float t = glm::clamp((cos_theta - e) / (st - e), 0.f, 1.f);
+  return t * t * (3.f - 2.f * t);
+}
+
+TESSERA_HOST_DEVICE inline bool sample_light(const SceneView& s, uint32_t light_index, const Vec3& ref_p, Vec2 u,
+                                             LightSample* out) {
+  const Light& l = s.lights[light_index];
+  LightSample ls;
+  switch (l.type) {
+    case LightType::Area: {
+      Vec3 b = sample_uniform_triangle(u);
+      const uint32_t* idx = s.indices + 3 * static_cast<size_t>(l.triangle);
+      const Vec3& p0 = s.positions[idx[0]];
+      const Vec3& p1 = s.positions[idx[1]];
+      const Vec3& p2 = s.positions[idx[2]];
+      Vec3 p = b.x * p0 + b.y * p1 + b.z * p2;
+      // Emission side: the geometric normal as make_surface_hit orients it.
+      Vec3 n = make_surface_hit_normal(s, l.triangle, b.y, b.z);
+      Vec3 d = p - ref_p;
+      Float dist2 = glm::dot(d, d);
+      if (!(dist2 > 0.f)) return false;
+      Float dist = glm::sqrt(dist2);
+      ls.wi = d / dist;
+      Float cos_l = -glm::dot(n, ls.wi);
+      if (!l.two_sided && cos_l <= 0.f) return false;
+      Float abs_cos = glm::abs(cos_l);
+      if (abs_cos <= 0.f || l.area <= 0.f) return false;
+      ls.pdf = dist2 / (abs_cos * l.area);
+      ls.L = l.L;
+      ls.p_light = offset_ray_origin(s, p, n, -ls.wi);
+      break;
+    }
+    case LightType::Point:
+    case LightType::Spot: {
+      Vec3 d = l.position - ref_p;
+      Float dist2 = glm::dot(d, d);
+      if (dist2 <= 0.f) return false;
+      ls.wi = d / glm::sqrt(dist2);
+      Float falloff = l.type == LightType::Spot ? spot_falloff(l, glm::dot(-ls.wi, l.direction)) : 1.f;
+      if (falloff <= 0.f) return false;
+      ls.L = l.L * (falloff / dist2);
+      ls.pdf = 1.f;
+      ls.delta = true;
+      ls.p_light = l.position;
+      break;
+    }
+    case LightType::Distant: {
+      ls.wi = l.direction;
+      ls.L = l.L;
+      ls.pdf = 1.f;
+      ls.delta = true;
+      ls.infinite = true;
+      break;
+    }
+    case LightType::Infinite: {
+      if (l.image < 0) {
+        ls.wi = sample_uniform_sphere(u);
+        ls.pdf = kUniformSpherePdf;
+      } else {
+        Float pdf_uv;
+        Vec2 uv = s.env_distributions[light_index].sample(u, &pdf_uv);
+        if (pdf_uv <= 0.f) return false;
+        Vec3 wl = equal_area_square_to_sphere(uv);
+        // light_from_world is a rotation: its transpose maps back to world.
+        ls.wi = glm::normalize(glm::transpose(l.light_from_world) * wl);
+        ls.pdf = pdf_uv * kInv4Pi;
+      }
+      ls.L = environment_radiance(s, l, ls.wi);
+      ls.infinite = true;
+      break;
+    }
+  }
+  if (!(ls.pdf > 0.f) || is_black(ls.L)) return false;
+  *out = ls;
+  return true;
+}
+
+// Solid-angle pdf that sample_light would have produced for hitting emissive
+// light l at distance dist along w (cos_l = dot(ng, -w)).
+TESSERA_HOST_DEVICE inline Float area_light_pdf(const Light& l, Float dist, Float cos_l) {
+  Float area = l.area;
+  Float c = glm::abs(cos_l);
+  if (area <= 0.f || c <= 0.f) return 0.f;
+  return dist * dist / (c * area);
+}
+
+}  // namespace tessera

@@ -1,0 +1,48 @@
+// Materials and textures as plain tagged structs. A Material is what a scene
+// file says; resolve_bsdf() (integrator side) turns it into BsdfParams at a hit.
+#pragma once
+
+#include "device.h"
+
+namespace tessera {
+
+// A material parameter: either a constant or a texture index.
+struct TextureSlot {
+  int32_t texture = -1;  // >= 0: index into the scene's textures; wins over value
+  Rgb value{0.f};        // constant (float parameters use value.x)
+};
+
+enum class TextureType : uint32_t { Constant = 0, Image, Scale, Checkerboard };
+
+// pbrt-v4 "uv" mapping: st = (su * u + du, sv * v + dv).
+struct Texture {
+  TextureType type = TextureType::Constant;
+  Rgb value{0.f};            // Constant
+  int32_t image = -1;        // Image: index into the scene's images
+  Float su = 1.f, sv = 1.f, du = 0.f, dv = 0.f;
+  Float scale = 1.f;         // Image: multiplier (pbrt "scale")
+  bool invert = false;       // Image: 1 - value (pbrt "invert")
+  TextureSlot a, b;          // Scale: a * b ("tex" * "scale"); Checkerboard: tex1, tex2
+};
+
+// Linear RGB texels, row 0 is the top row of the file.
+struct ImageView {
+  int32_t width = 0, height = 0;
+  const Rgb* texels = nullptr;
+};
+
+enum class MaterialType : uint32_t { Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, Interface, Mix };
+
+struct Material {
+  MaterialType type = MaterialType::Diffuse;
+  TextureSlot reflectance{ -1, Rgb(0.5f) };  // diffuse/coateddiffuse albedo; conductor "reflectance"
+  bool conductor_from_reflectance = false;  // conductor given by "reflectance" instead of eta/k
+  Rgb eta{0.2004f, 0.9240f, 1.1022f};       // conductor eta (pbrt default: metal-Cu)
+  Rgb k{3.9129f, 2.4528f, 2.1422f};          // conductor k
+  Float ior = 1.5f;                          // dielectric eta / coateddiffuse coating eta
+  Float alpha_x = 0.f, alpha_y = 0.f;        // GGX alpha, remapped from roughness by the loader
+  int32_t mix[2] = {-1, -1};                 // Mix: material indices
+  TextureSlot amount{ -1, Rgb(0.5f) };      // Mix: probability of choosing mix[1] (value.x)
+};
+
+}  // namespace tessera

@@ -1,0 +1,74 @@
+// Turning a scene Material into BsdfParams at a hit (textures, mix choice).
+#pragma once
+
+#include "bsdf.h"
+#include "effects.h"
+#include "rng.h"
+#include "surface.h"
+#include "texture_eval.h"
+
+namespace tessera {
+
+// pbrt-v4 picks a mix component with a hash of the hit, not with a sampler
+// dimension, so the choice is deterministic per point and direction.
+TESSERA_HOST_DEVICE inline Float mix_hash_float(const Vec3& p, const Vec3& wo, int32_t a, int32_t b) {
+  auto bits = [](Float f) {
+    union { Float f; uint32_t u; } c;
+    c.f = f;
+    return static_cast<uint64_t>(c.u);
+  };
+  uint64_t h = mix_bits(bits(p.x) ^ (bits(p.y) << 21) ^ (bits(p.z) << 42));
+  h = mix_bits(h ^ bits(wo.x) ^ (bits(wo.y) << 21) ^ (bits(wo.z) << 42));
+  h = mix_bits(h ^ (static_cast<uint64_t>(a) << 32) ^ static_cast<uint64_t>(b));
+  return static_cast<Float>(h >> 40) * 0x1p-24f;
+}
+
+// Returns false for an "interface" material: the surface only bounds a medium
+// and the ray continues through it.
+template <uint32_t Spec>
+TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t material, const SurfaceHit& h, const Vec3& wo,
+                                             BsdfParams* out) {
+  const Material* m = &s.materials[material];
+  if constexpr ((Spec & kSpecNonDiffuse) != 0) {
+    for (int guard = 0; m->type == MaterialType::Mix && guard < 16; ++guard) {
+      Float amount = (Spec & kSpecTextures) ? eval_slot(s, m->amount, h.uv).x : m->amount.value.x;
+      Float u = mix_hash_float(h.p, wo, m->mix[0], m->mix[1]);
+      m = &s.materials[amount < u ? m->mix[0] : m->mix[1]];
+    }
+    if (m->type == MaterialType::Interface || m->type == MaterialType::Mix) return false;
+  }
+  Rgb refl = (Spec & kSpecTextures) ? eval_slot(s, m->reflectance, h.uv) : m->reflectance.value;
+  BsdfParams b;
+  b.alpha_x = m->alpha_x;
+  b.alpha_y = m->alpha_y;
+  b.ior = m->ior;
+  switch (m->type) {
+    case MaterialType::Conductor:
+      b.type = BsdfType::Conductor;
+      if (m->conductor_from_reflectance) {
+        // pbrt-v4: eta = 1 and k chosen so that normal-incidence reflectance is r.
+        Rgb r = glm::clamp(refl, Rgb(0.f), Rgb(0.9999f));
+        b.eta = Rgb(1.f);
+        b.k = 2.f * glm::sqrt(r) / glm::sqrt(Rgb(1.f) - r);
+      } else {
+        b.eta = m->eta;
+        b.k = m->k;
+      }
+      break;
+    case MaterialType::Dielectric:
+      b.type = BsdfType::Dielectric;
+      break;
+    case MaterialType::CoatedDiffuse:
+      b.type = BsdfType::CoatedDiffuse;
+      b.reflectance = glm::clamp(refl, Rgb(0.f), Rgb(1.f));
+      break;
+    default:
+      b.type = BsdfType::Diffuse;
+      b.reflectance = glm::clamp(refl, Rgb(0.f), Rgb(1.f));
+      break;
+  }
+  *out = b;
+  return true;
+}
+
+}  // namespace tessera

@@ -1,0 +1,67 @@
+// Read-only views of a built scene: flat arrays + sizes, valid on the side
+// (CPU or GPU) whose memory they point into. Built by src/worker/scene_data.h.
+#pragma once
+
+#include "distribution.h"
+#include "light.h"
+#include "material.h"
+
+namespace tessera {
+
+enum TriangleFlags : uint32_t {
+  kTriFlipNormal = 1u << 0,   // negate cross(p0 - p2, p1 - p2)
+  kTriHasNormals = 1u << 1,   // per-vertex shading normals present
+  kTriHasUv = 1u << 2,        // per-vertex uv present (else pbrt's (0,0),(1,0),(1,1))
+};
+
+struct TriangleInfo {
+  int32_t material = 0;
+  int32_t light = -1;  // index into lights for emissive triangles
+  uint32_t flags = 0;
+};
+
+struct CameraView {
+  Mat3 world_from_camera_linear{1.f};  // upper 3x3 of world_from_camera (may include scale/flip)
+  Vec3 origin{0.f};                    // camera position in world space
+  Vec2 screen_min{-1.f}, screen_max{1.f};  // screen window, pbrt-v4 convention
+  Float tan_half_fov = 1.f;
+  int32_t width = 0, height = 0;
+};
+
+// Inverse cdf of one axis of a separable pixel filter, tabulated at n evenly
+// spaced u in [0,1] and interpolated linearly: O(1) per sample, no search.
+struct FilterView {
+  const Float* inverse_cdf = nullptr;  // offsets in [-radius, radius]
+  uint32_t n = 0;
+  Float radius = 0.5f;
+};
+
+struct SceneView {
+  const Vec3* positions = nullptr;
+  const Vec3* normals = nullptr;
+  const Vec2* uvs = nullptr;
+  const uint32_t* indices = nullptr;  // 3 per triangle
+  const TriangleInfo* triangles = nullptr;
+  uint32_t num_triangles = 0;
+
+  const Material* materials = nullptr;
+  uint32_t num_materials = 0;
+  const Texture* textures = nullptr;
+  const ImageView* images = nullptr;
+
+  const Light* lights = nullptr;
+  uint32_t num_lights = 0;
+  Distribution1DView light_select;     // power-proportional light selection
+  const int32_t* infinite_lights = nullptr;  // indices of Infinite lights
+  uint32_t num_infinite_lights = 0;
+  const Distribution2DView* env_distributions = nullptr;  // per light index, valid for image infinite lights
+
+  Float scene_radius = 1.f;  // bounding sphere, for distant lights' power
+  Vec3 scene_center{0.f};
+  Float ray_epsilon = 1e-4f; // origin offset scale (relative to coordinate magnitude)
+
+  CameraView camera;
+  FilterView filter;
+};
+
+}  // namespace tessera

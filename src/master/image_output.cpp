@@ -1,0 +1,55 @@
+#include "master/image_output.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfDoubleAttribute.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <stb/stb_image_write.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace tessera {
+
+void write_exr(const std::string& path, const ImageRgb& mean, const ImageRgb* variance, const ExrMetadata& meta) {
+  try {
+    Imf::Header header(mean.width, mean.height);
+    const char* names[3] = {"R", "G", "B"};
+    const char* var_names[3] = {"variance.R", "variance.G", "variance.B"};
+    for (int c = 0; c < 3; ++c) header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+    if (variance)
+      for (int c = 0; c < 3; ++c) header.channels().insert(var_names[c], Imf::Channel(Imf::FLOAT));
+    for (const auto& [k, v] : meta.strings) header.insert(k, Imf::StringAttribute(v));
+    for (const auto& [k, v] : meta.numbers) header.insert(k, Imf::DoubleAttribute(v));
+    Imf::FrameBuffer fb;
+    const size_t xs = 3 * sizeof(float), ys = xs * mean.width;
+    for (int c = 0; c < 3; ++c) {
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)(mean.rgb.data() + c), xs, ys));
+      if (variance) fb.insert(var_names[c], Imf::Slice(Imf::FLOAT, (char*)(variance->rgb.data() + c), xs, ys));
+    }
+    Imf::OutputFile file(path.c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(mean.height);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot write " + path + ": " + e.what());
+  }
+}
+
+void write_png_preview(const std::string& path, const ImageRgb& mean) {
+  std::vector<unsigned char> px(mean.rgb.size());
+  for (size_t i = 0; i < mean.rgb.size(); ++i) {
+    float v = mean.rgb[i];
+    if (!(v > 0.f)) v = 0.f;
+    v = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
+    px[i] = static_cast<unsigned char>(std::clamp(v, 0.f, 1.f) * 255.f + 0.5f);
+  }
+  if (!stbi_write_png(path.c_str(), mean.width, mean.height, 3, px.data(), mean.width * 3)) {
+    throw std::runtime_error("cannot write " + path);
+  }
+}
+
+}  // namespace tessera

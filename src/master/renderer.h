@@ -1,0 +1,46 @@
+// The local render loop: passes of samples per pixel over all tiles (oneTBB).
+// Between passes is where later work (guide updates, farm syncs) plugs in.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "master/film.h"
+#include "worker/embree_backend.h"
+#include "worker/render_tile.h"
+#include "worker/scene_data.h"
+
+namespace tessera {
+
+struct RenderOptions {
+  uint32_t spp = 16;            // 0 = unlimited (then time_budget_s must be set)
+  double time_budget_s = 0.0;   // 0 = none; whole passes are rendered until it is spent
+  int32_t max_depth = 5;
+  bool nee = true;
+  uint64_t seed = 0;
+  int32_t threads = 0;          // 0 = all cores
+  int32_t tile_size = 16;
+  uint32_t max_pass_spp = 8;
+  bool force_full_specialisation = false;  // benchmark switch: ignore the effects set
+  bool progress = true;
+};
+
+struct RenderStats {
+  uint32_t spp = 0;
+  uint32_t passes = 0;
+  double seconds = 0.0;
+  TileCounters counters;
+  uint32_t effects = 0;
+  uint32_t specialisation = 0;
+  int32_t threads = 0;
+  std::string stop_reason;
+};
+
+struct RenderResult {
+  Film film;
+  RenderStats stats;
+};
+
+RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& options);
+
+}  // namespace tessera

@@ -1,0 +1,126 @@
+#include "scene/image_io.h"
+
+#include <stb/stb_image.h>
+
+#include <ImfArray.h>
+#include <ImfRgbaFile.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <exception>
+
+namespace tessera {
+namespace {
+
+std::string lower_extension(const std::string& path) {
+  size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos) return "";
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+[[noreturn]] void fail(const std::string& path, const std::string& reason) {
+  throw SceneError("cannot read image '" + path + "': " + reason);
+}
+
+Float decode(Float v, const ColorEncoding& e) {
+  switch (e.kind) {
+    case ColorEncoding::Linear: return v;
+    case ColorEncoding::Gamma: return std::pow(v, e.gamma);
+    case ColorEncoding::SRGB: break;
+  }
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+ImageDesc load_exr(const std::string& path) {
+  try {
+    Imf::RgbaInputFile file(path.c_str());
+    Imath::Box2i dw = file.dataWindow();
+    const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
+    Imf::Array2D<Imf::Rgba> pixels(h, w);
+    // Shift the frame buffer so that the data window's corner lands on [0][0].
+    file.setFrameBuffer(&pixels[0][0] - dw.min.x - static_cast<ptrdiff_t>(dw.min.y) * w, 1, w);
+    file.readPixels(dw.min.y, dw.max.y);
+    ImageDesc img;
+    img.width = w;
+    img.height = h;
+    img.path = path;
+    img.texels.resize(static_cast<size_t>(w) * h);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const Imf::Rgba& p = pixels[y][x];
+        img.texels[static_cast<size_t>(y) * w + x] = Rgb(float(p.r), float(p.g), float(p.b));
+      }
+    return img;
+  } catch (const std::exception& e) {
+    fail(path, e.what());
+  }
+}
+
+ImageDesc load_with_stb(const std::string& path, const ColorEncoding& encoding) {
+  int w = 0, h = 0, channels = 0;
+  ImageDesc img;
+  img.path = path;
+  if (stbi_is_hdr(path.c_str())) {
+    float* data = stbi_loadf(path.c_str(), &w, &h, &channels, 3);
+    if (!data) fail(path, stbi_failure_reason() ? stbi_failure_reason() : "unknown error");
+    img.texels.resize(static_cast<size_t>(w) * h);
+    for (size_t i = 0; i < img.texels.size(); ++i) img.texels[i] = Rgb(data[3 * i], data[3 * i + 1], data[3 * i + 2]);
+    stbi_image_free(data);
+  } else if (stbi_is_16_bit(path.c_str())) {
+    stbi_us* data = stbi_load_16(path.c_str(), &w, &h, &channels, 3);
+    if (!data) fail(path, stbi_failure_reason() ? stbi_failure_reason() : "unknown error");
+    img.texels.resize(static_cast<size_t>(w) * h);
+    for (size_t i = 0; i < img.texels.size(); ++i)
+      for (int c = 0; c < 3; ++c) img.texels[i][c] = decode(data[3 * i + c] / 65535.f, encoding);
+    stbi_image_free(data);
+  } else {
+    stbi_uc* data = stbi_load(path.c_str(), &w, &h, &channels, 3);
+    if (!data) fail(path, stbi_failure_reason() ? stbi_failure_reason() : "unknown error");
+    // 256-entry table: decoding is the slow part for big textures.
+    Float table[256];
+    for (int v = 0; v < 256; ++v) table[v] = decode(v / 255.f, encoding);
+    img.texels.resize(static_cast<size_t>(w) * h);
+    for (size_t i = 0; i < img.texels.size(); ++i)
+      img.texels[i] = Rgb(table[data[3 * i]], table[data[3 * i + 1]], table[data[3 * i + 2]]);
+    stbi_image_free(data);
+  }
+  img.width = w;
+  img.height = h;
+  return img;
+}
+
+}  // namespace
+
+std::string ColorEncoding::name() const {
+  switch (kind) {
+    case Linear: return "linear";
+    case Gamma: return "gamma " + std::to_string(gamma);
+    case SRGB: break;
+  }
+  return "sRGB";
+}
+
+std::optional<ColorEncoding> parse_color_encoding(const std::string& text) {
+  if (text == "sRGB" || text == "srgb") return ColorEncoding{ColorEncoding::SRGB, 2.2f};
+  if (text == "linear") return ColorEncoding{ColorEncoding::Linear, 1.f};
+  if (text.rfind("gamma ", 0) == 0) {
+    char* end = nullptr;
+    float g = std::strtof(text.c_str() + 6, &end);
+    if (end != text.c_str() + 6 && *end == '\0' && g > 0.f) return ColorEncoding{ColorEncoding::Gamma, g};
+  }
+  return std::nullopt;
+}
+
+ImageDesc load_image(const std::string& path) { return load_image(path, ColorEncoding{}); }
+
+ImageDesc load_image(const std::string& path, const ColorEncoding& encoding) {
+  ImageDesc img = lower_extension(path) == "exr" ? load_exr(path) : load_with_stb(path, encoding);
+  if (img.width <= 0 || img.height <= 0) fail(path, "empty image");
+  return img;
+}
+
+}  // namespace tessera

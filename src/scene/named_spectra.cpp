@@ -1,0 +1,101 @@
+#include "scene/named_spectra.h"
+
+#include <cmath>
+#include <map>
+
+namespace tessera {
+namespace {
+
+// Multi-lobe Gaussian fit of the CIE 1931 colour matching functions (Wyman,
+// Sloan & Shirley 2013): accurate to a few per cent, and no 471-entry tables.
+double lobe(double lambda, double mu, double sigma_lo, double sigma_hi) {
+  double t = (lambda - mu) / (lambda < mu ? sigma_lo : sigma_hi);
+  return std::exp(-0.5 * t * t);
+}
+
+Vec3 cie_xyz(double l) {
+  double x = 1.056 * lobe(l, 599.8, 37.9, 31.0) + 0.362 * lobe(l, 442.0, 16.0, 26.7) -
+             0.065 * lobe(l, 501.1, 20.4, 26.2);
+  double y = 0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1);
+  double z = 1.217 * lobe(l, 437.0, 11.8, 36.0) + 0.681 * lobe(l, 459.0, 26.0, 13.8);
+  return Vec3(static_cast<Float>(x), static_cast<Float>(y), static_cast<Float>(z));
+}
+
+Rgb xyz_to_linear_srgb(Vec3 c) {
+  return Rgb(3.2404542f * c.x - 1.5371385f * c.y - 0.4985314f * c.z,
+             -0.9692660f * c.x + 1.8760108f * c.y + 0.0415560f * c.z,
+             0.0556434f * c.x - 0.2040259f * c.y + 1.0572252f * c.z);
+}
+
+// XYZ of a spectrum over the visible range (5 nm steps; normalisation is up to the caller).
+template <typename SpectrumFn>
+Vec3 integrate_xyz(SpectrumFn&& s) {
+  Vec3 sum(0.f);
+  for (double l = 360.; l <= 830.; l += 5.) sum += cie_xyz(l) * static_cast<Float>(s(l));
+  return sum;
+}
+
+
+// Conductor values are the spectra averaged over rough R/G/B bands (about
+// 600-700, 500-600, 400-500 nm); glasses use n_d (587.6 nm) as "near 550 nm".
+const std::map<std::string, Rgb>& table() {
+  static const std::map<std::string, Rgb> t = {
+      {"metal-Au-eta", {0.143f, 0.375f, 1.442f}},   {"metal-Au-k", {3.983f, 2.386f, 1.603f}},
+      {"metal-Ag-eta", {0.155f, 0.117f, 0.138f}},   {"metal-Ag-k", {4.828f, 3.122f, 2.147f}},
+      {"metal-Al-eta", {1.657f, 0.880f, 0.521f}},   {"metal-Al-k", {9.224f, 6.270f, 4.837f}},
+      {"metal-Cu-eta", {0.200f, 0.924f, 1.102f}},   {"metal-Cu-k", {3.913f, 2.453f, 2.142f}},
+      {"metal-CuZn-eta", {0.444f, 0.527f, 1.094f}}, {"metal-CuZn-k", {3.695f, 2.765f, 1.829f}},
+      {"metal-MgO-eta", {1.732f, 1.738f, 1.760f}},  {"metal-MgO-k", {0.f, 0.f, 0.f}},
+      {"metal-TiO2-eta", {2.74f, 2.87f, 3.10f}},    {"metal-TiO2-k", {0.f, 0.f, 0.0f}},
+      {"glass-BK7", Rgb(1.5168f)},                  {"glass-BAF10", Rgb(1.6700f)},
+      {"glass-FK51A", Rgb(1.4866f)},                {"glass-LASF9", Rgb(1.8503f)},
+      {"glass-F5", Rgb(1.6034f)},                   {"glass-F10", Rgb(1.6200f)},
+      {"glass-F11", Rgb(1.6209f)},
+  };
+  return t;
+}
+
+}  // namespace
+
+std::optional<Rgb> named_spectrum_rgb(const std::string& name) {
+  auto it = table().find(name);
+  if (it != table().end()) return it->second;
+  // Emission spectra: pbrt-v4 normalises them to unit luminance, and their
+  // colour casts (A is orange, F-series greenish) are beyond an RGB renderer's
+  // white balance anyway: treat them as white.
+  if (name.rfind("stdillum-", 0) == 0 || name.rfind("illum-", 0) == 0) return Rgb(1.f);
+  return std::nullopt;
+}
+
+Rgb blackbody_rgb(Float kelvin) {
+  if (!(kelvin > 0.f)) return Rgb(0.f);
+  const double c = 299792458., h = 6.62606957e-34, kb = 1.3806488e-23;
+  auto planck = [&](double lambda_nm) {
+    double l = lambda_nm * 1e-9;
+    return (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * kelvin)) - 1));
+  };
+  Vec3 xyz = integrate_xyz(planck);
+  if (!(xyz.y > 0.f)) return Rgb(0.f);
+  return glm::max(xyz_to_linear_srgb(xyz / xyz.y), Rgb(0.f));
+}
+
+Rgb sampled_spectrum_rgb(const std::vector<Float>& pairs) {
+  if (pairs.size() < 2) return Rgb(0.f);
+  const size_t n = pairs.size() / 2;
+  auto value_at = [&](double l) -> double {
+    if (l <= pairs[0]) return pairs[1];
+    for (size_t i = 0; i + 1 < n; ++i) {
+      double l0 = pairs[2 * i], l1 = pairs[2 * i + 2];
+      if (l <= l1) {
+        double t = l1 > l0 ? (l - l0) / (l1 - l0) : 0.;
+        return pairs[2 * i + 1] * (1 - t) + pairs[2 * i + 3] * t;
+      }
+    }
+    return pairs[2 * n - 1];
+  };
+  Rgb white = xyz_to_linear_srgb(integrate_xyz([](double) { return 1.; }));
+  Rgb rgb = xyz_to_linear_srgb(integrate_xyz(value_at));
+  return glm::max(rgb / white, Rgb(0.f));
+}
+
+}  // namespace tessera

@@ -1,0 +1,90 @@
+#include "scene/pbrt_lights.h"
+
+#include <cmath>
+
+#include "scene/pbrt_textures.h"
+
+namespace tessera {
+namespace {
+
+Vec3 transform_point(const Mat4& m, Vec3 p) { return Vec3(m * Vec4(p, 1.f)); }
+
+Float radians(Float degrees) { return degrees * kPi / 180.f; }
+
+// pbrt-v4 divides by SpectrumToPhotometric(spectrum), which for an RGB value
+// looks only at the colour space's illuminant: an "rgb" is used as given.
+// Blackbody and named spectra are already luminance-normalised by the
+// conversion to RGB, so the same holds for them.
+Rgb emission(const ParamSet& params, const std::string& name) { return params.get_rgb(name).value_or(Rgb(1.f)); }
+
+}  // namespace
+
+std::optional<Light> make_light(const std::string& type, const ParamSet& params, const Mat4& world_from_light,
+                                const DirectiveContext& ctx) {
+  Light l;
+  const Float scale = params.get_float("scale", 1.f);
+  if (type == "point") {
+    l.type = LightType::Point;
+    l.L = emission(params, "I") * scale;
+    // pbrt-v4: power sets the scale so that a white I emits `power`; the RGB
+    // colour itself is not taken into account.
+    if (Float power = params.get_float("power", -1.f); power > 0.f) l.L *= power / (4.f * kPi);
+    l.position = transform_point(world_from_light, params.get_point3("from").value_or(Vec3(0.f)));
+  } else if (type == "spot") {
+    l.type = LightType::Spot;
+    l.L = emission(params, "I") * scale;
+    const Float cone = params.get_float("coneangle", 30.f), delta = params.get_float("conedeltaangle", 5.f);
+    l.cos_falloff_end = std::cos(radians(cone));
+    l.cos_falloff_start = std::cos(radians(cone - delta));
+    if (Float power = params.get_float("power", -1.f); power > 0.f) {
+      Float k_e = 2.f * kPi * ((1.f - l.cos_falloff_start) + (l.cos_falloff_start - l.cos_falloff_end) / 2.f);
+      l.L *= power / k_e;
+    }
+    Vec3 from = params.get_point3("from").value_or(Vec3(0.f)), to = params.get_point3("to").value_or(Vec3(0.f, 0.f, 1.f));
+    if (from == to) ctx.fail("spot light \"from\" and \"to\" coincide");
+    l.position = transform_point(world_from_light, from);
+    l.direction = glm::normalize(Mat3(world_from_light) * (to - from));
+  } else if (type == "distant") {
+    l.type = LightType::Distant;
+    l.L = emission(params, "L") * scale;
+    if (Float e = params.get_float("illuminance", -1.f); e > 0.f) l.L *= e;
+    Vec3 from = params.get_point3("from").value_or(Vec3(0.f)), to = params.get_point3("to").value_or(Vec3(0.f, 0.f, 1.f));
+    if (from == to) ctx.fail("distant light \"from\" and \"to\" coincide");
+    l.direction = glm::normalize(Mat3(world_from_light) * (from - to));
+  } else if (type == "infinite") {
+    l.type = LightType::Infinite;
+    const bool has_l = params.find_any("L") != nullptr;
+    std::string filename = params.get_string("filename", "");
+    if (has_l && !filename.empty()) ctx.fail("infinite light takes either \"L\" or \"filename\", not both");
+    if (!filename.empty()) {
+      l.image = image_index(filename, params.get_string("encoding", "sRGB"), false, ctx);
+      const ImageDesc& img = ctx.scene.images[l.image];
+      if (img.width != img.height)
+        ctx.fail("infinite light image '" + img.path + "' is " + std::to_string(img.width) + "x" +
+                 std::to_string(img.height) + "; it must be square (equal-area octahedral)");
+      l.L = Rgb(scale);
+    } else {
+      l.L = emission(params, "L") * scale;
+    }
+    if (params.find_any("illuminance")) ctx.warn("infinite light \"illuminance\" is not supported; ignored");
+    if (params.find_any("portal")) ctx.warn("infinite light \"portal\" is not supported; ignored");
+    l.light_from_world = glm::inverse(Mat3(world_from_light));
+  } else {
+    ctx.warn("light \"" + type + "\" is not supported; skipped");
+    params.mark_all_used();
+    return std::nullopt;
+  }
+  return l;
+}
+
+AreaLightDesc make_area_light(const std::string& type, const ParamSet& params, const DirectiveContext& ctx) {
+  if (type != "diffuse") ctx.warn("area light \"" + type + "\" is not supported; using \"diffuse\"");
+  AreaLightDesc a;
+  a.L = emission(params, "L") * params.get_float("scale", 1.f);
+  a.two_sided = params.get_bool("twosided", false);
+  if (params.find_any("filename")) ctx.warn("image area lights (\"filename\") are not supported; using \"L\"");
+  if (params.find_any("power")) ctx.warn("area light \"power\" is not supported; ignored");
+  return a;
+}
+
+}  // namespace tessera

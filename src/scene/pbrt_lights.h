@@ -1,0 +1,21 @@
+// pbrt-v4 LightSource and AreaLightSource directives.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "scene/pbrt_context.h"
+
+namespace tessera {
+
+// point, spot, distant, infinite (constant "L" or equal-area "filename").
+// goniometric / projection / unknown: a warning and nullopt. `world_from_light`
+// is the CTM. Light "scale" (and "power"/"illuminance", as pbrt-v4 applies
+// them) are folded into L.
+std::optional<Light> make_light(const std::string& type, const ParamSet& params, const Mat4& world_from_light,
+                                const DirectiveContext& ctx);
+
+// AreaLightSource "diffuse". Other types warn and still give a diffuse emitter.
+AreaLightDesc make_area_light(const std::string& type, const ParamSet& params, const DirectiveContext& ctx);
+
+}  // namespace tessera

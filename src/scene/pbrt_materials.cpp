@@ -1,0 +1,128 @@
+#include "scene/pbrt_materials.h"
+
+#include <cmath>
+
+#include "scene/pbrt_textures.h"
+
+namespace tessera {
+namespace {
+
+// roughness / uroughness / vroughness / remaproughness, shared by the
+// microfacet materials. `prefix` selects e.g. "conductor." for coatedconductor.
+void read_roughness(Material& m, const ParamSet& params, const DirectiveContext& ctx, const std::string& prefix = "") {
+  Float r = constant_float(params, prefix + "roughness", 0.f, ctx);
+  Float u = constant_float(params, prefix + "uroughness", r, ctx);
+  Float v = constant_float(params, prefix + "vroughness", r, ctx);
+  if (params.get_bool("remaproughness", true)) {
+    u = roughness_to_alpha(u);
+    v = roughness_to_alpha(v);
+  }
+  m.alpha_x = u;
+  m.alpha_y = v;
+}
+
+// A dielectric index of refraction: a float, or a spectrum (named glasses)
+// read near 550 nm (green channel); dispersion is not modelled.
+Float read_ior(const ParamSet& params, const std::string& name, Float fallback, const DirectiveContext& ctx) {
+  if (params.get_texture(name)) {
+    ctx.warn("a texture for '" + name + "' is not supported; using " + std::to_string(fallback));
+    return fallback;
+  }
+  if (auto rgb = params.get_rgb(name, /*allow_float=*/true)) return rgb->y;
+  return fallback;
+}
+
+Rgb read_constant_rgb(const ParamSet& params, const std::string& name, Rgb fallback, const DirectiveContext& ctx) {
+  TextureSlot s = spectrum_slot(params, name, fallback, ctx);
+  if (s.texture < 0) return s.value;
+  const Texture& t = ctx.scene.textures[s.texture];
+  if (t.type == TextureType::Constant) return t.value;
+  ctx.warn("a non-constant texture for '" + name + "' is not supported; using its default");
+  return fallback;
+}
+
+void read_conductor(Material& m, const ParamSet& params, const DirectiveContext& ctx, const std::string& prefix) {
+  m.type = MaterialType::Conductor;
+  if (params.find_any(prefix + "reflectance")) {
+    m.conductor_from_reflectance = true;
+    m.reflectance = spectrum_slot(params, prefix + "reflectance", Rgb(1.f), ctx);
+  } else {
+    // A lone "float eta" is allowed too (grey).
+    const Material defaults;
+    m.eta = read_constant_rgb(params, prefix + "eta", defaults.eta, ctx);
+    if (auto f = params.get_float(prefix + "eta", -1.f); f > 0.f) m.eta = Rgb(f);
+    m.k = read_constant_rgb(params, prefix + "k", defaults.k, ctx);
+    if (auto f = params.get_float(prefix + "k", -1.f); f >= 0.f) m.k = Rgb(f);
+  }
+  read_roughness(m, params, ctx, prefix);
+}
+
+}  // namespace
+
+Float roughness_to_alpha(Float roughness) { return std::sqrt(std::max(roughness, 0.f)); }
+
+Material make_material(const std::string& type, const ParamSet& params, const DirectiveContext& ctx) {
+  Material m;
+  if (type == "diffuse") {
+    m.type = MaterialType::Diffuse;
+    m.reflectance = spectrum_slot(params, "reflectance", Rgb(0.5f), ctx);
+  } else if (type == "conductor") {
+    read_conductor(m, params, ctx, "");
+  } else if (type == "dielectric" || type == "thindielectric") {
+    if (type == "thindielectric") ctx.warn("thindielectric is approximated by dielectric (light refracts)");
+    m.type = MaterialType::Dielectric;
+    m.ior = read_ior(params, "eta", 1.5f, ctx);
+    read_roughness(m, params, ctx);
+  } else if (type == "coateddiffuse") {
+    m.type = MaterialType::CoatedDiffuse;
+    m.reflectance = spectrum_slot(params, "reflectance", Rgb(0.5f), ctx);
+    m.ior = read_ior(params, "eta", 1.5f, ctx);
+    read_roughness(m, params, ctx);
+    // Layer simulation controls: our coated model is analytic, so they do not apply.
+    params.find_any("thickness");
+    params.find_any("maxdepth");
+    params.find_any("nsamples");
+    if (params.find_any("albedo") || params.find_any("g"))
+      ctx.warn("coateddiffuse medium \"albedo\"/\"g\" are not supported; ignored");
+  } else if (type == "coatedconductor") {
+    ctx.warn("coatedconductor is approximated by its conductor layer");
+    read_conductor(m, params, ctx, "conductor.");
+    if (m.conductor_from_reflectance == false && params.find_any("reflectance")) {
+      m.conductor_from_reflectance = true;
+      m.reflectance = spectrum_slot(params, "reflectance", Rgb(1.f), ctx);
+    }
+    params.mark_all_used();  // interface.* etc.: approximated away, not unknown
+  } else if (type == "interface" || type == "none" || type == "") {
+    m.type = MaterialType::Interface;
+  } else if (type == "mix") {
+    m.type = MaterialType::Mix;
+    std::vector<std::string> names = params.get_strings("materials");
+    if (names.size() != 2) ctx.fail("mix material needs two names in \"string materials\"");
+    for (int i = 0; i < 2; ++i) {
+      auto it = ctx.names.materials.find(names[i]);
+      if (it == ctx.names.materials.end()) ctx.fail("unknown named material \"" + names[i] + "\" in mix");
+      m.mix[i] = it->second;
+    }
+    m.amount = float_slot(params, "amount", 0.5f, ctx);
+  } else if (type == "subsurface") {
+    ctx.warn("subsurface is approximated by dielectric (no scattering inside)");
+    m.type = MaterialType::Dielectric;
+    m.ior = read_ior(params, "eta", 1.33f, ctx);
+    read_roughness(m, params, ctx);
+    params.mark_all_used();
+  } else if (type == "diffusetransmission") {
+    ctx.warn("diffusetransmission is approximated by diffuse (no transmission)");
+    m.type = MaterialType::Diffuse;
+    m.reflectance = spectrum_slot(params, "reflectance", Rgb(0.25f), ctx);
+    params.mark_all_used();
+  } else {
+    ctx.warn("material \"" + type + "\" is not supported; using diffuse 0.5");
+    params.mark_all_used();
+  }
+  // Bump and normal maps would need tangent frames we do not carry.
+  if (params.find_any("displacement")) ctx.warn("\"displacement\" is not supported; ignored");
+  if (params.find_any("normalmap")) ctx.warn("\"normalmap\" is not supported; ignored");
+  return m;
+}
+
+}  // namespace tessera

@@ -1,0 +1,389 @@
+#include "scene/pbrt_parser.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "scene/pbrt_lights.h"
+#include "scene/pbrt_materials.h"
+#include "scene/pbrt_paths.h"
+#include "scene/pbrt_shapes.h"
+#include "scene/pbrt_textures.h"
+
+namespace tessera {
+namespace {
+
+constexpr int kMaxIncludeDepth = 32;
+
+[[noreturn]] void fail(const Token& at, const std::string& problem) { throw SceneError(at.where() + ": " + problem); }
+
+const Token& next_token(const std::vector<Token>& tokens, size_t& pos, const Token& at, const char* what) {
+  if (pos >= tokens.size()) fail(at, std::string("missing ") + what + " after " + at.text);
+  return tokens[pos++];
+}
+
+std::string read_string(const std::vector<Token>& tokens, size_t& pos, const Token& at) {
+  const Token& t = next_token(tokens, pos, at, "a quoted string");
+  if (t.kind != TokenKind::String) fail(t, "expected a quoted string after " + at.text + ", got '" + t.text + "'");
+  return t.text;
+}
+
+// `count` numbers, optionally bracketed (Transform [ ... ] and Transform ... are both seen).
+std::vector<Float> read_numbers(const std::vector<Token>& tokens, size_t& pos, size_t count, const Token& at) {
+  bool bracketed = pos < tokens.size() && tokens[pos].kind == TokenKind::OpenBracket;
+  if (bracketed) ++pos;
+  std::vector<Float> out;
+  while (out.size() < count) {
+    if (pos >= tokens.size() || (tokens[pos].kind == TokenKind::Word && is_pbrt_directive_name(tokens[pos].text)) ||
+        tokens[pos].kind == TokenKind::CloseBracket)
+      fail(at, at.text + " needs " + std::to_string(count) + " numbers, got " + std::to_string(out.size()));
+    const Token& t = tokens[pos++];
+    if (t.kind != TokenKind::Number) fail(t, "malformed number '" + t.text + "' for " + at.text);
+    out.push_back(static_cast<Float>(t.number));
+  }
+  if (bracketed) {
+    if (pos >= tokens.size() || tokens[pos].kind != TokenKind::CloseBracket)
+      fail(at, "unterminated array for " + at.text + " (expected " + std::to_string(count) + " numbers and ']')");
+    ++pos;
+  }
+  return out;
+}
+
+// Skips an unsupported directive's arguments: everything up to the next word
+// outside brackets that is not a bare bool.
+void skip_arguments(const std::vector<Token>& tokens, size_t& pos) {
+  int depth = 0;
+  while (pos < tokens.size()) {
+    const Token& t = tokens[pos];
+    if (t.kind == TokenKind::OpenBracket) ++depth;
+    else if (t.kind == TokenKind::CloseBracket) depth = depth > 0 ? depth - 1 : 0;
+    else if (t.kind == TokenKind::Word && depth == 0 && t.text != "true" && t.text != "false") return;
+    ++pos;
+  }
+}
+
+ParamSet read_params(const std::vector<Token>& tokens, size_t& pos, std::string owner, std::vector<std::string>& warnings) {
+  ParamSet ps(parse_param_list(tokens, pos), std::move(owner));
+  ps.warnings = &warnings;
+  return ps;
+}
+
+// pbrt-v4 LookAt: the camera-from-world transform of a camera at `eye`.
+Mat4 look_at(Vec3 eye, Vec3 target, Vec3 up, const Token& at, std::vector<std::string>& warnings) {
+  Vec3 dir = target - eye;
+  if (glm::length(dir) == 0.f) fail(at, "LookAt eye and target coincide");
+  dir = glm::normalize(dir);
+  Vec3 right = glm::cross(glm::normalize(up), dir);
+  if (!(glm::length(right) > 0.f)) {
+    warnings.push_back(at.where() + ": LookAt up vector is parallel to the view direction; ignored");
+    return Mat4(1.f);
+  }
+  right = glm::normalize(right);
+  Vec3 new_up = glm::cross(dir, right);
+  Mat4 world_from_camera(Vec4(right, 0.f), Vec4(new_up, 0.f), Vec4(dir, 0.f), Vec4(eye, 1.f));
+  return glm::inverse(world_from_camera);
+}
+
+bool is_world_directive(const std::string& d) {
+  return d == "Shape" || d == "Material" || d == "MakeNamedMaterial" || d == "NamedMaterial" || d == "Texture" ||
+         d == "LightSource" || d == "AreaLightSource" || d == "ObjectBegin" || d == "ObjectEnd" ||
+         d == "ObjectInstance" || d == "ReverseOrientation";
+}
+
+bool is_options_directive(const std::string& d) {
+  return d == "Camera" || d == "Film" || d == "Sampler" || d == "Integrator" || d == "PixelFilter" ||
+         d == "Accelerator";
+}
+
+std::string quoted(const std::string& directive, const std::string& type) { return directive + " \"" + type + "\""; }
+
+}  // namespace
+
+PbrtParser::PbrtParser(std::string search_dir) : search_dir_(std::move(search_dir)) {
+  scene_.materials.push_back(Material{});  // pbrt's default: diffuse 0.5
+}
+
+DirectiveContext PbrtParser::context(const Token& at, const std::string& including_dir) {
+  return DirectiveContext{scene_, names_, at.where(), including_dir, search_dir_};
+}
+
+void PbrtParser::parse_text(const std::string& text, const std::string& file_name, const std::string& including_dir) {
+  parse_tokens(tokenize_pbrt(text, file_name), including_dir);
+}
+
+void PbrtParser::parse_tokens(const std::vector<Token>& tokens, const std::string& including_dir) {
+  size_t pos = 0;
+  while (pos < tokens.size()) directive(tokens, pos, including_dir);
+}
+
+void PbrtParser::require_world(const Token& at, bool inside) const {
+  if (inside && !world_begun_) fail(at, "'" + at.text + "' before WorldBegin (missing WorldBegin?)");
+  if (!inside && world_begun_) fail(at, "'" + at.text + "' is not allowed after WorldBegin");
+}
+
+void PbrtParser::push(char kind, const Token& at) { stack_.push_back({kind, state_, at.where()}); }
+
+void PbrtParser::pop(char kind, const Token& at) {
+  if (stack_.empty()) {
+    const char* begin = kind == 'o' ? "ObjectBegin" : kind == 't' ? "TransformBegin" : "AttributeBegin";
+    fail(at, at.text + " without matching " + begin);
+  }
+  StackEntry e = stack_.back();
+  stack_.pop_back();
+  if (e.kind != kind)
+    scene_.warnings.push_back(at.where() + ": " + at.text + " closes the block opened at " + e.where);
+  if (kind == 't') {
+    state_.ctm = e.state.ctm;  // TransformEnd restores only the transform
+  } else {
+    state_ = e.state;
+  }
+}
+
+void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const std::string& including_dir) {
+  const Token& at = tokens[pos++];
+  if (at.kind != TokenKind::Word) fail(at, "expected a directive, got '" + at.text + "'");
+  const std::string& d = at.text;
+  if (is_world_directive(d)) require_world(at, true);
+  if (is_options_directive(d)) require_world(at, false);
+  std::vector<std::string>& warnings = scene_.warnings;
+  auto warn = [&](const std::string& m) { warnings.push_back(at.where() + ": " + m); };
+  Mat4& ctm = state_.ctm;
+
+  if (d == "Translate") {
+    std::vector<Float> v = read_numbers(tokens, pos, 3, at);
+    ctm = ctm * glm::translate(Mat4(1.f), Vec3(v[0], v[1], v[2]));
+  } else if (d == "Scale") {
+    std::vector<Float> v = read_numbers(tokens, pos, 3, at);
+    ctm = ctm * glm::scale(Mat4(1.f), Vec3(v[0], v[1], v[2]));
+  } else if (d == "Rotate") {
+    std::vector<Float> v = read_numbers(tokens, pos, 4, at);
+    Vec3 axis(v[1], v[2], v[3]);
+    if (glm::length(axis) == 0.f) fail(at, "Rotate axis is zero");
+    ctm = ctm * glm::rotate(Mat4(1.f), v[0] * kPi / 180.f, glm::normalize(axis));
+  } else if (d == "LookAt") {
+    std::vector<Float> v = read_numbers(tokens, pos, 9, at);
+    ctm = ctm * look_at(Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5]), Vec3(v[6], v[7], v[8]), at, warnings);
+  } else if (d == "Transform" || d == "ConcatTransform") {
+    // pbrt-v4 reads the 16 numbers row-major and transposes: they are the
+    // matrix's columns, exactly glm's storage order.
+    std::vector<Float> v = read_numbers(tokens, pos, 16, at);
+    Mat4 m = glm::make_mat4(v.data());
+    ctm = d == "Transform" ? m : ctm * m;
+  } else if (d == "Identity") {
+    ctm = Mat4(1.f);
+  } else if (d == "CoordinateSystem") {
+    coordinate_systems_[read_string(tokens, pos, at)] = ctm;
+  } else if (d == "CoordSysTransform") {
+    std::string name = read_string(tokens, pos, at);
+    auto it = coordinate_systems_.find(name);
+    if (it == coordinate_systems_.end()) warn("unknown coordinate system \"" + name + "\"; ignored");
+    else ctm = it->second;
+  } else if (d == "ReverseOrientation") {
+    state_.reverse_orientation = !state_.reverse_orientation;
+  } else if (d == "AttributeBegin") {
+    push('a', at);
+  } else if (d == "AttributeEnd") {
+    pop('a', at);
+  } else if (d == "TransformBegin" || d == "TransformEnd") {
+    warn(d + " is deprecated in pbrt-v4; treated as a transform-only block");
+    if (d == "TransformBegin") push('t', at);
+    else pop('t', at);
+  } else if (d == "Include" || d == "Import") {
+    std::string name = read_string(tokens, pos, at);
+    std::string path = resolve_scene_path(name, including_dir, search_dir_);
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail(at, d + " file '" + path + "' not found or unreadable");
+    if (include_depth_ >= kMaxIncludeDepth) fail(at, d + " nested too deeply (recursive include?)");
+    std::stringstream text;
+    text << in.rdbuf();
+    ++include_depth_;
+    parse_text(text.str(), path, directory_of(path));
+    --include_depth_;
+  } else if (d == "WorldBegin") {
+    if (world_begun_) fail(at, "WorldBegin appears twice");
+    world_begun_ = true;
+    ctm = Mat4(1.f);
+    coordinate_systems_["world"] = ctm;
+  } else if (d == "WorldEnd") {
+    warn("WorldEnd is pbrt-v3 syntax; ignored");
+  } else if (d == "Camera") {
+    std::string type = read_string(tokens, pos, at);
+    camera(at, type, read_params(tokens, pos, quoted(d, type), warnings));
+  } else if (d == "Film") {
+    std::string type = read_string(tokens, pos, at);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    if (type != "rgb" && type != "gbuffer" && type != "spectral") warn("film \"" + type + "\" treated as \"rgb\"");
+    scene_.film.xres = ps.get_int("xresolution", 1280);
+    scene_.film.yres = ps.get_int("yresolution", 720);
+    scene_.film.filename = ps.get_string("filename", scene_.film.filename);
+    if (scene_.film.xres <= 0 || scene_.film.yres <= 0) fail(at, "film resolution must be positive");
+    ps.report_unused(warnings);
+  } else if (d == "Sampler") {
+    std::string type = read_string(tokens, pos, at);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    scene_.spp = ps.get_int("pixelsamples", 16);
+    if (scene_.spp <= 0) fail(at, "pixelsamples must be positive");
+    scene_.seed = static_cast<uint64_t>(ps.get_int("seed", static_cast<int>(scene_.seed)));
+    ps.find_any("jitter");
+    ps.find_any("randomization");
+    ps.report_unused(warnings);
+  } else if (d == "Integrator") {
+    std::string type = read_string(tokens, pos, at);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    if (type != "path" && type != "volpath") warn("integrator \"" + type + "\" is rendered with \"path\"");
+    scene_.max_depth = ps.get_int("maxdepth", 5);
+    if (type != "path") ps.mark_all_used();
+    ps.report_unused(warnings);
+  } else if (d == "PixelFilter") {
+    std::string type = read_string(tokens, pos, at);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    FilterDesc f;
+    if (type == "box") {
+      f.type = FilterType::Box;
+      f.radius = ps.get_float("xradius", 0.5f);
+      ps.get_float("yradius", f.radius);
+    } else {
+      if (type != "gaussian") {
+        warn("pixel filter \"" + type + "\" is not supported; using \"gaussian\"");
+        ps.mark_all_used();
+      }
+      f.type = FilterType::Gaussian;
+      f.radius = ps.get_float("xradius", 1.5f);
+      ps.get_float("yradius", f.radius);
+      f.sigma = ps.get_float("sigma", 0.5f);
+    }
+    scene_.filter = f;
+    ps.report_unused(warnings);
+  } else if (d == "Material") {
+    std::string type = read_string(tokens, pos, at);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    scene_.materials.push_back(make_material(type, ps, context(at, including_dir)));
+    state_.material = static_cast<int32_t>(scene_.materials.size() - 1);
+    ps.report_unused(warnings);
+  } else if (d == "MakeNamedMaterial") {
+    std::string name = read_string(tokens, pos, at);
+    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings);
+    std::string type = ps.get_string("type", "");
+    if (type.empty()) fail(at, "MakeNamedMaterial \"" + name + "\" needs \"string type\"");
+    if (names_.materials.count(name)) warn("named material \"" + name + "\" redefined");
+    scene_.materials.push_back(make_material(type, ps, context(at, including_dir)));
+    names_.materials[name] = static_cast<int32_t>(scene_.materials.size() - 1);
+    ps.report_unused(warnings);
+  } else if (d == "NamedMaterial") {
+    std::string name = read_string(tokens, pos, at);
+    auto it = names_.materials.find(name);
+    if (it == names_.materials.end()) fail(at, "unknown named material \"" + name + "\"");
+    state_.material = it->second;
+  } else if (d == "Texture") {
+    std::string name = read_string(tokens, pos, at);
+    std::string kind = read_string(tokens, pos, at);
+    std::string cls = read_string(tokens, pos, at);
+    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings);
+    make_named_texture(name, kind, cls, ps, context(at, including_dir));
+    ps.report_unused(warnings);
+  } else if (d == "LightSource") {
+    std::string type = read_string(tokens, pos, at);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    if (auto light = make_light(type, ps, ctm, context(at, including_dir))) {
+      if (!open_instance_.empty()) warn("lights inside ObjectBegin are not instanced; added once");
+      scene_.lights.push_back(*light);
+    }
+    ps.report_unused(warnings);
+  } else if (d == "AreaLightSource") {
+    std::string type = read_string(tokens, pos, at);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    scene_.area_lights.push_back(make_area_light(type, ps, context(at, including_dir)));
+    state_.area_light = static_cast<int32_t>(scene_.area_lights.size() - 1);
+    ps.report_unused(warnings);
+  } else if (d == "Shape") {
+    std::string type = read_string(tokens, pos, at);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    shape(at, type, ps, including_dir);
+    ps.report_unused(warnings);
+  } else if (d == "ObjectBegin") {
+    std::string name = read_string(tokens, pos, at);
+    if (!open_instance_.empty()) fail(at, "ObjectBegin \"" + name + "\" inside ObjectBegin \"" + open_instance_ + "\"");
+    if (instances_.count(name)) warn("object \"" + name + "\" redefined");
+    push('o', at);
+    open_instance_ = name;
+    instances_[name].clear();
+  } else if (d == "ObjectEnd") {
+    if (open_instance_.empty()) fail(at, "ObjectEnd without matching ObjectBegin");
+    pop('o', at);
+    open_instance_.clear();
+  } else if (d == "ObjectInstance") {
+    std::string name = read_string(tokens, pos, at);
+    if (!open_instance_.empty()) fail(at, "ObjectInstance inside ObjectBegin \"" + open_instance_ + "\"");
+    auto it = instances_.find(name);
+    if (it == instances_.end()) fail(at, "unknown object \"" + name + "\"");
+    for (const MeshDesc& def : it->second) {
+      MeshDesc copy = def;
+      transform_mesh(copy, ctm);  // definitions are stored in world space of the definition
+      copy.where = at.where();
+      scene_.meshes.push_back(std::move(copy));
+    }
+  } else if (d == "ActiveTransform") {
+    const Token& which = next_token(tokens, pos, at, "All, StartTime or EndTime");
+    if (which.text != "All") warn("ActiveTransform " + which.text + " (motion blur) is not supported");
+  } else if (d == "TransformTimes") {
+    read_numbers(tokens, pos, 2, at);
+    warn("TransformTimes (motion blur) is not supported; ignored");
+  } else if (d == "ColorSpace" || d == "Option" || d == "Attribute" || d == "MakeNamedMedium" ||
+             d == "MediumInterface" || d == "Accelerator") {
+    warn("'" + d + "' is not supported; ignored");
+    skip_arguments(tokens, pos);
+  } else {
+    warn("unknown directive '" + d + "'; skipped");
+    skip_arguments(tokens, pos);
+  }
+}
+
+void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet& params) {
+  std::vector<std::string>& warnings = scene_.warnings;
+  if (type != "perspective") warnings.push_back(at.where() + ": camera \"" + type + "\" treated as \"perspective\"");
+  if (glm::determinant(state_.ctm) == 0.f) fail(at, "camera transform is singular");
+  scene_.camera.world_from_camera = glm::inverse(state_.ctm);
+  scene_.camera.fov_degrees = params.get_float("fov", 90.f);
+  scene_.camera.where = at.where();
+  coordinate_systems_["camera"] = scene_.camera.world_from_camera;
+  if (params.find_any("lensradius") || params.find_any("focaldistance"))
+    warnings.push_back(at.where() + ": depth of field (lensradius/focaldistance) is not supported; ignored");
+  if (type != "perspective") params.mark_all_used();
+  params.report_unused(warnings);
+}
+
+void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet& params,
+                       const std::string& including_dir) {
+  ShapeContext ctx{at.where(), including_dir, search_dir_, state_.ctm, state_.reverse_orientation, &scene_.warnings};
+  std::optional<MeshDesc> mesh = make_shape_mesh(type, params, ctx);
+  if (!mesh) {
+    params.mark_all_used();
+    return;
+  }
+  mesh->material = state_.material;
+  mesh->area_light = state_.area_light;
+  if (!open_instance_.empty()) {
+    if (mesh->area_light >= 0) {
+      scene_.warnings.push_back(at.where() + ": area lights inside ObjectBegin are not supported (as in pbrt-v4); not emissive");
+      mesh->area_light = -1;
+    }
+    instances_[open_instance_].push_back(std::move(*mesh));
+  } else {
+    scene_.meshes.push_back(std::move(*mesh));
+  }
+}
+
+SceneDesc PbrtParser::finish(const std::string& file_name, int last_line) {
+  const std::string where = file_name + ":" + std::to_string(last_line);
+  if (!world_begun_) throw SceneError(where + ": missing WorldBegin");
+  if (!open_instance_.empty()) scene_.warnings.push_back(where + ": ObjectBegin \"" + open_instance_ + "\" not closed");
+  for (const StackEntry& e : stack_)
+    if (e.kind != 'o') scene_.warnings.push_back(e.where + ": block not closed before end of file");
+  if (scene_.meshes.empty() && scene_.lights.empty()) throw SceneError(where + ": empty scene (no shapes and no lights)");
+  return std::move(scene_);
+}
+
+}  // namespace tessera

@@ -1,0 +1,60 @@
+// Walks pbrt-v4 directives, keeping pbrt's graphics state (transform,
+// orientation, material, area light; AttributeBegin/End stack; named
+// coordinate systems; object instances) and filling a SceneDesc.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "scene/pbrt_context.h"
+#include "scene/pbrt_tokenizer.h"
+
+namespace tessera {
+
+class PbrtParser {
+ public:
+  // `search_dir`: the main file's directory, the fallback for relative names.
+  explicit PbrtParser(std::string search_dir);
+
+  // Parses one file's text (Include/Import recurse into here). Throws SceneError.
+  void parse_text(const std::string& text, const std::string& file_name, const std::string& including_dir);
+
+  // Checks for a missing WorldBegin and an empty scene, reporting `file:last_line`.
+  SceneDesc finish(const std::string& file_name, int last_line);
+
+ private:
+  struct GraphicsState {
+    Mat4 ctm{1.f};
+    bool reverse_orientation = false;
+    int32_t material = 0;
+    int32_t area_light = -1;
+  };
+  struct StackEntry {
+    char kind;  // 'a' AttributeBegin, 't' TransformBegin, 'o' ObjectBegin
+    GraphicsState state;
+    std::string where;
+  };
+
+  void parse_tokens(const std::vector<Token>& tokens, const std::string& including_dir);
+  void directive(const std::vector<Token>& tokens, size_t& pos, const std::string& including_dir);
+  void shape(const Token& at, const std::string& type, const ParamSet& params, const std::string& including_dir);
+  void camera(const Token& at, const std::string& type, const ParamSet& params);
+  void push(char kind, const Token& at);
+  void pop(char kind, const Token& at);
+  void require_world(const Token& at, bool inside) const;
+  DirectiveContext context(const Token& at, const std::string& including_dir);
+
+  SceneDesc scene_;
+  NamedObjects names_;
+  std::string search_dir_;
+  GraphicsState state_;
+  std::vector<StackEntry> stack_;
+  std::map<std::string, Mat4> coordinate_systems_;
+  std::map<std::string, std::vector<MeshDesc>> instances_;
+  std::string open_instance_;  // non-empty between ObjectBegin and ObjectEnd
+  bool world_begun_ = false;
+  int include_depth_ = 0;
+};
+
+}  // namespace tessera

@@ -1,0 +1,228 @@
+#include "scene/pbrt_shapes.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "scene/pbrt_paths.h"
+#include "scene/ply_mesh.h"
+
+namespace tessera {
+namespace {
+
+[[noreturn]] void fail(const ShapeContext& ctx, const std::string& problem) {
+  throw SceneError(ctx.where + ": " + problem);
+}
+
+void warn(const ShapeContext& ctx, const std::string& message) {
+  if (ctx.warnings) ctx.warnings->push_back(ctx.where + ": " + message);
+}
+
+// Indices must be triangles (or patches of `per_face`) within the vertex list.
+std::vector<uint32_t> checked_indices(const std::vector<int>& raw, size_t vertex_count, size_t per_face,
+                                      const std::string& shape, const ShapeContext& ctx) {
+  if (raw.size() % per_face != 0)
+    fail(ctx, shape + " \"indices\" count " + std::to_string(raw.size()) + " is not a multiple of " +
+                  std::to_string(per_face));
+  std::vector<uint32_t> out;
+  out.reserve(raw.size());
+  for (int i : raw) {
+    if (i < 0 || static_cast<size_t>(i) >= vertex_count)
+      fail(ctx, shape + " index " + std::to_string(i) + " out of range (" + std::to_string(vertex_count) +
+                    " vertices)");
+    out.push_back(static_cast<uint32_t>(i));
+  }
+  return out;
+}
+
+// Optional per-vertex data must match the vertex count; pbrt-v4 drops it otherwise.
+template <typename T>
+void drop_if_mismatched(std::vector<T>& data, size_t vertex_count, const char* name, const ShapeContext& ctx) {
+  if (!data.empty() && data.size() != vertex_count) {
+    warn(ctx, std::string("\"") + name + "\" has " + std::to_string(data.size()) + " entries for " +
+                  std::to_string(vertex_count) + " vertices; ignored");
+    data.clear();
+  }
+}
+
+MeshDesc triangle_mesh(const ParamSet& params, const ShapeContext& ctx) {
+  MeshDesc m;
+  m.p = params.get_point3s("P");
+  if (m.p.empty()) fail(ctx, "trianglemesh needs \"point3 P\"");
+  std::vector<int> raw = params.get_ints("indices");
+  if (raw.empty()) {
+    if (m.p.size() != 3) fail(ctx, "trianglemesh needs \"integer indices\" unless it has exactly 3 vertices");
+    raw = {0, 1, 2};
+  }
+  m.indices = checked_indices(raw, m.p.size(), 3, "trianglemesh", ctx);
+  m.uv = params.get_point2s("uv");
+  if (m.uv.empty()) m.uv = params.get_point2s("st");  // pbrt-v3 name
+  m.n = params.get_normals("N");
+  drop_if_mismatched(m.uv, m.p.size(), "uv", ctx);
+  drop_if_mismatched(m.n, m.p.size(), "N", ctx);
+  if (params.find_any("S")) warn(ctx, "per-vertex tangents \"S\" are not supported; ignored");
+  return m;
+}
+
+MeshDesc bilinear_mesh(const ParamSet& params, const ShapeContext& ctx) {
+  std::vector<Vec3> p = params.get_point3s("P");
+  if (p.empty()) fail(ctx, "bilinearmesh needs \"point3 P\"");
+  std::vector<int> raw = params.get_ints("indices");
+  if (raw.empty()) {
+    if (p.size() != 4) fail(ctx, "bilinearmesh needs \"integer indices\" unless it has exactly 4 vertices");
+    raw = {0, 1, 2, 3};
+  }
+  std::vector<uint32_t> quads = checked_indices(raw, p.size(), 4, "bilinearmesh", ctx);
+  MeshDesc m;
+  m.p = std::move(p);
+  m.uv = params.get_point2s("uv");
+  m.n = params.get_normals("N");
+  drop_if_mismatched(m.uv, m.p.size(), "uv", ctx);
+  drop_if_mismatched(m.n, m.p.size(), "N", ctx);
+  // Patch (p00, p10, p01, p11): both halves keep pbrt's dpdu x dpdv orientation.
+  for (size_t q = 0; q < quads.size(); q += 4) {
+    uint32_t p00 = quads[q], p10 = quads[q + 1], p01 = quads[q + 2], p11 = quads[q + 3];
+    m.indices.insert(m.indices.end(), {p00, p10, p11, p00, p11, p01});
+  }
+  return m;
+}
+
+MeshDesc ply_mesh(const ParamSet& params, const ShapeContext& ctx) {
+  std::string name = params.get_string("filename", "");
+  if (name.empty()) fail(ctx, "plymesh needs \"string filename\"");
+  std::string path = resolve_scene_path(name, ctx.including_dir, ctx.search_dir);
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) fail(ctx, "plymesh file '" + path + "' not found");
+  PlyMesh ply;
+  try {
+    ply = load_ply_mesh(path);
+  } catch (const SceneError& e) {
+    fail(ctx, e.what());
+  }
+  MeshDesc m;
+  m.p = std::move(ply.p);
+  m.n = std::move(ply.n);
+  m.uv = std::move(ply.uv);
+  m.indices = std::move(ply.indices);
+  return m;
+}
+
+// Grid over (ring, segment) with quads split so that cross(p0 - p2, p1 - p2)
+// follows d(ring) x d(segment). Rows whose first or last ring collapses to a
+// point (sphere poles, disk centre) lose the degenerate half.
+void add_grid_triangles(MeshDesc& m, int rings, int segments, bool first_ring_is_point, bool last_ring_is_point) {
+  auto v = [&](int i, int j) { return static_cast<uint32_t>(i * (segments + 1) + j); };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      uint32_t a = v(i, j), b = v(i, j + 1), c = v(i + 1, j + 1), d = v(i + 1, j);
+      if (!(i == 0 && first_ring_is_point)) m.indices.insert(m.indices.end(), {d, b, a});
+      if (!(i == rings - 1 && last_ring_is_point)) m.indices.insert(m.indices.end(), {b, d, c});
+    }
+}
+
+constexpr int kSphereThetaSteps = 64, kSpherePhiSteps = 128;
+
+MeshDesc sphere_mesh(const ParamSet& params, const ShapeContext& ctx) {
+  const Float r = params.get_float("radius", 1.f);
+  const Float zmin = params.get_float("zmin", -r), zmax = params.get_float("zmax", r);
+  const Float phimax = params.get_float("phimax", 360.f);
+  if (zmin > -r || zmax < r || phimax < 360.f) warn(ctx, "partial spheres (zmin/zmax/phimax) are not supported; using a full sphere");
+  if (!(r > 0.f)) fail(ctx, "sphere radius must be positive");
+  MeshDesc m;
+  // Rings run from the +z pole (theta = 0) down, so d(theta) x d(phi) is outward.
+  for (int i = 0; i <= kSphereThetaSteps; ++i) {
+    Float theta = kPi * i / kSphereThetaSteps;
+    for (int j = 0; j <= kSpherePhiSteps; ++j) {
+      Float phi = 2.f * kPi * j / kSpherePhiSteps;
+      Vec3 dir(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+      if (i == 0 || i == kSphereThetaSteps) dir = Vec3(0.f, 0.f, i == 0 ? 1.f : -1.f);  // exact poles
+      m.p.push_back(r * dir);
+      m.n.push_back(dir);
+      m.uv.emplace_back(phi / (2.f * kPi), 1.f - theta / kPi);
+    }
+  }
+  add_grid_triangles(m, kSphereThetaSteps, kSpherePhiSteps, true, true);
+  return m;
+}
+
+constexpr int kDiskRings = 4, kDiskSegments = 128;
+
+MeshDesc disk_mesh(const ParamSet& params, const ShapeContext& ctx) {
+  const Float h = params.get_float("height", 0.f), radius = params.get_float("radius", 1.f);
+  const Float inner = params.get_float("innerradius", 0.f);
+  if (params.get_float("phimax", 360.f) < 360.f) warn(ctx, "partial disks (phimax) are not supported; using a full disk");
+  if (!(radius > inner) || inner < 0.f) fail(ctx, "disk needs 0 <= innerradius < radius");
+  MeshDesc m;
+  // Rings run outward, so d(r) x d(phi) is +z.
+  for (int i = 0; i <= kDiskRings; ++i) {
+    Float rr = inner + (radius - inner) * i / kDiskRings;
+    for (int j = 0; j <= kDiskSegments; ++j) {
+      Float phi = 2.f * kPi * j / kDiskSegments;
+      m.p.emplace_back(rr * std::cos(phi), rr * std::sin(phi), h);
+      m.uv.emplace_back(phi / (2.f * kPi), (radius - rr) / (radius - inner));
+    }
+  }
+  add_grid_triangles(m, kDiskRings, kDiskSegments, inner == 0.f, false);
+  return m;
+}
+
+Mat3 normal_matrix(const Mat4& m) { return glm::transpose(glm::inverse(Mat3(m))); }
+
+void check_finite(const MeshDesc& m, const ShapeContext& ctx) {
+  for (const Vec3& p : m.p)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      fail(ctx, "non-finite vertex coordinates (NaN or Inf)");
+}
+
+}  // namespace
+
+bool swaps_handedness(const Mat4& m) { return glm::determinant(Mat3(m)) < 0.f; }
+
+void transform_mesh(MeshDesc& mesh, const Mat4& m) {
+  for (Vec3& p : mesh.p) p = Vec3(m * Vec4(p, 1.f));
+  const Mat3 nm = normal_matrix(m);
+  for (Vec3& n : mesh.n) {
+    Vec3 t = nm * n;
+    Float len = glm::length(t);
+    n = len > 0.f ? t / len : n;
+  }
+  if (swaps_handedness(m)) mesh.flip_normals = !mesh.flip_normals;
+}
+
+std::optional<MeshDesc> make_shape_mesh(const std::string& type, const ParamSet& params, const ShapeContext& ctx) {
+  MeshDesc m;
+  bool quadric = false;
+  if (type == "trianglemesh") {
+    m = triangle_mesh(params, ctx);
+  } else if (type == "bilinearmesh") {
+    m = bilinear_mesh(params, ctx);
+  } else if (type == "plymesh") {
+    m = ply_mesh(params, ctx);
+  } else if (type == "sphere") {
+    m = sphere_mesh(params, ctx);
+    quadric = true;
+  } else if (type == "disk") {
+    m = disk_mesh(params, ctx);
+    quadric = true;
+  } else {
+    warn(ctx, "unsupported shape \"" + type + "\"; skipped");
+    return std::nullopt;
+  }
+  m.where = ctx.where;
+  transform_mesh(m, ctx.world_from_object);  // flip_normals = swaps handedness
+  const bool swaps = m.flip_normals;
+  if (!quadric) {
+    // Triangles: pbrt-v4 flips the world-space cross product.
+    m.flip_normals = ctx.reverse_orientation != swaps;
+  } else {
+    // Quadrics: pbrt-v4 flips the *object-space* normal for reverse XOR swaps and
+    // then transforms it, so a mirrored sphere faces inward. Reproduce that:
+    // the world normal is the transformed outward normal, negated for rev XOR swaps.
+    m.flip_normals = ctx.reverse_orientation;
+    if (ctx.reverse_orientation != swaps)
+      for (Vec3& n : m.n) n = -n;
+  }
+  check_finite(m, ctx);
+  return m;
+}
+
+}  // namespace tessera

@@ -1,0 +1,80 @@
+// What a scene file describes, in world space, before any acceleration
+// structure is built. Produced by the pbrt-v4 loader (pbrt_loader.h) or by
+// builtin_scenes.h; consumed by scene building (src/scene/scene.h).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "kernels/light.h"
+#include "kernels/material.h"
+
+namespace tessera {
+
+// Raised for malformed input. what() is one line: "file:line: problem".
+struct SceneError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct MeshDesc {
+  std::vector<Vec3> p;          // world-space positions
+  std::vector<Vec3> n;          // optional world-space shading normals (empty or p.size())
+  std::vector<Vec2> uv;         // optional (empty or p.size())
+  std::vector<uint32_t> indices;  // three per triangle, all < p.size()
+  int32_t material = 0;         // index into SceneDesc::materials
+  // pbrt's ReverseOrientation XOR "transform swaps handedness". The geometric
+  // normal is normalize(cross(p0 - p2, p1 - p2)), negated when this is set
+  // (when shading normals exist, it is instead flipped to their side).
+  bool flip_normals = false;
+  int32_t area_light = -1;      // index into SceneDesc::area_lights, -1 = not emissive
+  std::string where;            // "file:line" of the Shape directive, for messages
+};
+
+struct AreaLightDesc {
+  Rgb L{1.f};  // radiance with "scale" folded in
+  bool two_sided = false;
+};
+
+struct ImageDesc {
+  int32_t width = 0, height = 0;
+  std::vector<Rgb> texels;  // linear RGB, row 0 = top of the file
+  std::string path;
+};
+
+struct CameraDesc {
+  Mat4 world_from_camera{1.f};  // pbrt camera space: x right, y up, z forward (left-handed)
+  Float fov_degrees = 90.f;     // pbrt-v4: angle spanned by the shorter image axis
+  std::string where;
+};
+
+struct FilmDesc {
+  int32_t xres = 1280, yres = 720;
+  std::string filename = "pbrt.exr";
+};
+
+enum class FilterType : uint32_t { Gaussian = 0, Box };
+struct FilterDesc {
+  FilterType type = FilterType::Gaussian;
+  Float radius = 1.5f;  // pbrt-v4 defaults: gaussian radius 1.5, sigma 0.5; box radius 0.5
+  Float sigma = 0.5f;
+};
+
+struct SceneDesc {
+  CameraDesc camera;
+  FilmDesc film;
+  FilterDesc filter;
+  int32_t spp = 16;        // pbrt-v4 default pixelsamples
+  int32_t max_depth = 5;   // pbrt-v4 default maxdepth
+  uint64_t seed = 0;       // Sampler "integer seed"
+  std::vector<MeshDesc> meshes;
+  std::vector<Material> materials;  // never empty after loading (index 0 = pbrt's default diffuse 0.5)
+  std::vector<Texture> textures;
+  std::vector<ImageDesc> images;
+  std::vector<AreaLightDesc> area_lights;
+  std::vector<Light> lights;        // point, spot, distant, infinite (area lights come from meshes)
+  std::vector<std::string> warnings;  // "file:line: message", in order of appearance
+  std::string source;               // file name, or "<builtin:cornell-box>"
+};
+
+}  // namespace tessera

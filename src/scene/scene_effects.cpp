@@ -1,0 +1,92 @@
+#include "scene/scene_effects.h"
+
+#include <vector>
+
+#include "kernels/effects.h"
+
+namespace tessera {
+namespace {
+
+bool slot_textured(const TextureSlot& s) { return s.texture >= 0; }
+
+void add_material_effects(const SceneDesc& scene, int32_t index, uint32_t& e, int depth) {
+  if (index < 0 || index >= static_cast<int32_t>(scene.materials.size()) || depth > 16) return;
+  const Material& m = scene.materials[index];
+  const bool smooth = m.alpha_x < 1e-3f && m.alpha_y < 1e-3f;
+  switch (m.type) {
+    case MaterialType::Diffuse:
+      e |= kEffectDiffuse;
+      if (slot_textured(m.reflectance)) e |= kEffectTextures;
+      break;
+    case MaterialType::Conductor:
+      e |= smooth ? kEffectSpecular : kEffectGlossy;
+      if (m.conductor_from_reflectance && slot_textured(m.reflectance)) e |= kEffectTextures;
+      break;
+    case MaterialType::Dielectric:
+      e |= (smooth ? kEffectSpecular : kEffectGlossy) | kEffectTransmission;
+      break;
+    case MaterialType::CoatedDiffuse:
+      e |= kEffectDiffuse | (smooth ? kEffectSpecular : kEffectGlossy);
+      if (slot_textured(m.reflectance)) e |= kEffectTextures;
+      break;
+    case MaterialType::Interface:
+      e |= kEffectInterface;
+      break;
+    case MaterialType::Mix:
+      e |= kEffectMix;
+      if (slot_textured(m.amount)) e |= kEffectTextures;
+      add_material_effects(scene, m.mix[0], e, depth + 1);
+      add_material_effects(scene, m.mix[1], e, depth + 1);
+      break;
+  }
+}
+
+}  // namespace
+
+uint32_t compute_effects(const SceneDesc& scene) {
+  uint32_t e = 0;
+  std::vector<bool> seen(scene.materials.size(), false);
+  for (const MeshDesc& m : scene.meshes) {
+    if (m.indices.empty()) continue;
+    if (m.material >= 0 && m.material < static_cast<int32_t>(seen.size()) && !seen[m.material]) {
+      seen[m.material] = true;
+      add_material_effects(scene, m.material, e, 0);
+    }
+    if (m.area_light >= 0) e |= kEffectAreaLights;
+    if (!m.n.empty()) e |= kEffectShadingNormals;
+  }
+  for (const Light& l : scene.lights) {
+    if (l.type == LightType::Infinite) e |= kEffectEnvironment;
+    else if (l.type != LightType::Area) e |= kEffectDeltaLights;
+  }
+  return e;
+}
+
+std::string describe_effects(uint32_t e) {
+  static const char* names[] = {"diffuse", "glossy", "specular", "transmission", "textures", "area-lights",
+                                "delta-lights", "environment", "mix", "interface", "shading-normals"};
+  std::string out;
+  for (uint32_t i = 0; i < sizeof(names) / sizeof(names[0]); ++i) {
+    if (e & (1u << i)) {
+      if (!out.empty()) out += ", ";
+      out += names[i];
+    }
+  }
+  return out.empty() ? "none" : out;
+}
+
+std::string describe_specialisation(uint32_t s) {
+  if (s == kSpecAll) return "full";
+  static const char* names[] = {"non-diffuse-bsdfs", "textures", "area-lights", "delta-lights", "environment"};
+  std::string out;
+  for (uint32_t i = 0; i < 5; ++i) {
+    if (s & (1u << i)) {
+      if (!out.empty()) out += "+";
+      out += names[i];
+    }
+  }
+  if (s & kSpecNonDiffuse) return out;
+  return out.empty() ? "lambertian-only" : "lambertian-only+" + out;
+}
+
+}  // namespace tessera

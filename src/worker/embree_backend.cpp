@@ -1,0 +1,43 @@
+#include "worker/embree_backend.h"
+
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace tessera {
+namespace {
+
+void embree_error(void*, RTCError code, const char* message) {
+  if (code == RTC_ERROR_NONE) return;
+  throw std::runtime_error(std::string("embree: ") + (message ? message : "unknown error"));
+}
+
+}  // namespace
+
+EmbreeScene::EmbreeScene(const SceneData& data) {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw std::runtime_error("embree: cannot create device");
+  rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
+  scene_ = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+  const size_t nv = data.positions().size(), nt = data.num_triangles();
+  if (nt > 0) {
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    // New buffers (not shared) so Embree owns the padding it needs past the end.
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
+    std::memcpy(v, data.positions().data(), nv * 3 * sizeof(float));
+    auto* ix = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), nt));
+    std::memcpy(ix, data.indices().data(), nt * 3 * sizeof(uint32_t));
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene_, geom);
+    rtcReleaseGeometry(geom);
+  }
+  rtcCommitScene(scene_);
+}
+
+EmbreeScene::~EmbreeScene() {
+  if (scene_) rtcReleaseScene(scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+}  // namespace tessera

@@ -1,0 +1,60 @@
+#include "worker/render_tile.h"
+
+#include <array>
+#include <utility>
+
+namespace tessera {
+namespace {
+
+template <uint32_t Spec>
+TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, const TileSettings& settings,
+                              const TileJob& job, Film& film) {
+  TileCounters tc;
+  for (int32_t y = job.y0; y < job.y1; ++y) {
+    for (int32_t x = job.x0; x < job.x1; ++x) {
+      const uint64_t pixel_index = static_cast<uint64_t>(y) * static_cast<uint64_t>(film.width) + x;
+      PixelAccum& acc = film.at(x, y);
+      for (uint32_t si = job.sample_begin; si < job.sample_end; ++si) {
+        Rng rng = Rng::for_sample(settings.seed, pixel_index, si);
+        Vec2 offset = sample_filter_offset(s.filter, rng.uniform2());
+        Vec2 p_film(x + 0.5f + offset.x, y + 0.5f + offset.y);
+        Ray ray = generate_camera_ray(s.camera, p_film);
+        Rgb L = trace_path<Spec>(s, tracer, ray, rng, settings.path, tc.path);
+        if (!is_finite(L)) {
+          ++tc.rejected_nonfinite;
+          L = Rgb(0.f);
+        } else if (L.x < 0.f || L.y < 0.f || L.z < 0.f) {
+          ++tc.rejected_negative;
+          L = glm::max(L, Rgb(0.f));
+        }
+        if (is_black(L)) ++tc.zero_radiance;
+        for (int c = 0; c < 3; ++c) {
+          acc.sum[c] += L[c];
+          acc.sum_sq[c] += static_cast<double>(L[c]) * L[c];
+        }
+        ++acc.n;
+        ++tc.samples;
+      }
+    }
+  }
+  return tc;
+}
+
+using TileFn = TileCounters (*)(const SceneView&, const EmbreeTracer&, const TileSettings&, const TileJob&, Film&);
+
+template <size_t... I>
+constexpr std::array<TileFn, sizeof...(I)> make_table(std::index_sequence<I...>) {
+  return {&render_tile_spec<static_cast<uint32_t>(I)>...};
+}
+
+// One instantiation per specialisation; chosen once per tile.
+constexpr auto kTileFns = make_table(std::make_index_sequence<kSpecAll + 1>{});
+
+}  // namespace
+
+TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, const TileSettings& settings,
+                         const TileJob& job, Film& film) {
+  return kTileFns[settings.specialisation & kSpecAll](scene, tracer, settings, job, film);
+}
+
+}  // namespace tessera

@@ -1,0 +1,46 @@
+// The worker's core: render a rectangle of pixels for a range of sample
+// indices into the film, a pure function of (scene, job, seed).
+#pragma once
+
+#include <cstdint>
+
+#include "kernels/integrator.h"
+#include "master/film.h"
+#include "worker/embree_backend.h"
+
+namespace tessera {
+
+struct TileJob {
+  int32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // [x0, x1) x [y0, y1)
+  uint32_t sample_begin = 0, sample_end = 0;
+};
+
+struct TileSettings {
+  uint64_t seed = 0;
+  PathSettings path;
+  uint32_t specialisation = kSpecAll;
+};
+
+struct TileCounters {
+  PathCounters path;
+  uint64_t samples = 0;
+  uint64_t zero_radiance = 0;    // samples whose estimate is exactly black
+  uint64_t rejected_nonfinite = 0;  // NaN/Inf estimates replaced by 0 (and counted)
+  uint64_t rejected_negative = 0;
+
+  void add(const TileCounters& o) {
+    path.rays += o.path.rays;
+    path.shadow_rays += o.path.shadow_rays;
+    path.vertices += o.path.vertices;
+    path.interface_skips += o.path.interface_skips;
+    samples += o.samples;
+    zero_radiance += o.zero_radiance;
+    rejected_nonfinite += o.rejected_nonfinite;
+    rejected_negative += o.rejected_negative;
+  }
+};
+
+TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, const TileSettings& settings,
+                         const TileJob& job, Film& film);
+
+}  // namespace tessera

@@ -1,0 +1,178 @@
+#include "worker/scene_data.h"
+
+#include <cmath>
+
+#include "kernels/equal_area.h"
+#include "kernels/vecmath.h"
+#include "scene/scene_effects.h"
+
+namespace tessera {
+
+SceneData::SceneData(SceneDesc desc) : desc_(std::move(desc)) {
+  effects_ = compute_effects(desc_);
+  flatten_meshes();
+  if (triangles_.empty() && desc_.lights.empty()) {
+    throw SceneError(desc_.source + ": empty scene (no shapes and no lights)");
+  }
+  build_lights();
+  build_camera();
+  build_filter();
+  build_view();
+}
+
+void SceneData::flatten_meshes() {
+  for (const MeshDesc& m : desc_.meshes) {
+    const uint32_t base = static_cast<uint32_t>(positions_.size());
+    const bool has_n = !m.n.empty(), has_uv = !m.uv.empty();
+    for (size_t i = 0; i < m.p.size(); ++i) {
+      positions_.push_back(m.p[i]);
+      normals_.push_back(has_n ? m.n[i] : Vec3(0.f));
+      uvs_.push_back(has_uv ? m.uv[i] : Vec2(0.f));
+      bounds_.lo = glm::min(bounds_.lo, m.p[i]);
+      bounds_.hi = glm::max(bounds_.hi, m.p[i]);
+    }
+    TriangleInfo info;
+    info.material = m.material;
+    info.flags = (m.flip_normals ? kTriFlipNormal : 0u) | (has_n ? kTriHasNormals : 0u) | (has_uv ? kTriHasUv : 0u);
+    for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+      const Vec3 &a = m.p[m.indices[t]], &b = m.p[m.indices[t + 1]], &c = m.p[m.indices[t + 2]];
+      // Degenerate triangles can never be hit or sampled; dropping them keeps
+      // area-light pdfs finite.
+      if (glm::length(glm::cross(b - a, c - a)) <= 0.f) continue;
+      for (int k = 0; k < 3; ++k) indices_.push_back(base + m.indices[t + k]);
+      TriangleInfo ti = info;
+      if (m.area_light >= 0) {
+        const AreaLightDesc& al = desc_.area_lights[m.area_light];
+        if (!is_black(al.L)) {
+          Light l;
+          l.type = LightType::Area;
+          l.L = al.L;
+          l.two_sided = al.two_sided;
+          l.triangle = static_cast<uint32_t>(triangles_.size());
+          l.area = 0.5f * glm::length(glm::cross(b - a, c - a));
+          ti.light = static_cast<int32_t>(lights_.size());
+          lights_.push_back(l);
+        }
+      }
+      triangles_.push_back(ti);
+    }
+  }
+}
+
+void SceneData::build_lights() {
+  for (const Light& l : desc_.lights) lights_.push_back(l);
+  Vec3 center = triangles_.empty() ? Vec3(0.f) : 0.5f * (bounds_.lo + bounds_.hi);
+  Float radius = triangles_.empty() ? 1.f : glm::max(1e-3f, 0.5f * glm::length(bounds_.hi - bounds_.lo));
+
+  image_views_.reserve(desc_.images.size());
+  for (const ImageDesc& img : desc_.images) image_views_.push_back(ImageView{img.width, img.height, img.texels.data()});
+
+  env_storage_.resize(lights_.size());
+  std::vector<Float> power(lights_.size(), 0.f);
+  for (size_t i = 0; i < lights_.size(); ++i) {
+    const Light& l = lights_[i];
+    switch (l.type) {
+      case LightType::Area: {
+        power[i] = luminance(l.L) * l.area * kPi * (l.two_sided ? 2.f : 1.f);
+        break;
+      }
+      case LightType::Point: power[i] = 4.f * kPi * luminance(l.L); break;
+      case LightType::Spot:
+        power[i] = luminance(l.L) * 2.f * kPi * (1.f - 0.5f * (l.cos_falloff_start + l.cos_falloff_end));
+        break;
+      case LightType::Distant: power[i] = luminance(l.L) * kPi * radius * radius; break;
+      case LightType::Infinite: {
+        infinite_lights_.push_back(static_cast<int32_t>(i));
+        Float avg = luminance(l.L);
+        if (l.image >= 0) {
+          const ImageDesc& img = desc_.images[l.image];
+          std::vector<Float> f(img.texels.size());
+          double sum = 0.0;
+          for (size_t p = 0; p < f.size(); ++p) {
+            f[p] = luminance(img.texels[p]);
+            sum += f[p];
+          }
+          env_storage_[i] = Distribution2D(f, img.width, img.height);
+          avg *= static_cast<Float>(sum / std::max<size_t>(1, f.size()));
+        }
+        power[i] = 4.f * kPi * kPi * radius * radius * avg;
+        break;
+      }
+    }
+  }
+  light_select_ = Distribution1D(power);
+  env_views_.resize(lights_.size());
+  for (size_t i = 0; i < lights_.size(); ++i) env_views_[i] = env_storage_[i].view();
+  view_.scene_center = center;
+  view_.scene_radius = radius;
+}
+
+void SceneData::build_camera() {
+  const FilmDesc& film = desc_.film;
+  camera_.width = film.xres;
+  camera_.height = film.yres;
+  camera_.world_from_camera_linear = Mat3(desc_.camera.world_from_camera);
+  camera_.origin = Vec3(desc_.camera.world_from_camera * Vec4(0.f, 0.f, 0.f, 1.f));
+  Float aspect = static_cast<Float>(film.xres) / static_cast<Float>(film.yres);
+  if (aspect > 1.f) {
+    camera_.screen_min = Vec2(-aspect, -1.f);
+    camera_.screen_max = Vec2(aspect, 1.f);
+  } else {
+    camera_.screen_min = Vec2(-1.f, -1.f / aspect);
+    camera_.screen_max = Vec2(1.f, 1.f / aspect);
+  }
+  camera_.tan_half_fov = std::tan(glm::radians(desc_.camera.fov_degrees) * 0.5f);
+}
+
+void SceneData::build_filter() {
+  // Tabulate one axis of the separable filter; sampling it with weight 1 is
+  // filter importance sampling (pbrt-v4's default for the Gaussian).
+  const FilterDesc& f = desc_.filter;
+  constexpr int kBins = 256;
+  std::vector<Float> table(kBins, 1.f);
+  if (f.type == FilterType::Gaussian) {
+    auto g = [&](Float x) { return std::exp(-x * x / (2.f * f.sigma * f.sigma)); };
+    for (int i = 0; i < kBins; ++i) {
+      Float x = ((i + 0.5f) / kBins * 2.f - 1.f) * f.radius;
+      table[i] = std::max(0.f, g(x) - g(f.radius));
+    }
+  }
+  Distribution1D dist(table);
+  constexpr int kInverseSize = 1025;
+  filter_inverse_cdf_.resize(kInverseSize);
+  for (int i = 0; i < kInverseSize; ++i) {
+    Float u = std::min(static_cast<Float>(i) / (kInverseSize - 1), 0x1.fffffep-1f);
+    Float x = dist.view().sample_continuous(u, nullptr, nullptr);
+    filter_inverse_cdf_[i] = (2.f * x - 1.f) * f.radius;
+  }
+  filter_inverse_cdf_.back() = f.radius;
+}
+
+void SceneData::build_view() {
+  SceneView& v = view_;
+  v.positions = positions_.data();
+  v.normals = normals_.data();
+  v.uvs = uvs_.data();
+  v.indices = indices_.data();
+  v.triangles = triangles_.data();
+  v.num_triangles = static_cast<uint32_t>(triangles_.size());
+  v.materials = desc_.materials.data();
+  v.num_materials = static_cast<uint32_t>(desc_.materials.size());
+  v.textures = desc_.textures.data();
+  v.images = image_views_.data();
+  v.lights = lights_.data();
+  v.num_lights = static_cast<uint32_t>(lights_.size());
+  v.light_select = light_select_.view();
+  v.infinite_lights = infinite_lights_.data();
+  v.num_infinite_lights = static_cast<uint32_t>(infinite_lights_.size());
+  v.env_distributions = env_views_.data();
+  v.camera = camera_;
+  v.filter.inverse_cdf = filter_inverse_cdf_.data();
+  v.filter.n = static_cast<uint32_t>(filter_inverse_cdf_.size());
+  v.filter.radius = desc_.filter.radius;
+  // Offsets relative to coordinate magnitude: float carries ~7 digits, the
+  // reconstructed hit point is good to a few ulps.
+  v.ray_epsilon = 1e-4f;
+}
+
+}  // namespace tessera

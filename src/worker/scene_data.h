@@ -1,0 +1,61 @@
+// A scene flattened into the arrays kernels read (kernels/scene_view.h):
+// all meshes merged into one triangle list, one Light per emissive triangle,
+// distributions for light selection, environment maps and the pixel filter.
+// Owns the memory; view() stays valid while the SceneData lives and is not moved.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "kernels/scene_view.h"
+#include "scene/scene_desc.h"
+#include "worker/distribution_build.h"
+
+namespace tessera {
+
+struct Bounds {
+  Vec3 lo{3.4e38f}, hi{-3.4e38f};
+};
+
+class SceneData {
+ public:
+  // The film resolution and camera come from desc (apply command-line
+  // overrides to desc first). Throws SceneError for an empty scene.
+  explicit SceneData(SceneDesc desc);
+  SceneData(const SceneData&) = delete;
+  SceneData& operator=(const SceneData&) = delete;
+
+  const SceneView& view() const { return view_; }
+  const SceneDesc& desc() const { return desc_; }
+  uint32_t effects() const { return effects_; }
+  const Bounds& bounds() const { return bounds_; }
+  size_t num_triangles() const { return triangles_.size(); }
+  const std::vector<Vec3>& positions() const { return positions_; }
+  const std::vector<uint32_t>& indices() const { return indices_; }
+
+ private:
+  void flatten_meshes();
+  void build_lights();
+  void build_camera();
+  void build_filter();
+  void build_view();
+
+  SceneDesc desc_;
+  uint32_t effects_ = 0;
+  Bounds bounds_;
+  std::vector<Vec3> positions_, normals_;
+  std::vector<Vec2> uvs_;
+  std::vector<uint32_t> indices_;
+  std::vector<TriangleInfo> triangles_;
+  std::vector<ImageView> image_views_;
+  std::vector<Light> lights_;
+  std::vector<int32_t> infinite_lights_;
+  Distribution1D light_select_;
+  std::vector<Distribution2D> env_storage_;     // one per light (empty for non-image lights)
+  std::vector<Distribution2DView> env_views_;
+  std::vector<Float> filter_inverse_cdf_;
+  CameraView camera_;
+  SceneView view_;
+};
+
+}  // namespace tessera

@@ -1,0 +1,142 @@
+// The binary end to end: bad input gets one clear line naming file:line and a
+// non-zero exit; good input writes EXR + PNG; compare reports sizes.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "render_helpers.h"
+
+namespace tessera {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int exit_code;
+  std::string output;  // stdout + stderr
+};
+
+RunResult run(const std::string& args) {
+  std::string cmd = std::string(TESSERA_BINARY) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
+  int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128, out};
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("tessera_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+    return (dir_ / name).string();
+  }
+  fs::path dir_;
+};
+
+const char* kHeader = R"(LookAt 0 0 -5 0 0 0 0 1 0
+Camera "perspective" "float fov" [ 40 ]
+Film "rgb" "integer xresolution" [ 8 ] "integer yresolution" [ 8 ]
+WorldBegin
+LightSource "point" "rgb I" [ 1 1 1 ] "point3 from" [ 0 0 -2 ]
+)";
+
+void expect_one_line_error(const RunResult& r, const std::string& where) {
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(where), std::string::npos) << "expected '" << where << "' in: " << r.output;
+  EXPECT_NE(r.output.find("error"), std::string::npos) << r.output;
+  size_t lines = 0;
+  for (char c : r.output) lines += c == '\n';
+  EXPECT_EQ(lines, 1u) << r.output;
+}
+
+TEST_F(CliTest, BadNumber) {
+  auto f = write("bad_number.pbrt", std::string(kHeader) + "Shape \"sphere\" \"float radius\" [ 1.2.3 ]\n");
+  expect_one_line_error(run("render -q " + f + " -o " + (dir_ / "x.exr").string()), "bad_number.pbrt:6");
+}
+
+TEST_F(CliTest, NanCoordinate) {
+  auto f = write("nan.pbrt", std::string(kHeader) +
+                                 "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 nan 1 0 ] \"integer indices\" [ 0 1 2 ]\n");
+  expect_one_line_error(run("render -q " + f), "nan.pbrt:6");
+}
+
+TEST_F(CliTest, IndexOutOfRange) {
+  auto f = write("index.pbrt", std::string(kHeader) +
+                                   "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 7 ]\n");
+  expect_one_line_error(run("render -q " + f), "index.pbrt:6");
+}
+
+TEST_F(CliTest, MissingInclude) {
+  auto f = write("include.pbrt", std::string(kHeader) + "Include \"nowhere.pbrt\"\n");
+  expect_one_line_error(run("render -q " + f), "include.pbrt:6");
+}
+
+TEST_F(CliTest, MissingPly) {
+  auto f = write("ply.pbrt", std::string(kHeader) + "Shape \"plymesh\" \"string filename\" \"missing.ply\"\n");
+  expect_one_line_error(run("render -q " + f), "ply.pbrt:6");
+}
+
+TEST_F(CliTest, EmptyScene) {
+  auto f = write("empty.pbrt", "Camera \"perspective\"\nWorldBegin\n");
+  RunResult r = run("render -q " + f);
+  expect_one_line_error(r, "empty.pbrt");
+}
+
+TEST_F(CliTest, MissingSceneFile) {
+  RunResult r = run("render -q " + (dir_ / "does-not-exist.pbrt").string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("does-not-exist.pbrt"), std::string::npos) << r.output;
+}
+
+TEST_F(CliTest, UnknownDirectiveWarnsAndRenders) {
+  auto f = write("warn.pbrt", std::string(kHeader) + "FancyDirective 1 2 3\nShape \"sphere\"\n");
+  std::string out = (dir_ / "warn.exr").string();
+  RunResult r = run("render -q --spp 2 " + f + " -o " + out);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("warn.pbrt:6"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_TRUE(fs::exists(dir_ / "warn.png"));
+}
+
+TEST_F(CliTest, RenderStatsAndCompare) {
+  std::string a = (dir_ / "a.exr").string(), b = (dir_ / "b.exr").string(), c = (dir_ / "c.exr").string();
+  std::string stats = (dir_ / "stats.json").string();
+  ASSERT_EQ(run("render -q --res 24x16 --spp 4 --seed 3 -o " + a + " --stats " + stats).exit_code, 0);
+  ASSERT_EQ(run("render -q --res 24x16 --spp 4 --seed 3 --threads 1 -o " + b).exit_code, 0);
+  std::ifstream js(stats);
+  std::string json((std::istreambuf_iterator<char>(js)), {});
+  for (const char* key : {"\"spp\": 4", "\"samples_per_second\"", "\"rays_per_second\"", "\"mean_path_length\"",
+                          "\"zero_contribution_fraction\"", "\"nonfinite_samples_rejected\": 0", "\"effects\""})
+    EXPECT_NE(json.find(key), std::string::npos) << key << " in " << json;
+  // Same seed, different thread count: identical images, zero error.
+  RunResult same = run("compare --json " + a + " " + b);
+  EXPECT_EQ(same.exit_code, 0);
+  EXPECT_NE(same.output.find("\"relmse\": 0,"), std::string::npos) << same.output;
+  ASSERT_EQ(run("render -q --res 16x16 --spp 1 -o " + c).exit_code, 0);
+  RunResult mismatch = run("compare " + a + " " + c);
+  EXPECT_NE(mismatch.exit_code, 0);
+  EXPECT_NE(mismatch.output.find("sizes differ"), std::string::npos) << mismatch.output;
+}
+
+TEST_F(CliTest, InfoPrintsEffects) {
+  RunResult r = run("info");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.output.find("effects:        diffuse, area-lights"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("36 triangles"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace tessera

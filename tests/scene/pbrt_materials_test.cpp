@@ -1,0 +1,164 @@
+// Materials, named materials, textures and the images they load.
+#include <stb/stb_image_write.h>
+
+#include <ImfRgbaFile.h>
+
+#include "scene/image_io.h"
+#include "scene/pbrt_materials.h"
+#include "scene_test_helpers.h"
+
+namespace tessera {
+namespace {
+
+using test::kTriangle;
+using test::load_world;
+
+const Material& material_of_last_mesh(const SceneDesc& s) { return s.materials.at(s.meshes.back().material); }
+
+TEST(PbrtMaterials, DiffuseAndNamedMaterials) {
+  SceneDesc s = load_world(std::string("MakeNamedMaterial \"red\" \"string type\" \"diffuse\" \"rgb reflectance\" [ 0.6 0.1 0.1 ]\n") +
+                           kTriangle + "NamedMaterial \"red\"\n" + kTriangle);
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_EQ(s.meshes[0].material, 0);
+  const Material& m = material_of_last_mesh(s);
+  EXPECT_EQ(m.type, MaterialType::Diffuse);
+  EXPECT_VEC3_NEAR(m.reflectance.value, Vec3(0.6f, 0.1f, 0.1f), 1e-6f);
+}
+
+TEST(PbrtMaterials, ConductorNamedSpectraAndRoughnessRemap) {
+  SceneDesc s = load_world(std::string("Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\""
+                                       " \"float roughness\" 0.09\n") + kTriangle);
+  const Material& m = material_of_last_mesh(s);
+  EXPECT_EQ(m.type, MaterialType::Conductor);
+  EXPECT_VEC3_NEAR(m.eta, Vec3(0.143f, 0.375f, 1.442f), 1e-3f);
+  EXPECT_VEC3_NEAR(m.k, Vec3(3.983f, 2.386f, 1.603f), 1e-3f);
+  EXPECT_NEAR(m.alpha_x, 0.3f, 1e-6f);
+  EXPECT_NEAR(m.alpha_y, 0.3f, 1e-6f);
+  s = load_world(std::string("Material \"conductor\" \"float uroughness\" 0.2 \"float vroughness\" 0.1 "
+                             "\"bool remaproughness\" false\n") + kTriangle);
+  EXPECT_FLOAT_EQ(material_of_last_mesh(s).alpha_x, 0.2f);
+  EXPECT_FLOAT_EQ(material_of_last_mesh(s).alpha_y, 0.1f);
+  EXPECT_VEC3_NEAR(material_of_last_mesh(s).eta, Vec3(0.2004f, 0.924f, 1.1022f), 1e-3f);  // metal-Cu default
+  s = load_world(std::string("Material \"conductor\" \"rgb reflectance\" [ 0.9 0.8 0.7 ]\n") + kTriangle);
+  EXPECT_TRUE(material_of_last_mesh(s).conductor_from_reflectance);
+  EXPECT_VEC3_NEAR(material_of_last_mesh(s).reflectance.value, Vec3(0.9f, 0.8f, 0.7f), 1e-6f);
+}
+
+TEST(PbrtMaterials, DielectricCoatedInterfaceMix) {
+  SceneDesc s = load_world(std::string("Material \"dielectric\" \"spectrum eta\" \"glass-BK7\"\n") + kTriangle +
+                           "Material \"dielectric\"\n" + kTriangle +
+                           "Material \"coateddiffuse\" \"rgb reflectance\" [ 0.2 0.3 0.4 ] \"float roughness\" 0.25 "
+                           "\"float thickness\" 0.02\n" + kTriangle + "Material \"interface\"\n" + kTriangle +
+                           "MakeNamedMaterial \"a\" \"string type\" \"diffuse\"\nMakeNamedMaterial \"b\" \"string type\" \"conductor\"\n"
+                           "Material \"mix\" \"string materials\" [ \"a\" \"b\" ] \"float amount\" 0.3\n" + kTriangle);
+  ASSERT_EQ(s.meshes.size(), 5u);
+  const Material& glass = s.materials[s.meshes[0].material];
+  EXPECT_EQ(glass.type, MaterialType::Dielectric);
+  EXPECT_NEAR(glass.ior, 1.5168f, 1e-3f);
+  EXPECT_FLOAT_EQ(s.materials[s.meshes[1].material].ior, 1.5f);
+  const Material& coated = s.materials[s.meshes[2].material];
+  EXPECT_EQ(coated.type, MaterialType::CoatedDiffuse);
+  EXPECT_NEAR(coated.alpha_x, 0.5f, 1e-6f);
+  EXPECT_FLOAT_EQ(coated.ior, 1.5f);
+  EXPECT_EQ(s.materials[s.meshes[3].material].type, MaterialType::Interface);
+  const Material& mix = s.materials[s.meshes[4].material];
+  EXPECT_EQ(mix.type, MaterialType::Mix);
+  EXPECT_EQ(s.materials[mix.mix[0]].type, MaterialType::Diffuse);
+  EXPECT_EQ(s.materials[mix.mix[1]].type, MaterialType::Conductor);
+  EXPECT_FLOAT_EQ(mix.amount.value.x, 0.3f);
+  EXPECT_TRUE(s.warnings.empty());
+}
+
+TEST(PbrtMaterials, ApproximatedMaterialsWarn) {
+  SceneDesc s = load_world(std::string("Material \"coatedconductor\" \"spectrum conductor.eta\" \"metal-Ag-eta\" "
+                                       "\"spectrum conductor.k\" \"metal-Ag-k\" \"float interface.roughness\" 0.1\n") + kTriangle +
+                           "Material \"diffusetransmission\"\n" + kTriangle);
+  EXPECT_EQ(s.materials[s.meshes[0].material].type, MaterialType::Conductor);
+  EXPECT_VEC3_NEAR(s.materials[s.meshes[0].material].eta, Vec3(0.155f, 0.117f, 0.138f), 1e-3f);
+  EXPECT_EQ(s.materials[s.meshes[1].material].type, MaterialType::Diffuse);
+  EXPECT_EQ(s.warnings.size(), 2u);
+}
+
+TEST(PbrtTextures, ConstantScaleCheckerboard) {
+  SceneDesc s = load_world(
+      "Texture \"c\" \"spectrum\" \"constant\" \"rgb value\" [ 0.1 0.2 0.3 ]\n"
+      "Texture \"f\" \"float\" \"constant\" \"float value\" 0.5\n"
+      "Texture \"s\" \"spectrum\" \"scale\" \"texture tex\" \"c\" \"texture scale\" \"f\"\n"
+      "Texture \"k\" \"spectrum\" \"checkerboard\" \"float uscale\" 8 \"float vscale\" 4 \"texture tex1\" \"s\" "
+      "\"rgb tex2\" [ 0 0 1 ]\n"
+      "Material \"diffuse\" \"texture reflectance\" \"k\"\n" + std::string(kTriangle) +
+      "Material \"conductor\" \"texture roughness\" \"f\"\n" + kTriangle);
+  ASSERT_EQ(s.textures.size(), 4u);
+  EXPECT_EQ(s.textures[0].type, TextureType::Constant);
+  EXPECT_VEC3_NEAR(s.textures[0].value, Vec3(0.1f, 0.2f, 0.3f), 1e-6f);
+  EXPECT_VEC3_NEAR(s.textures[1].value, Vec3(0.5f), 1e-6f);
+  EXPECT_EQ(s.textures[2].type, TextureType::Scale);
+  EXPECT_EQ(s.textures[2].a.texture, 0);
+  EXPECT_EQ(s.textures[2].b.texture, 1);
+  const Texture& k = s.textures[3];
+  EXPECT_EQ(k.type, TextureType::Checkerboard);
+  EXPECT_FLOAT_EQ(k.su, 8.f);
+  EXPECT_FLOAT_EQ(k.sv, 4.f);
+  EXPECT_EQ(k.a.texture, 2);
+  EXPECT_EQ(k.b.texture, -1);
+  EXPECT_VEC3_NEAR(k.b.value, Vec3(0, 0, 1), 1e-6f);
+  EXPECT_EQ(s.materials[s.meshes[0].material].reflectance.texture, 3);
+  // A constant float texture as roughness gives its value (remapped).
+  EXPECT_NEAR(s.materials[s.meshes[1].material].alpha_x, std::sqrt(0.5f), 1e-6f);
+}
+
+TEST(PbrtTextures, UnsupportedClassWarnsConstantHalf) {
+  SceneDesc s = load_world(std::string("Texture \"n\" \"float\" \"fbm\" \"integer octaves\" 4\n") + kTriangle);
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_VEC3_NEAR(s.textures[0].value, Vec3(0.5f), 1e-6f);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("test.pbrt:2"), std::string::npos);
+}
+
+TEST(PbrtTextures, ImagemapPngIsSrgbDecodedAndDeduplicated) {
+  test::TempDir dir;
+  // 2x1 RGB: (255,128,0) (0,0,64).
+  const unsigned char px[6] = {255, 128, 0, 0, 0, 64};
+  ASSERT_NE(stbi_write_png(dir.file("tex.png").c_str(), 2, 1, 3, px, 6), 0);
+  SceneDesc s = load_world(
+      "Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"tex.png\" \"float scale\" 2 \"bool invert\" true"
+      " \"float udelta\" 0.5\n"
+      "Texture \"b\" \"spectrum\" \"imagemap\" \"string filename\" \"tex.png\"\n"
+      "Texture \"c\" \"spectrum\" \"imagemap\" \"string filename\" \"tex.png\" \"string encoding\" \"linear\"\n"
+      "Texture \"d\" \"spectrum\" \"imagemap\" \"string filename\" \"tex.png\" \"string encoding\" \"gamma 2\"\n"
+      "Material \"diffuse\" \"texture reflectance\" \"a\"\n" + std::string(kTriangle),
+      dir.path());
+  ASSERT_EQ(s.images.size(), 3u);  // a and b share one image
+  EXPECT_EQ(s.textures[0].image, s.textures[1].image);
+  const ImageDesc& img = s.images[s.textures[0].image];
+  ASSERT_EQ(img.width, 2);
+  ASSERT_EQ(img.height, 1);
+  EXPECT_NEAR(img.texels[0].x, 1.f, 1e-6f);
+  EXPECT_NEAR(img.texels[0].y, 0.2158605f, 1e-4f);  // sRGB 128/255
+  EXPECT_NEAR(img.texels[1].z, 0.0512694f, 1e-4f);  // sRGB 64/255
+  EXPECT_NEAR(s.images[s.textures[2].image].texels[0].y, 128.f / 255.f, 1e-6f);
+  EXPECT_NEAR(s.images[s.textures[3].image].texels[0].y, std::pow(128.f / 255.f, 2.f), 1e-6f);
+  EXPECT_FLOAT_EQ(s.textures[0].scale, 2.f);
+  EXPECT_TRUE(s.textures[0].invert);
+  EXPECT_FLOAT_EQ(s.textures[0].du, 0.5f);
+}
+
+TEST(PbrtTextures, ExrImageLoadsLinear) {
+  test::TempDir dir;
+  Imf::Rgba pixels[2 * 2];
+  for (int i = 0; i < 4; ++i) pixels[i] = Imf::Rgba(0.25f * i, 2.f, 0.5f, 1.f);
+  {
+    Imf::RgbaOutputFile out(dir.file("env.exr").c_str(), 2, 2, Imf::WRITE_RGBA);
+    out.setFrameBuffer(pixels, 1, 2);
+    out.writePixels(2);
+  }
+  ImageDesc img = load_image(dir.file("env.exr"));
+  ASSERT_EQ(img.width, 2);
+  ASSERT_EQ(img.height, 2);
+  EXPECT_FLOAT_EQ(img.texels[3].x, 0.75f);
+  EXPECT_FLOAT_EQ(img.texels[1].y, 2.f);  // no clamping, no decoding
+  EXPECT_THROW(load_image(dir.file("missing.exr")), SceneError);
+}
+
+}  // namespace
+}  // namespace tessera

@@ -1,0 +1,134 @@
+// Transform directives, graphics-state blocks, Include and object instancing.
+#include "scene_test_helpers.h"
+
+namespace tessera {
+namespace {
+
+using test::kTriangle;
+using test::load_world;
+
+TEST(PbrtTransform, TranslateThenScaleAppliesScaleFirst) {
+  SceneDesc s = load_world(std::string("Translate 1 2 3\nScale 2 2 2\n") + kTriangle);
+  ASSERT_EQ(s.meshes.size(), 1u);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[1], Vec3(3, 2, 3), 1e-6f);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[2], Vec3(1, 4, 3), 1e-6f);
+  EXPECT_FALSE(s.meshes[0].flip_normals);
+}
+
+TEST(PbrtTransform, RotateIsDegreesAboutAxis) {
+  SceneDesc s = load_world(std::string("Rotate 90 0 0 1\n") + kTriangle);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[1], Vec3(0, 1, 0), 1e-6f);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[2], Vec3(-1, 0, 0), 1e-6f);
+}
+
+TEST(PbrtTransform, TransformTakesColumnsAsWritten) {
+  SceneDesc s = load_world(std::string("Transform [ 1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1 ]\n") + kTriangle);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[0], Vec3(5, 6, 7), 1e-6f);
+  // Transform replaces; ConcatTransform post-multiplies.
+  s = load_world(std::string("Translate 100 0 0\nTransform [ 2 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1 ]\n") + kTriangle);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[1], Vec3(2, 0, 0), 1e-6f);
+  s = load_world(std::string("Translate 1 0 0\nConcatTransform [ 2 0 0 0  0 1 0 0  0 0 1 0  0 0 3 1 ]\n") + kTriangle);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[1], Vec3(3, 0, 3), 1e-6f);
+}
+
+TEST(PbrtTransform, IdentityResets) {
+  SceneDesc s = load_world(std::string("Translate 1 2 3\nIdentity\n") + kTriangle);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[0], Vec3(0, 0, 0), 1e-6f);
+}
+
+TEST(PbrtTransform, LookAtGivesWorldFromCamera) {
+  SceneDesc s = load_pbrt_string("LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 40 ]\nWorldBegin\n" +
+                                     std::string(kTriangle),
+                                 "t.pbrt", ".");
+  const Mat4& m = s.camera.world_from_camera;
+  EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 0, 0, 1)), Vec3(0, 0, 5), 1e-5f);
+  EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 0, 1, 0)), Vec3(0, 0, -1), 1e-6f);  // forward
+  EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 1, 0, 0)), Vec3(0, 1, 0), 1e-6f);   // up
+  EXPECT_VEC3_NEAR(Vec3(m * Vec4(1, 0, 0, 0)), Vec3(-1, 0, 0), 1e-6f);  // right = up x forward
+  EXPECT_FLOAT_EQ(s.camera.fov_degrees, 40.f);
+  EXPECT_GT(glm::determinant(m), 0.f);
+  EXPECT_EQ(s.camera.where, "t.pbrt:2");
+}
+
+TEST(PbrtTransform, ScaleBeforeLookAtMirrorsCamera) {
+  SceneDesc s = load_pbrt_string("Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n" +
+                                     std::string(kTriangle),
+                                 "t.pbrt", ".");
+  const Mat4& m = s.camera.world_from_camera;
+  EXPECT_LT(glm::determinant(m), 0.f);
+  EXPECT_VEC3_NEAR(Vec3(m * Vec4(1, 0, 0, 0)), Vec3(1, 0, 0), 1e-6f);  // image x mirrored
+  EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 0, 1, 0)), Vec3(0, 0, -1), 1e-6f);
+  EXPECT_FLOAT_EQ(s.camera.fov_degrees, 90.f);
+  // The world CTM starts afresh: shapes are not mirrored.
+  EXPECT_FALSE(s.meshes[0].flip_normals);
+}
+
+TEST(PbrtTransform, MirroringShapeTransformSetsFlipNormals) {
+  SceneDesc s = load_world(std::string("Scale -1 1 1\n") + kTriangle);
+  EXPECT_TRUE(s.meshes[0].flip_normals);
+  // pbrt-v4 flips the world-space cross product back: the normal stays +z.
+  EXPECT_VEC3_NEAR(test::geometric_normal(s.meshes[0], 0), Vec3(0, 0, 1), 1e-6f);
+}
+
+TEST(PbrtTransform, ReverseOrientationFlipsAndCancelsWithMirror) {
+  SceneDesc s = load_world(std::string("ReverseOrientation\n") + kTriangle);
+  EXPECT_TRUE(s.meshes[0].flip_normals);
+  EXPECT_VEC3_NEAR(test::geometric_normal(s.meshes[0], 0), Vec3(0, 0, -1), 1e-6f);
+  s = load_world(std::string("ReverseOrientation\nScale 1 -1 1\n") + kTriangle);
+  EXPECT_FALSE(s.meshes[0].flip_normals);
+}
+
+TEST(PbrtTransform, AttributeBlockRestoresState) {
+  SceneDesc s = load_world(std::string("AttributeBegin\nTranslate 1 0 0\nReverseOrientation\n") +
+                           "Material \"conductor\"\n" + kTriangle + "AttributeEnd\n" + kTriangle);
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[0], Vec3(1, 0, 0), 1e-6f);
+  EXPECT_TRUE(s.meshes[0].flip_normals);
+  EXPECT_EQ(s.materials[s.meshes[0].material].type, MaterialType::Conductor);
+  EXPECT_VEC3_NEAR(s.meshes[1].p[0], Vec3(0, 0, 0), 1e-6f);
+  EXPECT_FALSE(s.meshes[1].flip_normals);
+  EXPECT_EQ(s.meshes[1].material, 0);
+}
+
+TEST(PbrtTransform, LegacyTransformBlockRestoresOnlyTransform) {
+  SceneDesc s = load_world(std::string("TransformBegin\nTranslate 1 0 0\nMaterial \"conductor\"\nTransformEnd\n") + kTriangle);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[0], Vec3(0, 0, 0), 1e-6f);
+  EXPECT_EQ(s.materials[s.meshes[0].material].type, MaterialType::Conductor);
+  ASSERT_FALSE(s.warnings.empty());
+  EXPECT_NE(s.warnings[0].find("test.pbrt:2"), std::string::npos);
+}
+
+TEST(PbrtTransform, NamedCoordinateSystems) {
+  SceneDesc s = load_pbrt_string(
+      "LookAt 1 2 3  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nTranslate 7 0 0\nCoordinateSystem \"seven\"\n"
+      "Identity\nCoordSysTransform \"camera\"\n" + std::string(kTriangle) + "CoordSysTransform \"seven\"\n" + kTriangle,
+      "t.pbrt", ".");
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[0], Vec3(1, 2, 3), 1e-5f);  // camera origin
+  EXPECT_VEC3_NEAR(s.meshes[1].p[0], Vec3(7, 0, 0), 1e-6f);
+}
+
+TEST(PbrtTransform, IncludeIsRelativeToIncludingFileAndKeepsState) {
+  test::TempDir dir;
+  dir.write("parts/box.pbrt", std::string("# included\n") + kTriangle);
+  dir.write("parts/nested.pbrt", "Include \"box.pbrt\"\n");
+  dir.write("scene.pbrt", "WorldBegin\nTranslate 0 0 2\nInclude \"parts/nested.pbrt\"\nImport \"parts/box.pbrt\"\n");
+  SceneDesc s = load_pbrt_file(dir.file("scene.pbrt"));
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[0], Vec3(0, 0, 2), 1e-6f);
+  EXPECT_NE(s.meshes[0].where.find("box.pbrt:2"), std::string::npos);
+}
+
+TEST(PbrtTransform, ObjectInstanceCopiesWithInstanceTransform) {
+  SceneDesc s = load_world(std::string("ObjectBegin \"tri\"\nTranslate 0 0 1\n") + kTriangle +
+                           "ObjectEnd\nTranslate 10 0 0\nObjectInstance \"tri\"\nScale -1 1 1\nObjectInstance \"tri\"\n");
+  ASSERT_EQ(s.meshes.size(), 2u);  // the definition itself is not rendered
+  EXPECT_VEC3_NEAR(s.meshes[0].p[1], Vec3(11, 0, 1), 1e-6f);
+  EXPECT_FALSE(s.meshes[0].flip_normals);
+  EXPECT_VEC3_NEAR(s.meshes[1].p[1], Vec3(9, 0, 1), 1e-6f);
+  EXPECT_TRUE(s.meshes[1].flip_normals);
+  EXPECT_EQ(s.meshes[1].where, "test.pbrt:9");
+}
+
+}  // namespace
+}  // namespace tessera
