@@ -1,5 +1,10 @@
 // The binary end to end: bad input gets one clear line naming file:line and a
 // non-zero exit; good input writes EXR + PNG; compare reports sizes.
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfDoubleAttribute.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -129,6 +134,42 @@ TEST_F(CliTest, RenderStatsAndCompare) {
   RunResult mismatch = run("compare " + a + " " + c);
   EXPECT_NE(mismatch.exit_code, 0);
   EXPECT_NE(mismatch.output.find("sizes differ"), std::string::npos) << mismatch.output;
+}
+
+TEST_F(CliTest, ExrHasVarianceLayerAndMetadata) {
+  std::string out = (dir_ / "m.exr").string();
+  ASSERT_EQ(run("render -q --res 16x12 --spp 3 --seed 9 -o " + out).exit_code, 0);
+  Imf::InputFile file(out.c_str());
+  const Imf::Header& h = file.header();
+  for (const char* ch : {"R", "G", "B", "variance.R", "variance.G", "variance.B"})
+    EXPECT_NE(h.channels().findChannel(ch), nullptr) << ch;
+  auto* spp = h.findTypedAttribute<Imf::DoubleAttribute>("spp");
+  ASSERT_NE(spp, nullptr);
+  EXPECT_EQ(spp->value(), 3.0);
+  auto* seed = h.findTypedAttribute<Imf::StringAttribute>("seed");
+  ASSERT_NE(seed, nullptr);
+  EXPECT_EQ(seed->value(), "9");
+  auto* effects = h.findTypedAttribute<Imf::StringAttribute>("effects");
+  ASSERT_NE(effects, nullptr);
+  EXPECT_EQ(effects->value(), "diffuse, area-lights");
+  EXPECT_NE(h.findTypedAttribute<Imf::DoubleAttribute>("seconds"), nullptr);
+  EXPECT_NE(h.findTypedAttribute<Imf::StringAttribute>("software"), nullptr);
+}
+
+TEST_F(CliTest, TimeBudgetStopsAfterWholePasses) {
+  std::string stats = (dir_ / "t.json").string();
+  RunResult r = run("render -q --res 32x32 --time 0.5 -o " + (dir_ / "t.exr").string() + " --stats " + stats);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream js(stats);
+  std::string json((std::istreambuf_iterator<char>(js)), {});
+  EXPECT_NE(json.find("\"stop_reason\": \"time\""), std::string::npos) << json;
+  EXPECT_EQ(json.find("\"spp\": 0,"), std::string::npos) << json;
+}
+
+TEST_F(CliTest, BadOptionValues) {
+  EXPECT_NE(run("render --res 12by4").exit_code, 0);
+  EXPECT_NE(run("render -o out.png").exit_code, 0);
+  EXPECT_NE(run("render --spp -3").exit_code, 0);
 }
 
 TEST_F(CliTest, InfoPrintsEffects) {
