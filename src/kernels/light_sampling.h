@@ -46,13 +46,9 @@ TESSERA_HOST_DEVICE inline bool sample_light(const SceneView& s, uint32_t light_
   switch (l.type) {
     case LightType::Area: {
       Vec3 b = sample_uniform_triangle(u);
-      const uint32_t* idx = s.indices + 3 * static_cast<size_t>(l.triangle);
-      const Vec3& p0 = s.positions[idx[0]];
-      const Vec3& p1 = s.positions[idx[1]];
-      const Vec3& p2 = s.positions[idx[2]];
-      Vec3 p = b.x * p0 + b.y * p1 + b.z * p2;
-      // Emission side: the geometric normal as make_surface_hit orients it.
-      Vec3 n = make_surface_hit_normal(s, l.triangle, b.y, b.z);
+      SurfaceHit h = make_surface_hit(s, l.triangle, b.y, b.z);
+      const Vec3& p = h.p;
+      const Vec3& n = h.ng;  // emission side, oriented as at a hit
       Vec3 d = p - ref_p;
       Float dist2 = glm::dot(d, d);
       if (!(dist2 > 0.f)) return false;

@@ -42,6 +42,9 @@ struct SceneView {
   const Vec2* uvs = nullptr;
   const uint32_t* indices = nullptr;  // 3 per triangle
   const TriangleInfo* triangles = nullptr;
+  // Unit geometric normal per triangle, normalize(cross(p0 - p2, p1 - p2)),
+  // already negated for kTriFlipNormal (precomputed: every hit needs it).
+  const Vec3* face_normals = nullptr;
   uint32_t num_triangles = 0;
 
   const Material* materials = nullptr;

@@ -14,25 +14,6 @@ struct SurfaceHit {
   uint32_t triangle;
 };
 
-// The oriented unit geometric normal only (what emission and offsets need).
-TESSERA_HOST_DEVICE inline Vec3 make_surface_hit_normal(const SceneView& s, uint32_t tri, Float b1, Float b2) {
-  const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
-  const TriangleInfo& info = s.triangles[tri];
-  const Vec3& p0 = s.positions[idx[0]];
-  const Vec3& p1 = s.positions[idx[1]];
-  const Vec3& p2 = s.positions[idx[2]];
-  Vec3 n = glm::cross(p0 - p2, p1 - p2);
-  Float len = glm::length(n);
-  n = len > 0.f ? n / len : Vec3(0.f, 0.f, 1.f);
-  if (info.flags & kTriFlipNormal) n = -n;
-  if (info.flags & kTriHasNormals) {
-    Float b0 = 1.f - b1 - b2;
-    Vec3 ns = b0 * s.normals[idx[0]] + b1 * s.normals[idx[1]] + b2 * s.normals[idx[2]];
-    if (glm::dot(n, ns) < 0.f) n = -n;
-  }
-  return n;
-}
-
 // b1, b2: barycentrics of vertices 1 and 2 (Embree's u, v).
 TESSERA_HOST_DEVICE inline SurfaceHit make_surface_hit(const SceneView& s, uint32_t tri, Float b1, Float b2) {
   const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
@@ -44,12 +25,8 @@ TESSERA_HOST_DEVICE inline SurfaceHit make_surface_hit(const SceneView& s, uint3
   SurfaceHit h;
   h.triangle = tri;
   h.p = b0 * p0 + b1 * p1 + b2 * p2;
-  Vec3 n = glm::cross(p0 - p2, p1 - p2);
-  Float len = glm::length(n);
-  n = len > 0.f ? n / len : Vec3(0.f, 0.f, 1.f);
-  if (info.flags & kTriFlipNormal) n = -n;
-  h.ng = n;
-  h.ns = n;
+  h.ng = s.face_normals[tri];
+  h.ns = h.ng;
   if (info.flags & kTriHasNormals) {
     Vec3 ns = b0 * s.normals[idx[0]] + b1 * s.normals[idx[1]] + b2 * s.normals[idx[2]];
     Float l = glm::length(ns);

@@ -38,7 +38,10 @@ void SceneData::flatten_meshes() {
       const Vec3 &a = m.p[m.indices[t]], &b = m.p[m.indices[t + 1]], &c = m.p[m.indices[t + 2]];
       // Degenerate triangles can never be hit or sampled; dropping them keeps
       // area-light pdfs finite.
-      if (glm::length(glm::cross(b - a, c - a)) <= 0.f) continue;
+      Vec3 n = glm::cross(a - c, b - c);
+      Float len = glm::length(n);
+      if (!(len > 0.f)) continue;
+      face_normals_.push_back((m.flip_normals ? -n : n) / len);
       for (int k = 0; k < 3; ++k) indices_.push_back(base + m.indices[t + k]);
       TriangleInfo ti = info;
       if (m.area_light >= 0) {
@@ -155,6 +158,7 @@ void SceneData::build_view() {
   v.uvs = uvs_.data();
   v.indices = indices_.data();
   v.triangles = triangles_.data();
+  v.face_normals = face_normals_.data();
   v.num_triangles = static_cast<uint32_t>(triangles_.size());
   v.materials = desc_.materials.data();
   v.num_materials = static_cast<uint32_t>(desc_.materials.size());

@@ -47,6 +47,7 @@ class SceneData {
   std::vector<Vec2> uvs_;
   std::vector<uint32_t> indices_;
   std::vector<TriangleInfo> triangles_;
+  std::vector<Vec3> face_normals_;
   std::vector<ImageView> image_views_;
   std::vector<Light> lights_;
   std::vector<int32_t> infinite_lights_;
