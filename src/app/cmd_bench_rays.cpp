@@ -3,7 +3,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
+#include <stdexcept>
 #include <chrono>
 #include <cstdio>
 #include <thread>
@@ -29,7 +31,9 @@ int run_bench(const BenchArgs& a) {
   EmbreeScene embree(scene);
   const EmbreeTracer tracer = embree.tracer();
   const Bounds& b = scene.bounds();
-  const int threads = a.threads > 0 ? static_cast<int>(a.threads) : static_cast<int>(std::thread::hardware_concurrency());
+  if (scene.num_triangles() == 0) throw std::runtime_error("bench-rays: the scene has no triangles");
+  const int threads = a.threads > 0 ? static_cast<int>(a.threads)
+                                    : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   tbb::task_arena arena(threads);
   // Origins uniform in the scene's bounding box, directions uniform on the
   // sphere: as incoherent as secondary rays get. Rays are generated before
@@ -65,8 +69,8 @@ CommandRunner add_bench_rays_command(CLI::App& app) {
   auto a = std::make_shared<BenchArgs>();
   CLI::App* c = app.add_subcommand("bench-rays", "Benchmark raw Embree rtcIntersect1 on random incoherent rays in a scene");
   c->add_option("scene", a->scene, "Scene file (omit for the built-in Cornell box)");
-  c->add_option("--rays", a->rays, "Number of rays")->check(CLI::PositiveNumber);
-  c->add_option("--threads", a->threads, "Threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  c->add_option("--rays", a->rays, "Number of rays")->check(CLI::Range(int64_t(1), int64_t(1) << 30));
+  c->add_option("--threads", a->threads, "Threads (0 = all cores)")->check(CLI::Range(0, 4096));
   return [a] { return run_bench(*a); };
 }
 

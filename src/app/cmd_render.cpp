@@ -26,8 +26,11 @@ void parse_resolution(const std::string& res, SceneDesc& d) {
   static const std::regex re("^([0-9]{1,5})x([0-9]{1,5})$");
   if (!std::regex_match(res, m, re) || std::stoi(m[1]) <= 0 || std::stoi(m[2]) <= 0)
     throw std::runtime_error("--res: expected WxH with positive integers, got '" + res + "'");
-  d.film.xres = std::stoi(m[1]);
-  d.film.yres = std::stoi(m[2]);
+  const int64_t w = std::stoi(m[1]), h = std::stoi(m[2]);
+  if (w > kMaxFilmDimension || h > kMaxFilmDimension || w * h > kMaxFilmPixels)
+    throw std::runtime_error("--res: " + res + " is larger than supported (" + std::to_string(kMaxFilmPixels) + " pixels)");
+  d.film.xres = static_cast<int32_t>(w);
+  d.film.yres = static_cast<int32_t>(h);
 }
 
 int run_render(const RenderArgs& a) {
@@ -49,13 +52,17 @@ int run_render(const RenderArgs& a) {
   if (opt.spp == 0 && opt.time_budget_s <= 0) throw std::runtime_error("--spp 0 needs a --time budget");
 
   std::string out = a.output;
-  if (out.empty()) out = std::filesystem::path(desc.film.filename.empty() ? "tessera.exr" : desc.film.filename).filename().string();
+  if (out.empty()) {
+    // The scene's Film filename, made an EXR (pbrt scenes often name a PNG).
+    std::filesystem::path f = std::filesystem::path(desc.film.filename.empty() ? "tessera.exr" : desc.film.filename).filename();
+    out = f.replace_extension(".exr").string();
+  }
   if (std::filesystem::path(out).extension() != ".exr") throw std::runtime_error("-o: output must end in .exr, got '" + out + "'");
   std::string preview = a.preview;
   if (preview.empty() && !a.no_preview) preview = std::filesystem::path(out).replace_extension(".png").string();
 
   SceneData scene(std::move(desc));
-  const uint32_t spec = opt.force_full_specialisation ? kSpecAll : specialisation_for(scene.effects());
+  const uint32_t spec = effective_specialisation(scene, opt);
   std::fprintf(stderr, "tessera: %s: %zu triangles, %u lights, %dx%d, %s, max depth %d\n",
                scene.desc().source.c_str(), scene.num_triangles(), scene.view().num_lights, scene.view().camera.width,
                scene.view().camera.height,
@@ -102,13 +109,13 @@ CommandRunner add_render_command(CLI::App& app) {
   CLI::App* c = app.add_subcommand("render", "Render a pbrt-v4 scene (default: the built-in Cornell box) to OpenEXR + PNG");
   c->add_option("scene", a->scene, "Scene file in pbrt-v4 syntax (omit for the built-in Cornell box)");
   c->add_option("-o,--output", a->output, "Output EXR (default: the scene's Film filename in the current directory)");
-  c->add_option("--spp", a->spp, "Samples per pixel (overrides the scene's Sampler)")->check(CLI::NonNegativeNumber);
+  c->add_option("--spp", a->spp, "Samples per pixel (overrides the scene's Sampler)")->check(CLI::Range(0, 1 << 30));
   c->add_option("--time", a->time, "Time budget in seconds: render whole passes until it is spent")->check(CLI::PositiveNumber);
   c->add_option("--res", a->res, "Resolution WxH (overrides the scene's Film)");
-  c->add_option("--max-depth", a->max_depth, "Maximum path depth, counted as pbrt-v4 does (overrides the Integrator)")->check(CLI::NonNegativeNumber);
+  c->add_option("--max-depth", a->max_depth, "Maximum path depth, counted as pbrt-v4 does (overrides the Integrator)")->check(CLI::Range(0, 1 << 20));
   c->add_option("--seed", a->seed, "Random seed (same seed -> bit-identical image)")->check(CLI::NonNegativeNumber);
-  c->add_option("--threads", a->threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
-  c->add_option("--tile", a->tile, "Tile size in pixels")->check(CLI::PositiveNumber);
+  c->add_option("--threads", a->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
+  c->add_option("--tile", a->tile, "Tile size in pixels")->check(CLI::Range(1, 4096));
   c->add_option("--stats", a->stats, "Write render statistics as JSON");
   c->add_option("--preview", a->preview, "sRGB PNG preview (default: beside the EXR)");
   c->add_flag("--no-preview", a->no_preview, "Do not write a PNG preview");

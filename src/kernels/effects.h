@@ -27,9 +27,8 @@ enum Specialisation : uint32_t {
   kSpecNonDiffuse = 1u << 0,   // any BSDF other than Lambertian (incl. mix/interface)
   kSpecTextures = 1u << 1,
   kSpecAreaLights = 1u << 2,
-  kSpecPointLights = 1u << 3,  // delta lights
-  kSpecEnvironment = 1u << 4,
-  kSpecAll = (1u << 5) - 1,
+  kSpecEnvironment = 1u << 3,
+  kSpecAll = (1u << 4) - 1,
 };
 
 TESSERA_HOST_DEVICE inline uint32_t specialisation_for(uint32_t effects) {
@@ -37,7 +36,6 @@ TESSERA_HOST_DEVICE inline uint32_t specialisation_for(uint32_t effects) {
   if (effects & (kEffectGlossy | kEffectSpecular | kEffectTransmission | kEffectMix | kEffectInterface)) s |= kSpecNonDiffuse;
   if (effects & kEffectTextures) s |= kSpecTextures;
   if (effects & kEffectAreaLights) s |= kSpecAreaLights;
-  if (effects & kEffectDeltaLights) s |= kSpecPointLights;
   if (effects & kEffectEnvironment) s |= kSpecEnvironment;
   return s;
 }

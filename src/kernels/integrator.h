@@ -81,6 +81,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   int32_t depth = 0;
   bool specular_bounce = false;
   Float prev_bsdf_pdf = 0.f;
+  Vec3 prev_p(0.f);  // last scattering point: MIS on emitter hits measures from it, as NEE does
   Float eta_scale = 1.f;
   int32_t interface_skips = 0;
 
@@ -116,7 +117,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             L += beta * l.L;
           } else {
             Float light_pdf = s.light_select.discrete_pmf(static_cast<uint32_t>(info.light)) *
-                              area_light_pdf(l, hit.t, cos_l);
+                              area_light_pdf(l.area, glm::length(h.p - prev_p), cos_l);
             L += beta * l.L * power_heuristic(prev_bsdf_pdf, light_pdf);
           }
         }
@@ -128,18 +129,21 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       // Interface: continue through without counting a bounce (pbrt's SkipIntersection).
       ++c.interface_skips;
       if (++interface_skips > 256) break;
-      ray.o = offset_ray_origin(s, h.p, h.ng, ray.d);
+      ray.o = offset_ray_origin(h, ray.d);
       continue;
     }
     if (depth++ == settings.max_depth) break;
 
-    Frame frame = Frame::from_z(h.ns);
+    // Anisotropic BSDFs need pbrt's orientation (x along dp/du); any frame
+    // around the normal serves the isotropic ones.
+    Frame frame = (Spec & kSpecNonDiffuse) && bsdf.alpha_x != bsdf.alpha_y
+                      ? Frame::from_tangent(h.ns, surface_dpdu(s, hit.triangle))
+                      : Frame::from_z(h.ns);
     Vec3 wo_l = frame.to_local(wo);
     if (wo_l.z == 0.f) break;
     uint32_t lobes = (Spec & kSpecNonDiffuse) ? bsdf_lobes(bsdf) : (kLobeReflection | kLobeDiffuse);
 
-    // Next-event estimation. The random numbers are drawn even when unused so
-    // that the stream layout does not depend on the outcome.
+    // Next-event estimation at non-specular vertices (pbrt-v4's SampleLd).
     if (settings.nee && lobes_have_non_specular(lobes) && s.num_lights > 0) {
       Float u_select = rng.uniform();
       Vec2 u_light = rng.uniform2();
@@ -150,12 +154,12 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         Vec3 wi_l = frame.to_local(ls.wi);
         Rgb f = eval_f<Spec>(bsdf, wo_l, wi_l) * abs_cos_theta(wi_l);
         if (!is_black(f)) {
-          Vec3 o = offset_ray_origin(s, h.p, h.ng, ls.wi);
+          Vec3 o = offset_ray_origin(h, ls.wi);
           Float tmax = kInfinity;
           if (!ls.infinite) tmax = glm::length(ls.p_light - o) * 0.9999f;
           ++c.shadow_rays;
-          if (!tracer.occluded(o, ls.wi, tmax)) {
-            Float light_pdf = pmf * ls.pdf;
+          Float light_pdf = pmf * ls.pdf;
+          if (light_pdf > 0.f && !tracer.occluded(o, ls.wi, tmax)) {
             Float w = 1.f;
             if (!ls.delta) w = power_heuristic(light_pdf, eval_pdf<Spec>(bsdf, wo_l, wi_l));
             L += beta * f * ls.L * (w / light_pdf);
@@ -173,8 +177,9 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     specular_bounce = (bs.lobe & kLobeSpecular) != 0;
     if (bs.lobe & kLobeTransmission) eta_scale *= sqr(bs.eta);
     Vec3 wi = frame.to_world(bs.wi);
-    ray.o = offset_ray_origin(s, h.p, h.ng, wi);
+    ray.o = offset_ray_origin(h, wi);
     ray.d = wi;
+    prev_p = h.p;
 
     // Russian roulette (pbrt-v4): after the second bounce, on throughput
     // corrected for radiance scaling at refractive boundaries.

@@ -21,7 +21,8 @@ struct Light {
   Float area = 0.f;            // Area: triangle area (precomputed: used by every pdf)
   bool two_sided = false;      // Area
   int32_t image = -1;          // Infinite: index into the scene's images (equal-area octahedral), -1 = constant L
-  Mat3 light_from_world{1.f};  // Infinite: rotation into the light's frame
+  Mat3 light_from_world{1.f};  // Infinite: into the light's frame (directions; normalise after)
+  Mat3 world_from_light{1.f};  // Infinite: its inverse (set when the scene is built)
 };
 
 }  // namespace tessera

@@ -24,6 +24,14 @@ TESSERA_HOST_DEVICE inline Rgb environment_radiance(const SceneView& s, const Li
   return l.L * image_lookup_nearest_equal_area(s.images[l.image], equal_area_sphere_to_square(wl));
 }
 
+// Solid-angle pdf of sampling a point on an area light (triangle of area
+// `area`) at distance dist, seen under cos_l = dot(n_light, -w).
+TESSERA_HOST_DEVICE inline Float area_light_pdf(Float area, Float dist, Float cos_l) {
+  Float c = glm::abs(cos_l);
+  if (!(area > 0.f) || !(c > 0.f)) return 0.f;
+  return dist * dist / (c * area);
+}
+
 TESSERA_HOST_DEVICE inline Float environment_pdf(const SceneView& s, uint32_t light_index, const Vec3& dir_world) {
   const Light& l = s.lights[light_index];
   if (l.image < 0) return kUniformSpherePdf;
@@ -56,11 +64,9 @@ TESSERA_HOST_DEVICE inline bool sample_light(const SceneView& s, uint32_t light_
       ls.wi = d / dist;
       Float cos_l = -glm::dot(n, ls.wi);
       if (!l.two_sided && cos_l <= 0.f) return false;
-      Float abs_cos = glm::abs(cos_l);
-      if (abs_cos <= 0.f || l.area <= 0.f) return false;
-      ls.pdf = dist2 / (abs_cos * l.area);
+      ls.pdf = area_light_pdf(l.area, dist, cos_l);
       ls.L = l.L;
-      ls.p_light = offset_ray_origin(s, p, n, -ls.wi);
+      ls.p_light = offset_ray_origin(h, -ls.wi);
       break;
     }
     case LightType::Point:
@@ -94,11 +100,13 @@ TESSERA_HOST_DEVICE inline bool sample_light(const SceneView& s, uint32_t light_
         Vec2 uv = s.env_distributions[light_index].sample(u, &pdf_uv);
         if (pdf_uv <= 0.f) return false;
         Vec3 wl = equal_area_square_to_sphere(uv);
-        // light_from_world is a rotation: its transpose maps back to world.
-        ls.wi = glm::normalize(glm::transpose(l.light_from_world) * wl);
+        ls.wi = glm::normalize(l.world_from_light * wl);
         ls.pdf = pdf_uv * kInv4Pi;
+        // Radiance of the sampled texel itself (pbrt-v4 ImageLe(uv)): going
+        // back through the direction could land in a neighbour at a border.
+        ls.L = l.L * image_lookup_nearest_equal_area(s.images[l.image], uv);
       }
-      ls.L = environment_radiance(s, l, ls.wi);
+      if (l.image < 0) ls.L = l.L;
       ls.infinite = true;
       break;
     }
@@ -106,15 +114,6 @@ TESSERA_HOST_DEVICE inline bool sample_light(const SceneView& s, uint32_t light_
   if (!(ls.pdf > 0.f) || is_black(ls.L)) return false;
   *out = ls;
   return true;
-}
-
-// Solid-angle pdf that sample_light would have produced for hitting emissive
-// light l at distance dist along w (cos_l = dot(ng, -w)).
-TESSERA_HOST_DEVICE inline Float area_light_pdf(const Light& l, Float dist, Float cos_l) {
-  Float area = l.area;
-  Float c = glm::abs(cos_l);
-  if (area <= 0.f || c <= 0.f) return 0.f;
-  return dist * dist / (c * area);
 }
 
 }  // namespace tessera

@@ -32,10 +32,15 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
   if constexpr ((Spec & kSpecNonDiffuse) != 0) {
     for (int guard = 0; m->type == MaterialType::Mix && guard < 16; ++guard) {
       Float amount = (Spec & kSpecTextures) ? eval_slot(s, m->amount, h.uv).x : m->amount.value.x;
-      Float u = mix_hash_float(h.p, wo, m->mix[0], m->mix[1]);
-      m = &s.materials[amount < u ? m->mix[0] : m->mix[1]];
+      int32_t pick;
+      if (amount <= 0.f) pick = m->mix[0];  // pbrt-v4 MixMaterial::ChooseMaterial
+      else if (amount >= 1.f) pick = m->mix[1];
+      else pick = amount < mix_hash_float(h.p, wo, m->mix[0], m->mix[1]) ? m->mix[0] : m->mix[1];
+      m = &s.materials[pick];
     }
-    if (m->type == MaterialType::Interface || m->type == MaterialType::Mix) return false;
+    // The loader rejects cycles, so only absurdly deep nesting can remain a Mix.
+    if (m->type == MaterialType::Mix) m = &s.materials[0];
+    if (m->type == MaterialType::Interface) return false;
   }
   Rgb refl = (Spec & kSpecTextures) ? eval_slot(s, m->reflectance, h.uv) : m->reflectance.value;
   BsdfParams b;

@@ -33,7 +33,6 @@ struct CameraView {
 struct FilterView {
   const Float* inverse_cdf = nullptr;  // offsets in [-radius, radius]
   uint32_t n = 0;
-  Float radius = 0.5f;
 };
 
 struct SceneView {
@@ -59,9 +58,6 @@ struct SceneView {
   uint32_t num_infinite_lights = 0;
   const Distribution2DView* env_distributions = nullptr;  // per light index, valid for image infinite lights
 
-  Float scene_radius = 1.f;  // bounding sphere, for distant lights' power
-  Vec3 scene_center{0.f};
-  Float ray_epsilon = 1e-4f; // origin offset scale (relative to coordinate magnitude)
 
   CameraView camera;
   FilterView filter;

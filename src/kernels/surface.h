@@ -8,6 +8,7 @@ namespace tessera {
 
 struct SurfaceHit {
   Vec3 p;      // position, interpolated from the vertices (more precise than o + t d)
+  Vec3 p_error;  // conservative bound on |p - exact| per axis (pbrt-v4's triangle bound)
   Vec3 ng;     // unit geometric normal, pbrt orientation (emission side of one-sided lights)
   Vec3 ns;     // unit shading normal (== ng without vertex normals)
   Vec2 uv;
@@ -25,6 +26,9 @@ TESSERA_HOST_DEVICE inline SurfaceHit make_surface_hit(const SceneView& s, uint3
   SurfaceHit h;
   h.triangle = tri;
   h.p = b0 * p0 + b1 * p1 + b2 * p2;
+  // pbrt-v4: gamma(7) * sum |b_i p_i| bounds the rounding error of h.p.
+  constexpr Float kGamma7 = 7.f * 0x1p-24f / (1.f - 7.f * 0x1p-24f);
+  h.p_error = kGamma7 * (glm::abs(b0 * p0) + glm::abs(b1 * p1) + glm::abs(b2 * p2));
   h.ng = s.face_normals[tri];
   h.ns = h.ng;
   if (info.flags & kTriHasNormals) {
@@ -44,11 +48,38 @@ TESSERA_HOST_DEVICE inline SurfaceHit make_surface_hit(const SceneView& s, uint3
   return h;
 }
 
-// Ray origin pushed off the surface along the geometric normal, towards w.
-TESSERA_HOST_DEVICE inline Vec3 offset_ray_origin(const SceneView& s, const Vec3& p, const Vec3& ng, const Vec3& w) {
-  Float mag = glm::max(1.f, max_component(glm::abs(p)));
-  Vec3 off = ng * (s.ray_epsilon * mag);
+// Ray origin pushed off the surface along the geometric normal, towards w,
+// by the rounding-error bound of the hit point (pbrt-v4's OffsetRayOrigin),
+// with a safety factor for Embree's own intersection arithmetic. Scale-free:
+// a scene modelled in millimetres or in kilometres gets the same relative offset.
+TESSERA_HOST_DEVICE inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& ng, const Vec3& w) {
+  constexpr Float kSafety = 16.f;
+  Float d = kSafety * glm::dot(glm::abs(ng), p_error) + 1e-30f;
+  Vec3 off = d * ng;
   return glm::dot(w, ng) >= 0.f ? p + off : p - off;
+}
+TESSERA_HOST_DEVICE inline Vec3 offset_ray_origin(const SurfaceHit& h, const Vec3& w) {
+  return offset_ray_origin(h.p, h.p_error, h.ng, w);
+}
+
+// dp/du of the triangle's uv parametrisation (pbrt-v4 Triangle), for shading
+// frames of anisotropic BSDFs; falls back to any tangent when uvs are degenerate.
+TESSERA_HOST_DEVICE inline Vec3 surface_dpdu(const SceneView& s, uint32_t tri) {
+  const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
+  const TriangleInfo& info = s.triangles[tri];
+  Vec2 uv0(0.f, 0.f), uv1(1.f, 0.f), uv2(1.f, 1.f);
+  if (info.flags & kTriHasUv) {
+    uv0 = s.uvs[idx[0]];
+    uv1 = s.uvs[idx[1]];
+    uv2 = s.uvs[idx[2]];
+  }
+  Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
+  Vec3 dp02 = s.positions[idx[0]] - s.positions[idx[2]], dp12 = s.positions[idx[1]] - s.positions[idx[2]];
+  Float det = duv02.x * duv12.y - duv02.y * duv12.x;
+  if (glm::abs(det) < 1e-9f) return Frame::from_z(s.face_normals[tri]).s;
+  Vec3 dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
+  if (!(glm::dot(dpdu, dpdu) > 0.f) || !is_finite(dpdu)) return Frame::from_z(s.face_normals[tri]).s;
+  return dpdu;
 }
 
 }  // namespace tessera

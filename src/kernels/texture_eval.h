@@ -7,7 +7,11 @@
 namespace tessera {
 
 TESSERA_HOST_DEVICE inline Rgb image_bilerp(const ImageView& img, Vec2 st) {
-  // pbrt-v4 flips t for image lookups and wraps with "repeat".
+  // pbrt-v4 flips t for image lookups and wraps with "repeat". Wrapping in
+  // float first keeps the integer conversions in range for any st (NaN -> 0).
+  st = st - glm::floor(st);
+  if (!(st.x >= 0.f && st.x <= 1.f)) st.x = 0.f;
+  if (!(st.y >= 0.f && st.y <= 1.f)) st.y = 0.f;
   Float x = st.x * img.width - 0.5f, y = (1.f - st.y) * img.height - 0.5f;
   Float fx = glm::floor(x), fy = glm::floor(y);
   Float dx = x - fx, dy = y - fy;
@@ -16,7 +20,7 @@ TESSERA_HOST_DEVICE inline Rgb image_bilerp(const ImageView& img, Vec2 st) {
     iy %= img.height;
     if (ix < 0) ix += img.width;
     if (iy < 0) iy += img.height;
-    return img.texels[static_cast<size_t>(iy) * img.width + ix];
+    return glm::max(img.texels[static_cast<size_t>(iy) * img.width + ix], Rgb(0.f));  // pbrt clamps negatives
   };
   int32_t ix = static_cast<int32_t>(fx), iy = static_cast<int32_t>(fy);
   return (1.f - dx) * (1.f - dy) * texel(ix, iy) + dx * (1.f - dy) * texel(ix + 1, iy) +
@@ -26,14 +30,16 @@ TESSERA_HOST_DEVICE inline Rgb image_bilerp(const ImageView& img, Vec2 st) {
 // Nearest-texel lookup in an equal-area octahedral environment map (pbrt-v4
 // ImageInfiniteLight::ImageLe): uv (0,0) is the top-left texel, no flip.
 TESSERA_HOST_DEVICE inline Rgb image_lookup_nearest_equal_area(const ImageView& img, Vec2 uv) {
-  int32_t x = glm::clamp(static_cast<int32_t>(uv.x * img.width), 0, img.width - 1);
-  int32_t y = glm::clamp(static_cast<int32_t>(uv.y * img.height), 0, img.height - 1);
-  return img.texels[static_cast<size_t>(y) * img.width + x];
+  Float fx = glm::clamp(uv.x, 0.f, 1.f) * img.width, fy = glm::clamp(uv.y, 0.f, 1.f) * img.height;
+  if (!(fx >= 0.f)) fx = 0.f;  // NaN
+  if (!(fy >= 0.f)) fy = 0.f;
+  int32_t x = glm::min(static_cast<int32_t>(fx), img.width - 1);
+  int32_t y = glm::min(static_cast<int32_t>(fy), img.height - 1);
+  return glm::max(img.texels[static_cast<size_t>(y) * img.width + x], Rgb(0.f));  // pbrt clamps negatives
 }
 
-// Textures may nest (scale of a checkerboard of images...). Nesting depth is
-// bounded by the loader's texture order (a texture only references earlier
-// ones), so this terminates; an explicit stack keeps it GPU-friendly.
+// Textures may nest (scale of a checkerboard of images...). The recursion
+// terminates because the loader only lets a texture reference earlier ones.
 TESSERA_HOST_DEVICE inline Rgb eval_texture(const SceneView& s, int32_t tex_index, Vec2 uv) {
   const Texture& t = s.textures[tex_index];
   Vec2 st(t.su * uv.x + t.du, t.sv * uv.y + t.dv);
@@ -50,7 +56,10 @@ TESSERA_HOST_DEVICE inline Rgb eval_texture(const SceneView& s, int32_t tex_inde
       return a * b;
     }
     case TextureType::Checkerboard: {
-      int64_t parity = static_cast<int64_t>(glm::floor(st.x)) + static_cast<int64_t>(glm::floor(st.y));
+      // Parity of floor(s) + floor(t), computed in float so huge or NaN st cannot overflow a cast.
+      Float sum = glm::floor(st.x) + glm::floor(st.y);
+      Float half = sum * 0.5f;
+      int64_t parity = (half == glm::floor(half)) ? 0 : 1;
       const TextureSlot& pick = (parity % 2 == 0) ? t.a : t.b;
       return pick.texture >= 0 ? eval_texture(s, pick.texture, uv) : pick.value;
     }

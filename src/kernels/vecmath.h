@@ -28,6 +28,17 @@ struct Frame {
     f.n = n;
     return f;
   }
+  // x along the tangent (made orthogonal to n), z = n: pbrt-v4's Frame::FromXZ.
+  TESSERA_HOST_DEVICE static Frame from_tangent(const Vec3& n, const Vec3& tangent) {
+    Vec3 s = tangent - n * glm::dot(n, tangent);
+    Float len = glm::length(s);
+    if (!(len > 1e-12f)) return from_z(n);
+    Frame f;
+    f.n = n;
+    f.s = s / len;
+    f.t = glm::cross(n, f.s);
+    return f;
+  }
   TESSERA_HOST_DEVICE Vec3 to_local(const Vec3& v) const { return Vec3(glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)); }
   TESSERA_HOST_DEVICE Vec3 to_world(const Vec3& v) const { return s * v.x + t * v.y + n * v.z; }
 };

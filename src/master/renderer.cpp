@@ -15,6 +15,10 @@
 
 namespace tessera {
 
+uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options) {
+  return options.force_full_specialisation ? kSpecAll : specialisation_for(scene.effects());
+}
+
 RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& opt) {
   const SceneView& view = scene.view();
   const int32_t w = view.camera.width, h = view.camera.height;
@@ -22,7 +26,7 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
   result.film = Film(w, h);
   RenderStats& stats = result.stats;
   stats.effects = scene.effects();
-  stats.specialisation = opt.force_full_specialisation ? kSpecAll : specialisation_for(scene.effects());
+  stats.specialisation = effective_specialisation(scene, opt);
 
   std::vector<TileJob> tiles;
   const int32_t ts = std::max(1, opt.tile_size);

@@ -41,6 +41,9 @@ struct RenderResult {
   RenderStats stats;
 };
 
+// The integrator specialisation a render with these options runs.
+uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options);
+
 RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& options);
 
 }  // namespace tessera

@@ -9,15 +9,33 @@
 namespace tessera {
 namespace {
 
-std::string escape(const std::string& s) {
-  std::string o;
+std::string quote(const std::string& s) {
+  std::string o = "\"";
   for (char c : s) {
     if (c == '"' || c == '\\') o += '\\';
     if (static_cast<unsigned char>(c) < 0x20) continue;
     o += c;
   }
-  return o;
+  return o + "\"";
 }
+
+std::string number(double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.9g", v);
+  return b;
+}
+
+// A flat JSON object written key by key, in insertion order.
+struct JsonObject {
+  std::string body;
+  void add(const char* key, const std::string& json_value) {
+    body += (body.empty() ? "  " : ",\n  ") + quote(key) + ": " + json_value;
+  }
+  void add(const char* key, double v) { add(key, number(v)); }
+  void add(const char* key, uint64_t v) { add(key, std::to_string(v)); }
+  void add_string(const char* key, const std::string& v) { add(key, quote(v)); }
+  std::string str() const { return "{\n" + body + "\n}\n"; }
+};
 
 }  // namespace
 
@@ -26,37 +44,31 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
   const double paths = static_cast<double>(c.samples);
   const double rays = static_cast<double>(c.path.rays + c.path.shadow_rays);
   const double secs = s.seconds > 0 ? s.seconds : 1e-9;
-  char buf[4096];
-  std::snprintf(buf, sizeof buf,
-                "{\n"
-                "  \"tessera_version\": \"%s\",\n"
-                "  \"scene\": \"%s\",\n"
-                "  \"width\": %d,\n  \"height\": %d,\n"
-                "  \"seed\": %llu,\n"
-                "  \"threads\": %d,\n"
-                "  \"spp\": %u,\n  \"passes\": %u,\n"
-                "  \"seconds\": %.6f,\n"
-                "  \"stop_reason\": \"%s\",\n"
-                "  \"paths\": %llu,\n"
-                "  \"rays\": %.0f,\n  \"camera_and_bounce_rays\": %llu,\n  \"shadow_rays\": %llu,\n"
-                "  \"samples_per_second\": %.3f,\n  \"rays_per_second\": %.3f,\n"
-                "  \"mean_path_length\": %.6f,\n"
-                "  \"zero_contribution_fraction\": %.6f,\n"
-                "  \"nonfinite_samples_rejected\": %llu,\n"
-                "  \"negative_samples_clamped\": %llu,\n"
-                "  \"interface_crossings\": %llu,\n"
-                "  \"effects\": \"%s\",\n"
-                "  \"specialisation\": \"%s\"\n"
-                "}\n",
-                TESSERA_VERSION, escape(scene).c_str(), width, height, static_cast<unsigned long long>(seed), s.threads,
-                s.spp, s.passes, s.seconds, s.stop_reason.c_str(), static_cast<unsigned long long>(c.samples), rays,
-                static_cast<unsigned long long>(c.path.rays), static_cast<unsigned long long>(c.path.shadow_rays),
-                paths / secs, rays / secs, paths > 0 ? c.path.vertices / paths : 0.0,
-                paths > 0 ? c.zero_radiance / paths : 0.0, static_cast<unsigned long long>(c.rejected_nonfinite),
-                static_cast<unsigned long long>(c.rejected_negative),
-                static_cast<unsigned long long>(c.path.interface_skips), describe_effects(s.effects).c_str(),
-                describe_specialisation(s.specialisation).c_str());
-  return buf;
+  JsonObject j;
+  j.add_string("tessera_version", TESSERA_VERSION);
+  j.add_string("scene", scene);
+  j.add("width", uint64_t(width));
+  j.add("height", uint64_t(height));
+  j.add("seed", seed);
+  j.add("threads", uint64_t(s.threads));
+  j.add("spp", uint64_t(s.spp));
+  j.add("passes", uint64_t(s.passes));
+  j.add("seconds", s.seconds);
+  j.add_string("stop_reason", s.stop_reason);
+  j.add("paths", c.samples);
+  j.add("rays", c.path.rays + c.path.shadow_rays);
+  j.add("camera_and_bounce_rays", c.path.rays);
+  j.add("shadow_rays", c.path.shadow_rays);
+  j.add("samples_per_second", paths / secs);
+  j.add("rays_per_second", rays / secs);
+  j.add("mean_path_length", paths > 0 ? c.path.vertices / paths : 0.0);
+  j.add("zero_contribution_fraction", paths > 0 ? c.zero_radiance / paths : 0.0);
+  j.add("nonfinite_samples_rejected", c.rejected_nonfinite);
+  j.add("negative_samples_clamped", c.rejected_negative);
+  j.add("interface_crossings", c.path.interface_skips);
+  j.add_string("effects", describe_effects(s.effects));
+  j.add_string("specialisation", describe_specialisation(s.specialisation));
+  return j.str();
 }
 
 void write_text_file(const std::string& path, const std::string& text) {

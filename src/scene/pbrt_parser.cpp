@@ -220,6 +220,10 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     scene_.film.yres = ps.get_int("yresolution", 720);
     scene_.film.filename = ps.get_string("filename", scene_.film.filename);
     if (scene_.film.xres <= 0 || scene_.film.yres <= 0) fail(at, "film resolution must be positive");
+    if (scene_.film.xres > kMaxFilmDimension || scene_.film.yres > kMaxFilmDimension ||
+        int64_t(scene_.film.xres) * scene_.film.yres > kMaxFilmPixels)
+      fail(at, "film resolution " + std::to_string(scene_.film.xres) + "x" + std::to_string(scene_.film.yres) +
+                   " is larger than supported (" + std::to_string(kMaxFilmPixels) + " pixels)");
     ps.report_unused(warnings);
   } else if (d == "Sampler") {
     std::string type = read_string(tokens, pos, at);
@@ -235,6 +239,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
     if (type != "path" && type != "volpath") warn("integrator \"" + type + "\" is rendered with \"path\"");
     scene_.max_depth = ps.get_int("maxdepth", 5);
+    if (scene_.max_depth < 0) fail(at, "maxdepth must not be negative");
     if (type != "path") ps.mark_all_used();
     ps.report_unused(warnings);
   } else if (d == "PixelFilter") {

@@ -48,6 +48,10 @@ struct CameraDesc {
   std::string where;
 };
 
+// Largest image we accept: each pixel costs ~56 bytes of accumulators.
+constexpr int64_t kMaxFilmDimension = 65536;
+constexpr int64_t kMaxFilmPixels = int64_t(1) << 27;
+
 struct FilmDesc {
   int32_t xres = 1280, yres = 720;
   std::string filename = "pbrt.exr";

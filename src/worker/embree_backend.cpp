@@ -7,9 +7,11 @@
 namespace tessera {
 namespace {
 
-void embree_error(void*, RTCError code, const char* message) {
-  if (code == RTC_ERROR_NONE) return;
-  throw std::runtime_error(std::string("embree: ") + (message ? message : "unknown error"));
+// Exceptions must not cross Embree's C API: remember the first message and
+// check after each call that can fail.
+void embree_error(void* user, RTCError code, const char* message) {
+  auto* first = static_cast<std::string*>(user);
+  if (code != RTC_ERROR_NONE && first->empty()) *first = message ? message : "unknown error";
 }
 
 }  // namespace
@@ -17,7 +19,16 @@ void embree_error(void*, RTCError code, const char* message) {
 EmbreeScene::EmbreeScene(const SceneData& data) {
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error("embree: cannot create device");
-  rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
+  rtcSetDeviceErrorFunction(device_, embree_error, &error_);
+  try {
+    build(data);
+  } catch (...) {
+    this->~EmbreeScene();
+    throw;
+  }
+}
+
+void EmbreeScene::build(const SceneData& data) {
   scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
   const size_t nv = data.positions().size(), nt = data.num_triangles();
@@ -25,19 +36,26 @@ EmbreeScene::EmbreeScene(const SceneData& data) {
     RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
     // New buffers (not shared) so Embree owns the padding it needs past the end.
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
-    std::memcpy(v, data.positions().data(), nv * 3 * sizeof(float));
     auto* ix = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), nt));
+    if (!v || !ix) {
+      rtcReleaseGeometry(geom);
+      throw std::runtime_error("embree: cannot allocate geometry buffers" + (error_.empty() ? "" : ": " + error_));
+    }
+    std::memcpy(v, data.positions().data(), nv * 3 * sizeof(float));
     std::memcpy(ix, data.indices().data(), nt * 3 * sizeof(uint32_t));
     rtcCommitGeometry(geom);
     rtcAttachGeometry(scene_, geom);
     rtcReleaseGeometry(geom);
   }
   rtcCommitScene(scene_);
+  if (!error_.empty()) throw std::runtime_error("embree: " + error_);
 }
 
 EmbreeScene::~EmbreeScene() {
   if (scene_) rtcReleaseScene(scene_);
   if (device_) rtcReleaseDevice(device_);
+  scene_ = nullptr;
+  device_ = nullptr;
 }
 
 }  // namespace tessera

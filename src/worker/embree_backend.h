@@ -4,6 +4,8 @@
 
 #include <embree3/rtcore.h>
 
+#include <string>
+
 #include "kernels/integrator.h"
 #include "worker/scene_data.h"
 
@@ -63,6 +65,8 @@ class EmbreeScene {
   EmbreeTracer tracer() const { return EmbreeTracer{scene_}; }
 
  private:
+  void build(const SceneData& data);
+  std::string error_;  // first error Embree reported
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
 };

@@ -64,7 +64,6 @@ void SceneData::flatten_meshes() {
 
 void SceneData::build_lights() {
   for (const Light& l : desc_.lights) lights_.push_back(l);
-  Vec3 center = triangles_.empty() ? Vec3(0.f) : 0.5f * (bounds_.lo + bounds_.hi);
   Float radius = triangles_.empty() ? 1.f : glm::max(1e-3f, 0.5f * glm::length(bounds_.hi - bounds_.lo));
 
   image_views_.reserve(desc_.images.size());
@@ -86,6 +85,7 @@ void SceneData::build_lights() {
       case LightType::Distant: power[i] = luminance(l.L) * kPi * radius * radius; break;
       case LightType::Infinite: {
         infinite_lights_.push_back(static_cast<int32_t>(i));
+        lights_[i].world_from_light = glm::inverse(l.light_from_world);
         Float avg = luminance(l.L);
         if (l.image >= 0) {
           const ImageDesc& img = desc_.images[l.image];
@@ -106,8 +106,6 @@ void SceneData::build_lights() {
   light_select_ = Distribution1D(power);
   env_views_.resize(lights_.size());
   for (size_t i = 0; i < lights_.size(); ++i) env_views_[i] = env_storage_[i].view();
-  view_.scene_center = center;
-  view_.scene_radius = radius;
 }
 
 void SceneData::build_camera() {
@@ -173,10 +171,6 @@ void SceneData::build_view() {
   v.camera = camera_;
   v.filter.inverse_cdf = filter_inverse_cdf_.data();
   v.filter.n = static_cast<uint32_t>(filter_inverse_cdf_.size());
-  v.filter.radius = desc_.filter.radius;
-  // Offsets relative to coordinate magnitude: float carries ~7 digits, the
-  // reconstructed hit point is good to a few ulps.
-  v.ray_epsilon = 1e-4f;
 }
 
 }  // namespace tessera
