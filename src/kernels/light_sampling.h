@@ -47,7 +47,7 @@ TESSERA_HOST_DEVICE inline Float spot_falloff(const Light& l, Float cos_theta) {
   return t * t * (3.f - 2.f * t);
 }
 
-TESSERA_HOST_DEVICE inline bool sample_light(const SceneView& s, uint32_t light_index, const Vec3& ref_p, Vec2 u,
+TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_t light_index, const Vec3& ref_p, Vec2 u,
                                              LightSample* out) {
   const Light& l = s.lights[light_index];
   LightSample ls;

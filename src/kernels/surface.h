@@ -16,7 +16,7 @@ struct SurfaceHit {
 };
 
 // b1, b2: barycentrics of vertices 1 and 2 (Embree's u, v).
-TESSERA_HOST_DEVICE inline SurfaceHit make_surface_hit(const SceneView& s, uint32_t tri, Float b1, Float b2) {
+TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& s, uint32_t tri, Float b1, Float b2) {
   const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
   const TriangleInfo& info = s.triangles[tri];
   Float b0 = 1.f - b1 - b2;
@@ -52,13 +52,13 @@ TESSERA_HOST_DEVICE inline SurfaceHit make_surface_hit(const SceneView& s, uint3
 // by the rounding-error bound of the hit point (pbrt-v4's OffsetRayOrigin),
 // with a safety factor for Embree's own intersection arithmetic. Scale-free:
 // a scene modelled in millimetres or in kilometres gets the same relative offset.
-TESSERA_HOST_DEVICE inline Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& ng, const Vec3& w) {
+TESSERA_HOST_DEVICE TESSERA_INLINE Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& ng, const Vec3& w) {
   constexpr Float kSafety = 16.f;
   Float d = kSafety * glm::dot(glm::abs(ng), p_error) + 1e-30f;
   Vec3 off = d * ng;
   return glm::dot(w, ng) >= 0.f ? p + off : p - off;
 }
-TESSERA_HOST_DEVICE inline Vec3 offset_ray_origin(const SurfaceHit& h, const Vec3& w) {
+TESSERA_HOST_DEVICE TESSERA_INLINE Vec3 offset_ray_origin(const SurfaceHit& h, const Vec3& w) {
   return offset_ray_origin(h.p, h.p_error, h.ng, w);
 }
 
