@@ -4,6 +4,7 @@
 #include <regex>
 
 #include "app/commands.h"
+#include "app/guide_setup.h"
 #include "app/scene_loading.h"
 #include "master/image_output.h"
 #include "master/renderer.h"
@@ -19,6 +20,7 @@ struct RenderArgs {
   int64_t seed = -1;
   double time = 0.0;
   bool quiet = false, no_preview = false, full_specialisation = false;
+  GuideArgs guide;
 };
 
 void parse_resolution(const std::string& res, SceneDesc& d) {
@@ -62,15 +64,26 @@ int run_render(const RenderArgs& a) {
   if (preview.empty() && !a.no_preview) preview = std::filesystem::path(out).replace_extension(".png").string();
 
   SceneData scene(std::move(desc));
-  const uint32_t spec = effective_specialisation(scene, opt);
+  std::string guide_why;
+  std::unique_ptr<GuideField> guide = make_guide(a.guide, scene, &guide_why);
+  const uint32_t spec = effective_specialisation(scene, opt, guide != nullptr);
   std::fprintf(stderr, "tessera: %s: %zu triangles, %u lights, %dx%d, %s, max depth %d\n",
                scene.desc().source.c_str(), scene.num_triangles(), scene.view().num_lights, scene.view().camera.width,
                scene.view().camera.height,
                opt.spp > 0 ? (std::to_string(opt.spp) + " spp").c_str() : "unlimited spp", opt.max_depth);
   std::fprintf(stderr, "tessera: effects: %s; integrator specialisation: %s\n", describe_effects(scene.effects()).c_str(),
                describe_specialisation(spec).c_str());
+  if (guide) {
+    std::fprintf(stderr, "tessera: guiding: %s (%s), %u direction bins, %s light selection, budget %.0f MB\n",
+                 guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable", guide_why.c_str(),
+                 guide->config().grid * guide->config().grid, guide->learned_lights() ? "learned" : "power-based",
+                 guide->config().budget_bytes / 1048576.0);
+  } else {
+    std::fprintf(stderr, "tessera: guiding: none (%s)\n", guide_why.c_str());
+  }
   EmbreeScene embree(scene);
-  RenderResult r = render(scene, embree, opt);
+  RenderResult r = render(scene, embree, opt, guide.get());
+  if (guide) save_guide(a.guide, *guide, scene);
 
   ImageRgb mean = film_mean(r.film), var = film_variance_of_mean(r.film);
   ExrMetadata meta;
@@ -79,6 +92,7 @@ int run_render(const RenderArgs& a) {
   meta.strings["seed"] = std::to_string(opt.seed);
   meta.strings["effects"] = describe_effects(scene.effects());
   meta.strings["specialisation"] = describe_specialisation(spec);
+  meta.strings["guide"] = r.stats.guide_mode;
   meta.strings["software"] = "tessera " TESSERA_VERSION;
   meta.strings["scene"] = scene.desc().source;
   write_exr(out, mean, &var, meta);
@@ -95,6 +109,13 @@ int run_render(const RenderArgs& a) {
     std::fprintf(stderr, "; rejected %llu NaN/Inf and %llu negative samples",
                  static_cast<unsigned long long>(c.rejected_nonfinite), static_cast<unsigned long long>(c.rejected_negative));
   std::fputc('\n', stderr);
+  if (guide) {
+    const GuideFieldStats& g = r.stats.guide;
+    std::fprintf(stderr, "tessera: guide: %llu cells, %.1f MB, %llu updates, %llu targets rejected%s\n",
+                 static_cast<unsigned long long>(g.cells), g.bytes / 1048576.0, static_cast<unsigned long long>(g.updates),
+                 static_cast<unsigned long long>(g.rejected_nonfinite + g.rejected_large),
+                 g.budget_reached ? ", memory budget reached" : "");
+  }
   if (!a.stats.empty()) {
     write_text_file(a.stats, stats_to_json(r.stats, scene.desc().source, mean.width, mean.height, opt.seed));
     std::printf("wrote %s\n", a.stats.c_str());
@@ -122,6 +143,7 @@ CommandRunner add_render_command(CLI::App& app) {
   c->add_flag("-q,--quiet", a->quiet, "No progress output");
   c->add_flag("--full-specialisation", a->full_specialisation,
               "Run the integrator compiled for every effect instead of the scene's effects set (for benchmarks)");
+  add_guide_options(c, a->guide);
   return [a] { return run_render(*a); };
 }
 

@@ -13,5 +13,6 @@ CommandRunner add_render_command(CLI::App& app);
 CommandRunner add_info_command(CLI::App& app);
 CommandRunner add_compare_command(CLI::App& app);
 CommandRunner add_bench_rays_command(CLI::App& app);
+CommandRunner add_guide_viz_command(CLI::App& app);
 
 }  // namespace tessera

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   add(tessera::add_info_command);
   add(tessera::add_compare_command);
   add(tessera::add_bench_rays_command);
+  add(tessera::add_guide_viz_command);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

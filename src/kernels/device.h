@@ -41,4 +41,15 @@ constexpr Float kInvPi = 0.31830988618379067154f;
 constexpr Float kInv2Pi = 0.15915494309189533577f;
 constexpr Float kInv4Pi = 0.07957747154594766788f;
 
+// Relaxed atomic add, for order-independent integer accumulators (sums come
+// out bit-identical whatever the thread or block order). Signed values are
+// added as their two's-complement bits.
+TESSERA_HOST_DEVICE inline void atomic_add_u64(uint64_t* p, uint64_t v) {
+#if TESSERA_IS_GPU_CODE
+  atomicAdd(reinterpret_cast<unsigned long long*>(p), static_cast<unsigned long long>(v));
+#else
+  __atomic_fetch_add(p, v, __ATOMIC_RELAXED);
+#endif
+}
+
 }  // namespace tessera

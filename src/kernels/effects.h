@@ -28,7 +28,8 @@ enum Specialisation : uint32_t {
   kSpecTextures = 1u << 1,
   kSpecAreaLights = 1u << 2,
   kSpecEnvironment = 1u << 3,
-  kSpecAll = (1u << 4) - 1,
+  kSpecGuiding = 1u << 4,      // learned guiding (set by the render options, not by the scene)
+  kSpecAll = (1u << 5) - 1,
 };
 
 TESSERA_HOST_DEVICE inline uint32_t specialisation_for(uint32_t effects) {

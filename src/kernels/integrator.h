@@ -9,6 +9,7 @@
 #include "bsdf.h"
 #include "camera.h"
 #include "effects.h"
+#include "guiding.h"
 #include "light_sampling.h"
 #include "material_eval.h"
 #include "rng.h"
@@ -29,11 +30,15 @@ struct PathCounters {
   uint64_t shadow_rays = 0;   // occlusion queries
   uint64_t vertices = 0;      // surface interactions along paths
   uint64_t interface_skips = 0;
+  uint64_t guidable_vertices = 0;  // vertices where the guide could be used (no delta lobe)
+  uint64_t guided_samples = 0;     // directions drawn from the guide
+  uint64_t guide_updates = 0;      // direction targets accepted by the guide
 };
 
 struct PathSettings {
   int32_t max_depth = 5;
   bool nee = true;  // false: emitters are found by BSDF sampling only (for tests and comparisons)
+  GuideView guide;  // read and updated by the kSpecGuiding specialisation only
 };
 
 namespace detail {
@@ -74,32 +79,62 @@ TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, const Vec3& wo, Fl
 }
 
 // Radiance arriving along the ray; consumes random numbers from rng in a fixed order.
+//
+// With kSpecGuiding, directions at vertices without a delta lobe are drawn
+// from a mixture of the BSDF and the learned guide (probability
+// guide.guide_prob), weighted by the mixture pdf, which also stands in for the
+// BSDF pdf in every MIS weight: the estimator stays unbiased whatever the
+// guide has learned. Each traced segment x -> y sends Dahm & Keller's target
+// Le(y) + (integral of Q f cos at y) to x's cell, and each shadow ray sends
+// its unoccluded contribution to the light-selection entry of x's cell.
 template <uint32_t Spec, class Tracer>
 TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray ray, Rng& rng,
                                    const PathSettings& settings, PathCounters& c) {
+  constexpr bool kGuide = (Spec & kSpecGuiding) != 0;
+  const GuideView& g = settings.guide;
+  const GuideView* guide = kGuide ? &g : nullptr;
   Rgb L(0.f), beta(1.f);
+  // Russian roulette decides on the throughput BSDF sampling alone would have
+  // (pbrt-v4's rule). Guided directions carry small weights exactly where the
+  // guide is confident; letting those weights drive roulette would kill the
+  // paths guiding worked to find. Any survival probability keeps the
+  // estimator unbiased, as the weight is divided by it.
+  Rgb rr_beta(1.f);
   int32_t depth = 0;
   bool specular_bounce = false;
-  Float prev_bsdf_pdf = 0.f;
+  Float prev_scatter_pdf = 0.f;  // pdf of the last sampled direction (the mixture's when guided)
   Vec3 prev_p(0.f);  // last scattering point: MIS on emitter hits measures from it, as NEE does
+  int32_t prev_cell = -1;  // guide cell of the last scattering point (its light selection)
   Float eta_scale = 1.f;
   int32_t interface_skips = 0;
+  // Learning update waiting for the end of the current segment: into entry
+  // pend_bin of cell pend_cell. pend_le holds Le(y) while a delta vertex y
+  // waits for its sampled direction.
+  int32_t pend_cell = -1;
+  uint32_t pend_bin = 0;
+  Float pend_le = 0.f;
+  bool pend_at_delta = false;
 
   for (;;) {
     TraceHit hit;
     ++c.rays;
     if (!tracer.intersect(ray.o, ray.d, kInfinity, &hit)) {
+      Rgb Le_total(0.f);
       if constexpr ((Spec & kSpecEnvironment) != 0) {
         for (uint32_t k = 0; k < s.num_infinite_lights; ++k) {
           uint32_t li = static_cast<uint32_t>(s.infinite_lights[k]);
           Rgb Le = environment_radiance(s, s.lights[li], ray.d);
+          Le_total += Le;
           if (depth == 0 || specular_bounce || !settings.nee) {
             L += beta * Le;
           } else {
-            Float light_pdf = s.light_select.discrete_pmf(li) * environment_pdf(s, li, ray.d);
-            L += beta * Le * power_heuristic(prev_bsdf_pdf, light_pdf);
+            Float light_pdf = light_select_pmf(s, guide, prev_cell, li) * environment_pdf(s, li, ray.d);
+            L += beta * Le * power_heuristic(prev_scatter_pdf, light_pdf);
           }
         }
+      }
+      if constexpr (kGuide) {
+        if (pend_cell >= 0 && !pend_at_delta && guide_record(g, pend_cell, pend_bin, luminance(Le_total))) ++c.guide_updates;
       }
       break;
     }
@@ -108,17 +143,19 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     Vec3 wo = -ray.d;
     const TriangleInfo& info = s.triangles[hit.triangle];
 
+    Rgb Le_hit(0.f);  // radiance emitted at this vertex towards the previous one
     if constexpr ((Spec & kSpecAreaLights) != 0) {
       if (info.light >= 0) {
         const Light& l = s.lights[info.light];
         Float cos_l = glm::dot(h.ng, wo);
         if (l.two_sided || cos_l > 0.f) {
+          Le_hit = l.L;
           if (depth == 0 || specular_bounce || !settings.nee) {
             L += beta * l.L;
           } else {
-            Float light_pdf = s.light_select.discrete_pmf(static_cast<uint32_t>(info.light)) *
+            Float light_pdf = light_select_pmf(s, guide, prev_cell, static_cast<uint32_t>(info.light)) *
                               area_light_pdf(l.area, glm::length(h.p - prev_p), cos_l);
-            L += beta * l.L * power_heuristic(prev_bsdf_pdf, light_pdf);
+            L += beta * l.L * power_heuristic(prev_scatter_pdf, light_pdf);
           }
         }
       }
@@ -132,7 +169,6 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       ray.o = offset_ray_origin(h, ray.d);
       continue;
     }
-    if (depth++ == settings.max_depth) break;
 
     // Anisotropic BSDFs need pbrt's orientation (x along dp/du); any frame
     // around the normal serves the isotropic ones.
@@ -140,16 +176,41 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
                       ? Frame::from_tangent(h.ns, surface_dpdu(s, hit.triangle))
                       : Frame::from_z(h.ns);
     Vec3 wo_l = frame.to_local(wo);
-    if (wo_l.z == 0.f) break;
     uint32_t lobes = (Spec & kSpecNonDiffuse) ? bsdf_lobes(bsdf) : (kLobeReflection | kLobeDiffuse);
+    const bool delta_lobe = (lobes & kLobeSpecular) != 0;
+
+    int32_t cell = -1;
+    if constexpr (kGuide) {
+      // The side the path is on: the two faces of a wall never share a cell.
+      Vec3 n_side = glm::dot(h.ng, wo) >= 0.f ? h.ng : -h.ng;
+      cell = guide_find_cell(g, h.p, n_side);
+      guide_record_normal(g, cell, n_side);
+      if (pend_cell >= 0) {
+        if (!delta_lobe) {
+          const bool lambertian = (Spec & kSpecNonDiffuse) == 0 || bsdf.type == BsdfType::Diffuse;
+          Float integral = guide_bins_integral(g, cell, bsdf, lambertian, wo_l,
+                                               [&](const Vec3& v) { return frame.to_local(v); }, rng.uniform());
+          if (guide_record(g, pend_cell, pend_bin, luminance(Le_hit) + integral)) ++c.guide_updates;
+          pend_cell = -1;
+        } else {
+          pend_le = luminance(Le_hit);  // finished once this vertex has sampled its direction
+          pend_at_delta = true;
+        }
+      }
+    }
+
+    if (depth++ == settings.max_depth) break;
+    if (wo_l.z == 0.f) break;
+    const bool guided_vertex = kGuide && !delta_lobe;
 
     // Next-event estimation at non-specular vertices (pbrt-v4's SampleLd).
     if (settings.nee && lobes_have_non_specular(lobes) && s.num_lights > 0) {
       Float u_select = rng.uniform();
       Vec2 u_light = rng.uniform2();
       Float pmf = 0.f;
-      uint32_t li = s.light_select.sample_discrete(u_select, &pmf);
+      uint32_t li = select_light(s, guide, cell, u_select, &pmf);
       LightSample ls;
+      Float learned = 0.f;  // unoccluded contribution of the selected light, for the guide
       if (pmf > 0.f && sample_light(s, li, h.p, u_light, &ls)) {
         Vec3 wi_l = frame.to_local(ls.wi);
         Rgb f = eval_f<Spec>(bsdf, wo_l, wi_l) * abs_cos_theta(wi_l);
@@ -161,34 +222,85 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           Float light_pdf = pmf * ls.pdf;
           if (light_pdf > 0.f && !tracer.occluded(o, ls.wi, tmax)) {
             Float w = 1.f;
-            if (!ls.delta) w = power_heuristic(light_pdf, eval_pdf<Spec>(bsdf, wo_l, wi_l));
+            if (!ls.delta) {
+              Float scatter_pdf = eval_pdf<Spec>(bsdf, wo_l, wi_l);
+              if (guided_vertex) scatter_pdf = g.guide_prob * guide_pdf(g, cell, ls.wi) + (1.f - g.guide_prob) * scatter_pdf;
+              w = power_heuristic(light_pdf, scatter_pdf);
+            }
             L += beta * f * ls.L * (w / light_pdf);
+            learned = luminance(f * ls.L) / ls.pdf;
           }
         }
+      }
+      if constexpr (kGuide) {
+        if (g.lights > 0 && pmf > 0.f) guide_record(g, cell, g.bins + li, learned);
       }
     }
 
     Float uc = rng.uniform();
     Vec2 u = rng.uniform2();
     BsdfSample bs;
-    if (!sample_f<Spec>(bsdf, wo_l, uc, u, &bs) || !(bs.pdf > 0.f)) break;
-    beta *= bs.f * (abs_cos_theta(bs.wi) / bs.pdf);
-    prev_bsdf_pdf = bs.pdf;
+    Vec3 wi;  // world space
+    Float scatter_pdf;
+    Float bsdf_pdf;  // the BSDF's own pdf of the direction taken (for roulette)
+    uint32_t wi_bin = 0;  // guide bin of wi (guiding only)
+    if (guided_vertex) {
+      // One extra dimension picks the strategy; the mixture pdf weights either.
+      ++c.guidable_vertices;
+      const Float p = g.guide_prob;
+      if (rng.uniform() < p) {
+        ++c.guided_samples;
+        Float guide_density;
+        if (!guide_sample(g, cell, uc, u, &wi, &guide_density, &wi_bin)) break;
+        bs.wi = frame.to_local(wi);
+        bs.f = eval_f<Spec>(bsdf, wo_l, bs.wi);
+        const bool transmit = !same_hemisphere(wo_l, bs.wi);
+        bs.lobe = transmit ? kLobeTransmission : kLobeReflection;
+        bs.eta = transmit ? (wo_l.z > 0.f ? bsdf.ior : 1.f / bsdf.ior) : 1.f;
+        bsdf_pdf = eval_pdf<Spec>(bsdf, wo_l, bs.wi);
+        scatter_pdf = p * guide_density + (1.f - p) * bsdf_pdf;
+      } else {
+        if (!sample_f<Spec>(bsdf, wo_l, uc, u, &bs) || !(bs.pdf > 0.f)) break;
+        wi = frame.to_world(bs.wi);
+        bsdf_pdf = bs.pdf;
+        wi_bin = guide_bin_of(g, wi);
+        scatter_pdf = p * guide_bin_pdf(g, cell, wi_bin) + (1.f - p) * bs.pdf;
+      }
+    } else {
+      if (!sample_f<Spec>(bsdf, wo_l, uc, u, &bs) || !(bs.pdf > 0.f)) break;
+      wi = frame.to_world(bs.wi);
+      scatter_pdf = bsdf_pdf = bs.pdf;
+      if constexpr (kGuide) wi_bin = guide_bin_of(g, wi);
+    }
+    if (!(scatter_pdf > 0.f)) break;
+    const Rgb weight = bs.f * (abs_cos_theta(bs.wi) / scatter_pdf);
+    if constexpr (kGuide) {
+      // A delta vertex's integral is the direction it actually took.
+      if (pend_at_delta && pend_cell >= 0 &&
+          guide_record(g, pend_cell, pend_bin, pend_le + guide_value(g, cell, wi_bin) * luminance(weight)))
+        ++c.guide_updates;
+      pend_cell = cell;
+      pend_bin = wi_bin;
+      pend_at_delta = false;
+    }
+    beta *= weight;
+    rr_beta *= bsdf_pdf > 0.f ? bs.f * (abs_cos_theta(bs.wi) / bsdf_pdf) : weight;
+    prev_scatter_pdf = scatter_pdf;
+    prev_cell = cell;
     specular_bounce = (bs.lobe & kLobeSpecular) != 0;
     if (bs.lobe & kLobeTransmission) eta_scale *= sqr(bs.eta);
-    Vec3 wi = frame.to_world(bs.wi);
     ray.o = offset_ray_origin(h, wi);
     ray.d = wi;
     prev_p = h.p;
 
     // Russian roulette (pbrt-v4): after the second bounce, on throughput
     // corrected for radiance scaling at refractive boundaries.
-    Rgb rr_beta = beta * eta_scale;
-    Float m = max_component(rr_beta);
+    Float m = max_component(rr_beta * eta_scale);
     if (m < 1.f && depth > 1) {
       Float q = glm::max(0.f, 1.f - m);
       if (rng.uniform() < q) break;
       beta /= 1.f - q;
+      rr_beta /= 1.f - q;
     }
     if (is_black(beta)) break;
   }

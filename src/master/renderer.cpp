@@ -15,18 +15,19 @@
 
 namespace tessera {
 
-uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options) {
-  return options.force_full_specialisation ? kSpecAll : specialisation_for(scene.effects());
+uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options, bool guiding) {
+  uint32_t spec = options.force_full_specialisation ? (kSpecAll & ~kSpecGuiding) : specialisation_for(scene.effects());
+  return guiding ? spec | kSpecGuiding : spec;
 }
 
-RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& opt) {
+RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& opt, GuideField* guide) {
   const SceneView& view = scene.view();
   const int32_t w = view.camera.width, h = view.camera.height;
   RenderResult result;
   result.film = Film(w, h);
   RenderStats& stats = result.stats;
   stats.effects = scene.effects();
-  stats.specialisation = effective_specialisation(scene, opt);
+  stats.specialisation = effective_specialisation(scene, opt, guide != nullptr);
 
   std::vector<TileJob> tiles;
   const int32_t ts = std::max(1, opt.tile_size);
@@ -67,6 +68,8 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
     uint32_t pass_spp = std::min<uint32_t>(opt.max_pass_spp, pass == 0 ? 1u : (1u << std::min(pass - 1, 20u)));
     if (opt.spp > 0) pass_spp = std::min(pass_spp, opt.spp - spp_done);
     const double pass_start = elapsed();
+    const TileCounters before = stats.counters;
+    if (guide) ts_settings.path.guide = guide->view();
     arena.execute([&] {
       tbb::parallel_for(size_t(0), tiles.size(), [&](size_t i) {
         TileJob job = tiles[i];
@@ -81,12 +84,30 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
         progress.advance(done, spp_done);
       });
     });
+    if (guide) {
+      const double fold_start = elapsed();
+      guide->fold();
+      stats.guide_fold_seconds += elapsed() - fold_start;
+    }
     spp_done += pass_spp;
     ++stats.passes;
     last_pass_s = elapsed() - pass_start;
+    PassStats ps;
+    ps.spp = pass_spp;
+    ps.seconds = last_pass_s;
+    ps.samples = stats.counters.samples - before.samples;
+    ps.zero_radiance = stats.counters.zero_radiance - before.zero_radiance;
+    ps.vertices = stats.counters.path.vertices - before.path.vertices;
+    ps.guided_samples = stats.counters.path.guided_samples - before.path.guided_samples;
+    ps.guidable_vertices = stats.counters.path.guidable_vertices - before.path.guidable_vertices;
+    stats.pass_stats.push_back(ps);
   }
   stats.spp = spp_done;
   stats.seconds = elapsed();
+  if (guide) {
+    stats.guide = guide->stats();
+    stats.guide_mode = guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable";
+  }
   progress.finish(samples_done.load(), spp_done);
   return result;
 }

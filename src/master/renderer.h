@@ -4,7 +4,9 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
+#include "guidecache/guide_field.h"
 #include "master/film.h"
 #include "worker/embree_backend.h"
 #include "worker/render_tile.h"
@@ -25,6 +27,17 @@ struct RenderOptions {
   bool progress = true;
 };
 
+// What one pass did (learning progress shows here when guiding).
+struct PassStats {
+  uint32_t spp = 0;           // samples per pixel in this pass
+  double seconds = 0.0;       // wall time of the pass, guide fold included
+  uint64_t samples = 0;
+  uint64_t zero_radiance = 0;
+  uint64_t vertices = 0;      // surface interactions
+  uint64_t guided_samples = 0;
+  uint64_t guidable_vertices = 0;
+};
+
 struct RenderStats {
   uint32_t spp = 0;
   uint32_t passes = 0;
@@ -34,6 +47,10 @@ struct RenderStats {
   uint32_t specialisation = 0;
   int32_t threads = 0;
   std::string stop_reason;
+  std::vector<PassStats> pass_stats;
+  std::string guide_mode = "none";  // none | qtable | qlearning
+  GuideFieldStats guide;            // as the field stood at the end (when guided)
+  double guide_fold_seconds = 0.0;
 };
 
 struct RenderResult {
@@ -42,8 +59,12 @@ struct RenderResult {
 };
 
 // The integrator specialisation a render with these options runs.
-uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options);
+uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options, bool guiding);
 
-RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& options);
+// Renders passes until options.spp or the time budget is reached. With a
+// guide, every pass samples from the field as it stood when the pass began
+// and the pass's learning is folded in before the next one.
+RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& options,
+                    GuideField* guide = nullptr);
 
 }  // namespace tessera

@@ -68,6 +68,31 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
   j.add("interface_crossings", c.path.interface_skips);
   j.add_string("effects", describe_effects(s.effects));
   j.add_string("specialisation", describe_specialisation(s.specialisation));
+  j.add_string("guide", s.guide_mode);
+  if (s.guide_mode != "none") {
+    j.add("guide_cache_bytes", s.guide.bytes);
+    j.add("guide_cells", s.guide.cells);
+    j.add("guide_updates", s.guide.updates);
+    j.add("guide_splits", s.guide.splits);
+    j.add("guide_budget_reached", std::string(s.guide.budget_reached ? "true" : "false"));
+    j.add("guide_targets_rejected_nonfinite", s.guide.rejected_nonfinite);
+    j.add("guide_targets_rejected_large", s.guide.rejected_large);
+    j.add("guide_fold_seconds", s.guide_fold_seconds);
+    j.add("guided_sample_fraction",
+          c.path.guidable_vertices > 0 ? double(c.path.guided_samples) / double(c.path.guidable_vertices) : 0.0);
+  }
+  // Per pass: how learning changes the paths.
+  std::string passes = "[";
+  for (size_t i = 0; i < s.pass_stats.size(); ++i) {
+    const PassStats& p = s.pass_stats[i];
+    const double n = p.samples > 0 ? double(p.samples) : 1.0;
+    passes += (i ? ",\n    " : "\n    ") + std::string("{\"spp\": ") + std::to_string(p.spp) +
+              ", \"seconds\": " + number(p.seconds) + ", \"zero_contribution_fraction\": " +
+              number(p.zero_radiance / n) + ", \"mean_path_length\": " + number(p.vertices / n) +
+              ", \"guided_sample_fraction\": " +
+              number(p.guidable_vertices ? double(p.guided_samples) / double(p.guidable_vertices) : 0.0) + "}";
+  }
+  j.add("per_pass", passes + "\n  ]");
   return j.str();
 }
 

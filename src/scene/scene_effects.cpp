@@ -77,9 +77,9 @@ std::string describe_effects(uint32_t e) {
 
 std::string describe_specialisation(uint32_t s) {
   if (s == kSpecAll) return "full";
-  static const char* names[] = {"non-diffuse-bsdfs", "textures", "area-lights", "environment"};
+  static const char* names[] = {"non-diffuse-bsdfs", "textures", "area-lights", "environment", "guiding"};
   std::string out;
-  for (uint32_t i = 0; i < 4; ++i) {
+  for (uint32_t i = 0; i < 5; ++i) {
     if (s & (1u << i)) {
       if (!out.empty()) out += "+";
       out += names[i];

@@ -33,6 +33,9 @@ struct TileCounters {
     path.shadow_rays += o.path.shadow_rays;
     path.vertices += o.path.vertices;
     path.interface_skips += o.path.interface_skips;
+    path.guidable_vertices += o.path.guidable_vertices;
+    path.guided_samples += o.path.guided_samples;
+    path.guide_updates += o.path.guide_updates;
     samples += o.samples;
     zero_radiance += o.zero_radiance;
     rejected_nonfinite += o.rejected_nonfinite;

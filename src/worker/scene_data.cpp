@@ -1,5 +1,6 @@
 #include "worker/scene_data.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "kernels/equal_area.h"
@@ -171,6 +172,56 @@ void SceneData::build_view() {
   v.camera = camera_;
   v.filter.inverse_cdf = filter_inverse_cdf_.data();
   v.filter.n = static_cast<uint32_t>(filter_inverse_cdf_.size());
+}
+
+namespace {
+
+// FNV-1a over raw bytes: stable across runs and machines of one endianness.
+struct Fnv1a {
+  uint64_t h = 0xcbf29ce484222325ull;
+  void add(const void* data, size_t n) {
+    const auto* b = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 0x100000001b3ull;
+  }
+  template <class T>
+  void add_vector(const std::vector<T>& v) {
+    uint64_t n = v.size();
+    add(&n, sizeof n);
+    if (!v.empty()) add(v.data(), v.size() * sizeof(T));
+  }
+};
+
+}  // namespace
+
+uint64_t SceneData::fingerprint() const {
+  Fnv1a f;
+  f.add_vector(positions_);
+  f.add_vector(indices_);
+  for (const TriangleInfo& t : triangles_) {
+    f.add(&t.material, sizeof t.material);
+    f.add(&t.light, sizeof t.light);
+  }
+  for (const Light& l : lights_) {
+    f.add(&l.type, sizeof l.type);
+    f.add(&l.L, sizeof l.L);
+    f.add(&l.position, sizeof l.position);
+  }
+  uint64_t materials = desc_.materials.size();
+  f.add(&materials, sizeof materials);
+  return f.h;
+}
+
+Float SceneData::max_emitted_radiance() const {
+  Float m = 0.f;
+  for (const Light& l : lights_) {
+    Float scale = 1.f;
+    if (l.type == LightType::Infinite && l.image >= 0) {
+      scale = 0.f;
+      for (const Rgb& t : desc_.images[l.image].texels) scale = std::max(scale, luminance(t));
+    }
+    m = std::max(m, luminance(l.L) * scale);
+  }
+  return m;
 }
 
 }  // namespace tessera

@@ -32,6 +32,11 @@ class SceneData {
   size_t num_triangles() const { return triangles_.size(); }
   const std::vector<Vec3>& positions() const { return positions_; }
   const std::vector<uint32_t>& indices() const { return indices_; }
+  // A hash of geometry, materials and lights: ties a saved guide cache to its scene.
+  uint64_t fingerprint() const;
+  // The brightest radiance (or intensity, for point-like lights) any light
+  // emits, in luminance: the scale of the guide's learning targets.
+  Float max_emitted_radiance() const;
 
  private:
   void flatten_meshes();

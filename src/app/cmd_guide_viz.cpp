@@ -1,0 +1,130 @@
+// tessera guide-viz SCENE: look inside a learned guide cache.
+//  (a) the learned distribution at a point and normal, as an image of the
+//      equal-area direction square (and its brightest bins on stdout);
+//  (b) the seed thesis' diagnostic render: every path follows the highest-Q direction.
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <numeric>
+
+#include "app/commands.h"
+#include "app/guide_setup.h"
+#include "app/scene_loading.h"
+#include "kernels/guide_diagnostic.h"
+#include "master/image_output.h"
+#include "master/renderer.h"
+
+namespace tessera {
+namespace {
+
+struct VizArgs {
+  std::string scene, distribution, diagnostic;
+  std::vector<double> point, normal;
+  int64_t train_spp = 64, max_depth = 16, seed = 0;
+  GuideArgs guide;
+};
+
+void write_distribution(const VizArgs& a, const GuideField& field) {
+  if (a.point.size() != 3 || a.normal.size() != 3)
+    throw std::runtime_error("guide-viz: --distribution needs --point X Y Z and --normal X Y Z");
+  const Vec3 p(a.point[0], a.point[1], a.point[2]);
+  Vec3 n(a.normal[0], a.normal[1], a.normal[2]);
+  if (!(glm::length(n) > 0.f)) throw std::runtime_error("guide-viz: --normal must not be zero");
+  n = glm::normalize(n);
+  const int32_t cell = field.find_cell(p, n);
+  const uint32_t grid = field.config().grid, bins = grid * grid;
+  const Float* q = field.cell_values(cell);
+  // Each bin becomes a block of pixels; the image is the equal-area square
+  // (the centre is +z, the corners -z).
+  const int32_t scale = std::max<int32_t>(1, 256 / static_cast<int32_t>(grid));
+  ImageRgb img;
+  img.width = img.height = static_cast<int32_t>(grid) * scale;
+  img.rgb.assign(size_t(img.width) * img.height * 3, 0.f);
+  for (int32_t y = 0; y < img.height; ++y)
+    for (int32_t x = 0; x < img.width; ++x) {
+      // Row 0 is the top of the image: v grows downwards as in the square.
+      const uint32_t bin = uint32_t(y / scale) * grid + uint32_t(x / scale);
+      for (int c = 0; c < 3; ++c) img.rgb[(size_t(y) * img.width + x) * 3 + c] = q[bin];
+    }
+  ExrMetadata meta;
+  meta.strings["content"] = "learned incident radiance Q per direction bin (equal-area octahedral square)";
+  meta.numbers["cell"] = cell;
+  write_exr(a.distribution, img, nullptr, meta);
+  std::vector<uint32_t> order(bins);
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](uint32_t i, uint32_t j) { return q[i] > q[j] || (q[i] == q[j] && i < j); });
+  std::printf("cell %d at (%g, %g, %g), normal (%g, %g, %g); brightest bins:\n", cell, p.x, p.y, p.z, n.x, n.y, n.z);
+  for (uint32_t k = 0; k < std::min<uint32_t>(5, bins); ++k) {
+    const uint32_t b = order[k];
+    Vec3 d = equal_area_square_to_sphere(Vec2((b % grid + 0.5f) / grid, (b / grid + 0.5f) / grid));
+    std::printf("  bin %3u  dir (%+.3f, %+.3f, %+.3f)  Q %.6g\n", b, d.x, d.y, d.z, q[b]);
+  }
+  std::printf("wrote %s\n", a.distribution.c_str());
+}
+
+void write_diagnostic(const VizArgs& a, const SceneData& scene, const EmbreeScene& embree, GuideField& field) {
+  const SceneView& s = scene.view();
+  const GuideView g = field.view();
+  const EmbreeTracer tracer = embree.tracer();
+  ImageRgb img;
+  img.width = s.camera.width;
+  img.height = s.camera.height;
+  img.rgb.assign(size_t(img.width) * img.height * 3, 0.f);
+  tbb::parallel_for(0, img.height, [&](int32_t y) {
+    for (int32_t x = 0; x < img.width; ++x) {
+      Ray ray = generate_camera_ray(s.camera, Vec2(x + 0.5f, y + 0.5f));
+      Rgb L = trace_greedy_path(s, g, tracer, ray, static_cast<int32_t>(a.max_depth));
+      for (int c = 0; c < 3; ++c) img.rgb[(size_t(y) * img.width + x) * 3 + c] = L[c];
+    }
+  });
+  ExrMetadata meta;
+  meta.strings["content"] = "greedy paths along the highest learned Q (diagnostic, not a rendering)";
+  write_exr(a.diagnostic, img, nullptr, meta);
+  write_png_preview(std::filesystem::path(a.diagnostic).replace_extension(".png").string(), img);
+  std::printf("wrote %s\n", a.diagnostic.c_str());
+}
+
+int run_guide_viz(VizArgs a) {
+  if (a.distribution.empty() && a.diagnostic.empty())
+    throw std::runtime_error("guide-viz: nothing to do; give --distribution FILE.exr and/or --diagnostic FILE.exr");
+  SceneData scene(load_scene_or_builtin(a.scene));
+  EmbreeScene embree(scene);
+  if (a.guide.mode == "auto" || a.guide.mode == "none") a.guide.mode = "qtable";
+  std::string why;
+  std::unique_ptr<GuideField> field = make_guide(a.guide, scene, &why);
+  if (a.guide.in.empty()) {
+    // No saved cache: learn one now with a short guided render.
+    RenderOptions opt;
+    opt.spp = static_cast<uint32_t>(a.train_spp);
+    opt.max_depth = scene.desc().max_depth;
+    opt.seed = static_cast<uint64_t>(a.seed);
+    opt.progress = false;
+    render(scene, embree, opt, field.get());
+    std::printf("trained the guide with %lld spp (%u cells)\n", static_cast<long long>(a.train_spp), field->num_cells());
+  }
+  if (!a.distribution.empty()) write_distribution(a, *field);
+  if (!a.diagnostic.empty()) write_diagnostic(a, scene, embree, *field);
+  return 0;
+}
+
+}  // namespace
+
+CommandRunner add_guide_viz_command(CLI::App& app) {
+  auto a = std::make_shared<VizArgs>();
+  CLI::App* c = app.add_subcommand("guide-viz", "Inspect a learned guide: its distribution at a point, or greedy diagnostic paths");
+  c->add_option("scene", a->scene, "Scene file in pbrt-v4 syntax (omit for the built-in Cornell box)");
+  c->add_option("--distribution", a->distribution, "Write the learned distribution at --point/--normal (EXR)");
+  c->add_option("--point", a->point, "Point X Y Z (world space)")->expected(3);
+  c->add_option("--normal", a->normal, "Surface normal X Y Z at the point (the side being lit)")->expected(3);
+  c->add_option("--diagnostic", a->diagnostic, "Write the highest-Q greedy-path render (EXR + PNG)");
+  c->add_option("--train-spp", a->train_spp, "Without --guide-in: learn with a guided render of this many spp")
+      ->check(CLI::Range(1, 1 << 20));
+  c->add_option("--max-depth", a->max_depth, "Greedy path length")->check(CLI::Range(1, 1024));
+  c->add_option("--seed", a->seed, "Seed of the training render")->check(CLI::NonNegativeNumber);
+  add_guide_options(c, a->guide);
+  return [a] { return run_guide_viz(*a); };
+}
+
+}  // namespace tessera

@@ -1,0 +1,75 @@
+#include "app/guide_setup.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "kernels/effects.h"
+
+namespace tessera {
+
+void add_guide_options(CLI::App* cmd, GuideArgs& a) {
+  cmd->add_option("--guide", a.mode,
+                  "Learned guiding: qtable (expected SARSA), qlearning (max rule), none; auto = the scene's effects decide")
+      ->check(CLI::IsMember({"auto", "none", "qtable", "qlearning"}));
+  cmd->add_option("--guide-budget", a.budget_mb, "Guide cache memory budget in MB (cells stop refining there)")
+      ->check(CLI::Range(0.1, 1048576.0));
+  cmd->add_option("--guide-mix", a.mix, "Probability of sampling a direction from the guide instead of the BSDF")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--guide-split", a.split, "Updates a cell takes before it splits (0 = 24 per direction bin)")
+      ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+  cmd->add_option("--guide-in", a.in, "Start from a guide cache saved by --guide-out (same scene only)");
+  cmd->add_option("--guide-out", a.out, "Save the learned guide cache after rendering");
+}
+
+bool guiding_helps(uint32_t effects) {
+  const bool scatters = (effects & (kEffectDiffuse | kEffectGlossy)) != 0;
+  const bool lit = (effects & (kEffectAreaLights | kEffectDeltaLights | kEffectEnvironment)) != 0;
+  return scatters && lit;
+}
+
+std::unique_ptr<GuideField> make_guide(const GuideArgs& a, const SceneData& scene, std::string* why) {
+  std::string mode = a.mode;
+  if (mode == "auto") {
+    mode = guiding_helps(scene.effects()) ? "qtable" : "none";
+    *why = mode == "qtable" ? "auto: the scene has non-specular surfaces and lights"
+                            : "auto: no non-specular surface is lit, nothing to guide";
+  } else {
+    *why = "--guide " + mode;
+  }
+  if (mode == "none" && a.in.empty()) return nullptr;
+  if (!a.in.empty()) {
+    std::ifstream f(a.in, std::ios::binary);
+    if (!f) throw std::runtime_error("--guide-in: cannot open " + a.in);
+    try {
+      auto g = std::make_unique<GuideField>(GuideField::load(f, scene.fingerprint()));
+      *why = "loaded from " + a.in;
+      return g;
+    } catch (const std::exception& e) {
+      throw std::runtime_error("--guide-in " + a.in + ": " + e.what());
+    }
+  }
+  GuideConfig cfg;
+  cfg.budget_bytes = static_cast<uint64_t>(std::llround(a.budget_mb * 1048576.0));
+  cfg.guide_prob = static_cast<Float>(a.mix);
+  cfg.split_updates = static_cast<uint64_t>(a.split);
+  cfg.target = mode == "qlearning" ? GuideTarget::QLearning : GuideTarget::ExpectedSarsa;
+  const Bounds& b = scene.bounds();
+  return std::make_unique<GuideField>(cfg, b.lo, b.hi, scene.view().num_lights, scene.max_emitted_radiance());
+}
+
+void save_guide(const GuideArgs& a, const GuideField& guide, const SceneData& scene) {
+  if (a.out.empty()) return;
+  const std::string tmp = a.out + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) throw std::runtime_error("--guide-out: cannot write " + tmp);
+    guide.save(f, scene.fingerprint());
+    f.close();
+    if (!f) throw std::runtime_error("--guide-out: cannot write " + tmp);
+  }
+  std::filesystem::rename(tmp, a.out);
+}
+
+}  // namespace tessera

@@ -1,0 +1,35 @@
+// Guide-cache options shared by `render` and `guide-viz`: which rule learns,
+// its memory budget, and loading/saving a cache.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <string>
+
+#include "guidecache/guide_field.h"
+#include "worker/scene_data.h"
+
+namespace tessera {
+
+struct GuideArgs {
+  std::string mode = "auto";  // auto | none | qtable | qlearning
+  double budget_mb = 64.0;
+  double mix = 0.5;           // probability of sampling a direction from the guide
+  int64_t split = 0;          // updates before a cell splits (0 = the library's default)
+  std::string in, out;
+};
+
+void add_guide_options(CLI::App* cmd, GuideArgs& args);
+
+// The effects set decides "auto": guiding needs a surface that scatters
+// non-specularly (diffuse or glossy) lit by some light.
+bool guiding_helps(uint32_t effects);
+
+// nullptr when guiding is off. Loads --guide-in when given (its learning rule
+// and budget then come from the file). *why explains the choice for the log.
+std::unique_ptr<GuideField> make_guide(const GuideArgs& args, const SceneData& scene, std::string* why);
+
+// Writes the cache to --guide-out when given (temp file + rename: never a torn file).
+void save_guide(const GuideArgs& args, const GuideField& guide, const SceneData& scene);
+
+}  // namespace tessera

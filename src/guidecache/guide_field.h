@@ -1,0 +1,124 @@
+// The learned guide cache (host side): owns the flat arrays behind a
+// GuideView, folds a pass's accumulators into the field, refines cells where
+// they are visited often (within a memory budget), and serialises.
+//
+// Learning rule: each entry's value is the running mean of the targets it
+// received, i.e. Q <- Q + alpha (target - Q) with alpha = 1 / (1 + visits)
+// (Dahm & Keller 2017). Folding a pass's (sum, count) at once gives exactly
+// the same mean as applying its targets one by one, in any order.
+//
+// Everything a fold decides (values, splits) is a function of the field and
+// the summed accumulators only, so every process that folds the same sums
+// keeps an identical field. No MPI here: a farm sums accumulators() across
+// ranks and then calls fold().
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "guidecache/guide_view.h"
+
+namespace tessera {
+
+struct GuideConfig {
+  uint32_t grid = 12;                   // 12 x 12 = 144 direction bins, as in Dahm & Keller
+  uint64_t budget_bytes = 64ull << 20;  // cells stop splitting when the next split would exceed it
+  uint64_t split_updates = 0;           // a leaf splits after this many updates; 0 = 24 per bin
+  uint32_t max_depth = 20;              // octree levels below a root
+  Float guide_prob = 0.5f;
+  Float light_guide_prob = 0.5f;
+  Float floor = 0.05f;                  // share of each distribution spread uniformly: no impossible bin
+  GuideTarget target = GuideTarget::ExpectedSarsa;
+  uint32_t max_learned_lights = 256;    // more lights than this: light selection stays power-based
+
+  bool operator==(const GuideConfig&) const = default;
+};
+
+struct GuideFieldStats {
+  uint64_t cells = 0;
+  uint64_t bytes = 0;
+  uint64_t updates = 0;              // targets folded in, all passes
+  uint64_t rejected_nonfinite = 0;   // NaN/Inf/negative targets
+  uint64_t rejected_large = 0;       // targets beyond the fixed-point range
+  uint64_t splits = 0;
+  bool budget_reached = false;       // a split was refused for memory
+};
+
+class GuideField {
+ public:
+  GuideField() = default;
+  // bounds_lo/hi: the scene's bounds; num_lights: learned light selection is
+  // on when 2 <= num_lights <= config.max_learned_lights; radiance_scale: the
+  // brightest emitted radiance (sets the fixed-point range of targets).
+  GuideField(const GuideConfig& config, const Vec3& bounds_lo, const Vec3& bounds_hi, uint32_t num_lights,
+             Float radiance_scale);
+
+  // Valid until the next fold(), load or destruction. Accumulators are
+  // writable through it.
+  GuideView view();
+
+  // Folds accumulated targets into the values, refines busy cells, rebuilds
+  // the sampling distributions and clears the accumulators.
+  void fold();
+
+  // The pass's accumulators, laid out as one array for reduction across
+  // processes: sums, counts, normals, rejections (all 64-bit integers, summed).
+  std::vector<uint64_t>& accumulators() { return acc_; }
+
+  const GuideConfig& config() const { return config_; }
+  GuideFieldStats stats() const;
+  uint32_t num_cells() const { return static_cast<uint32_t>(cell_updates_.size()); }
+  uint32_t learned_lights() const { return lights_; }
+  // The leaf cell for a point (host-side convenience over view()).
+  int32_t find_cell(const Vec3& p, const Vec3& n) const;
+  const Float* cell_values(int32_t cell) const { return &value_[static_cast<size_t>(cell) * stride()]; }
+
+  // Versioned binary serialisation (cereal). scene_fingerprint ties a cache to
+  // the scene it was learned on; load() throws std::runtime_error when the
+  // stream is not a guide cache, has another version, or another fingerprint.
+  void save(std::ostream& out, uint64_t scene_fingerprint) const;
+  static GuideField load(std::istream& in, uint64_t scene_fingerprint);
+
+  bool operator==(const GuideField& o) const;
+
+  template <class Archive>
+  void serialize(Archive& ar);
+
+ private:
+  uint32_t stride() const { return bins_ + lights_; }
+  uint64_t bytes_per_cell() const;
+  uint64_t split_threshold() const;
+  size_t add_cell();
+  void split(size_t node);
+  void build_distributions();
+  void build_bin_dirs();
+  // Offsets of the parts of acc_.
+  size_t acc_count_offset() const { return num_cells() * size_t(stride()); }
+  size_t acc_normal_offset() const { return 2 * num_cells() * size_t(stride()); }
+  size_t acc_rejected_offset() const { return acc_normal_offset() + 3 * size_t(num_cells()); }
+  void resize_accumulators();
+
+  GuideConfig config_;
+  Vec3 lo_{0.f};
+  Float extent_ = 1.f;
+  uint32_t bins_ = 0, lights_ = 0;
+  Float fixed_scale_ = 1.f, max_target_ = 1.f;
+
+  std::vector<GuideNode> nodes_;
+  std::vector<uint8_t> node_depth_;
+  std::vector<Float> value_;           // cells * stride
+  std::vector<uint32_t> visits_;       // cells * stride (saturating)
+  std::vector<int64_t> normal_sum_;    // cells * 3, fixed point
+  std::vector<uint64_t> cell_updates_; // direction updates since the cell was made
+  GuideFieldStats totals_;
+
+  // Derived (rebuilt by build_distributions, not serialised).
+  std::vector<Vec3> bin_dirs_;
+  std::vector<Float> dir_cdf_, light_cdf_, irradiance_, qmax_;
+  std::vector<uint8_t> learn_normal_;
+  std::vector<uint64_t> acc_;
+};
+
+}  // namespace tessera

@@ -1,0 +1,179 @@
+// Read side of the guide cache, shared by CPU and CUDA kernels: find the
+// spatial cell of a surface point, sample and evaluate the learned direction
+// distribution, and record learning targets into the pass's accumulators.
+//
+// The field is frozen during a pass (values and distributions are read-only);
+// updates go to integer accumulators with relaxed atomic adds, which makes
+// their sums independent of thread, block and rank order. GuideField (host)
+// folds them into the values between passes.
+//
+// Directions are bins of Clarberg's equal-area octahedral map over the full
+// sphere in world space: every bin covers the same solid angle 4 pi / bins, so
+// a bin's probability converts to a density with one multiplication, and the
+// two sides of a thin wall (which see opposite hemispheres) never mix.
+#pragma once
+
+#include "kernels/distribution.h"
+#include "kernels/equal_area.h"
+
+namespace tessera {
+
+// What a learning target estimates beyond the emitted radiance.
+enum class GuideTarget : uint32_t {
+  ExpectedSarsa = 0,  // the integral of Q f cos over the next vertex's bins (Dahm & Keller)
+  QLearning = 1,      // the largest Q at the next vertex times the BSDF's albedo ("max" rule)
+};
+
+// Octree node over one normal class. Leaves own a cell; inner nodes have 8
+// consecutive children starting at `child`, in octant order (bit 0 = x).
+struct GuideNode {
+  int32_t child = -1;
+  int32_t cell = -1;
+};
+
+// Surface points are split by the dominant axis of their normal (+-x, +-y,
+// +-z), so surfaces facing different ways never share a cell.
+constexpr uint32_t kGuideNormalClasses = 6;
+
+// Fixed-point scale for normals accumulated per cell (only their direction matters).
+constexpr Float kGuideNormalScale = 1048576.f;
+
+struct GuideView {
+  // Spatial octrees: nodes[0..5] are the roots of the normal classes; each
+  // covers the cube [lo, lo + extent]^3.
+  const GuideNode* nodes = nullptr;
+  Vec3 lo{0.f};
+  Float extent = 1.f;
+
+  uint32_t grid = 12;      // bins per side of the equal-area square
+  uint32_t bins = 144;     // grid * grid
+  uint32_t lights = 0;     // learned light-selection entries per cell (0 = off)
+  uint32_t stride = 144;   // entries per cell: bins, then lights
+  const Vec3* bin_dirs = nullptr;  // centre direction of each bin
+
+  // Frozen per cell: values (incident radiance per bin, contribution per light),
+  // cdfs of the sampling distributions, and what targets need.
+  const Float* value = nullptr;        // cells * stride
+  const Float* dir_cdf = nullptr;      // cells * (bins + 1)
+  const Float* light_cdf = nullptr;    // cells * (lights + 1)
+  const Float* irradiance = nullptr;   // cells: sum over bins of Q max(cos, 0) dOmega about the cell normal
+  const Float* qmax = nullptr;         // cells: largest Q over the bins above the cell's surface
+  const uint8_t* learn_normal = nullptr;  // cells: 1 while the cell's mean normal is still being estimated
+
+  // Accumulators for the running pass (relaxed atomics).
+  uint64_t* acc_sum = nullptr;     // cells * stride, fixed point (target * fixed_scale)
+  uint64_t* acc_count = nullptr;   // cells * stride
+  uint64_t* acc_normal = nullptr;  // cells * 3, fixed point (kGuideNormalScale)
+  uint64_t* rejected = nullptr;    // [0] NaN/Inf/negative targets, [1] targets too large for the fixed point
+  Float fixed_scale = 1.f;
+  Float max_target = 1e30f;        // larger targets are rejected (and counted), never clamped
+
+  Float guide_prob = 0.5f;         // mixture weight of guided direction sampling
+  Float light_guide_prob = 0.5f;   // mixture weight of learned light selection
+  GuideTarget target = GuideTarget::ExpectedSarsa;
+
+  TESSERA_HOST_DEVICE Float bin_solid_angle() const { return 4.f * kPi / static_cast<Float>(bins); }
+  TESSERA_HOST_DEVICE Distribution1DView dir_distribution(int32_t cell) const {
+    Distribution1DView d;
+    d.cdf = dir_cdf + static_cast<size_t>(cell) * (bins + 1);
+    d.n = bins;
+    return d;
+  }
+  TESSERA_HOST_DEVICE Distribution1DView light_distribution(int32_t cell) const {
+    Distribution1DView d;
+    d.cdf = light_cdf + static_cast<size_t>(cell) * (lights + 1);
+    d.n = lights;
+    return d;
+  }
+};
+
+TESSERA_HOST_DEVICE inline uint32_t guide_normal_class(const Vec3& n) {
+  Vec3 a = glm::abs(n);
+  if (a.x >= a.y && a.x >= a.z) return n.x >= 0.f ? 0u : 1u;
+  if (a.y >= a.z) return n.y >= 0.f ? 2u : 3u;
+  return n.z >= 0.f ? 4u : 5u;
+}
+
+// The leaf cell holding point p on a surface whose normal (on the side the
+// path is on) is n.
+TESSERA_HOST_DEVICE inline int32_t guide_find_cell(const GuideView& g, const Vec3& p, const Vec3& n) {
+  Vec3 lo = g.lo;
+  Float size = g.extent;
+  const GuideNode* node = &g.nodes[guide_normal_class(n)];
+  while (node->child >= 0) {
+    size *= 0.5f;
+    Vec3 mid = lo + size;
+    uint32_t octant = (p.x >= mid.x ? 1u : 0u) | (p.y >= mid.y ? 2u : 0u) | (p.z >= mid.z ? 4u : 0u);
+    if (octant & 1u) lo.x = mid.x;
+    if (octant & 2u) lo.y = mid.y;
+    if (octant & 4u) lo.z = mid.z;
+    node = &g.nodes[node->child + static_cast<int32_t>(octant)];
+  }
+  return node->cell;
+}
+
+TESSERA_HOST_DEVICE inline uint32_t guide_bin_of(const GuideView& g, const Vec3& dir) {
+  Vec2 uv = equal_area_sphere_to_square(dir);
+  uint32_t ix = glm::min(static_cast<uint32_t>(glm::max(uv.x, 0.f) * g.grid), g.grid - 1);
+  uint32_t iy = glm::min(static_cast<uint32_t>(glm::max(uv.y, 0.f) * g.grid), g.grid - 1);
+  return iy * g.grid + ix;
+}
+
+TESSERA_HOST_DEVICE inline Float guide_value(const GuideView& g, int32_t cell, uint32_t entry) {
+  return g.value[static_cast<size_t>(cell) * g.stride + entry];
+}
+
+// Solid-angle density of guided sampling in cell for directions in bin.
+TESSERA_HOST_DEVICE inline Float guide_bin_pdf(const GuideView& g, int32_t cell, uint32_t bin) {
+  return g.dir_distribution(cell).discrete_pmf(bin) * (static_cast<Float>(g.bins) * kInv4Pi);
+}
+// Solid-angle density of guided sampling in cell for a unit world direction.
+TESSERA_HOST_DEVICE inline Float guide_pdf(const GuideView& g, int32_t cell, const Vec3& dir) {
+  return guide_bin_pdf(g, cell, guide_bin_of(g, dir));
+}
+
+// Draws a bin from the cell's distribution (u_bin) and a point within it (u),
+// uniformly in area on the equal-area square, hence uniformly in solid angle.
+// *bin receives the bin the direction lies in (for the learning update).
+TESSERA_HOST_DEVICE inline bool guide_sample(const GuideView& g, int32_t cell, Float u_bin, Vec2 u, Vec3* dir,
+                                             Float* pdf, uint32_t* bin_out) {
+  Float pmf = 0.f;
+  uint32_t bin = g.dir_distribution(cell).sample_discrete(u_bin, &pmf);
+  if (!(pmf > 0.f)) return false;
+  Float inv_grid = 1.f / static_cast<Float>(g.grid);
+  Vec2 sq((static_cast<Float>(bin % g.grid) + u.x) * inv_grid, (static_cast<Float>(bin / g.grid) + u.y) * inv_grid);
+  *dir = glm::normalize(equal_area_square_to_sphere(sq));
+  // The density is that of the bin the direction maps back to, so sample and
+  // pdf() agree exactly even where float rounding moves a point across an edge.
+  *bin_out = guide_bin_of(g, *dir);
+  *pdf = guide_bin_pdf(g, cell, *bin_out);
+  return *pdf > 0.f;
+}
+
+// Adds one learning target to entry (a bin, or bins + light) of a cell.
+// Returns false (and counts it) when the target is rejected.
+TESSERA_HOST_DEVICE inline bool guide_record(const GuideView& g, int32_t cell, uint32_t entry, Float target) {
+  if (!(target >= 0.f) || !(target <= 3.4e38f)) {  // NaN, negative or infinite
+    atomic_add_u64(&g.rejected[0], 1);
+    return false;
+  }
+  if (target > g.max_target) {
+    atomic_add_u64(&g.rejected[1], 1);
+    return false;
+  }
+  size_t i = static_cast<size_t>(cell) * g.stride + entry;
+  atomic_add_u64(&g.acc_sum[i], static_cast<uint64_t>(static_cast<double>(target) * g.fixed_scale + 0.5));
+  atomic_add_u64(&g.acc_count[i], 1);
+  return true;
+}
+
+// Accumulates the normal of a point that learned into the cell: the cell's
+// mean normal orients its cosine weighting.
+TESSERA_HOST_DEVICE inline void guide_record_normal(const GuideView& g, int32_t cell, const Vec3& n) {
+  if (!g.learn_normal[cell]) return;
+  uint64_t* a = g.acc_normal + 3 * static_cast<size_t>(cell);
+  for (int k = 0; k < 3; ++k)
+    atomic_add_u64(&a[k], static_cast<uint64_t>(static_cast<int64_t>(n[k] * kGuideNormalScale)));
+}
+
+}  // namespace tessera

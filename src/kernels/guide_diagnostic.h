@@ -1,0 +1,56 @@
+// The seed thesis' diagnostic render of a learned guide: every path follows,
+// at each vertex, the bin with the largest Q max(cos, 0). Where the guide has
+// learned well, these greedy paths run into the light sources; where they end
+// in darkness, the guide points nowhere useful. Not an estimator of anything.
+#pragma once
+
+#include "integrator.h"
+
+namespace tessera {
+
+template <class Tracer>
+TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g, const Tracer& tracer, Ray ray,
+                                          int32_t max_depth) {
+  constexpr uint32_t kSpec = kSpecAll & ~kSpecGuiding;
+  Rgb beta(1.f);
+  for (int32_t depth = 0; depth <= max_depth; ++depth) {
+    TraceHit hit;
+    if (!tracer.intersect(ray.o, ray.d, kInfinity, &hit)) {
+      Rgb Le(0.f);
+      for (uint32_t k = 0; k < s.num_infinite_lights; ++k)
+        Le += environment_radiance(s, s.lights[s.infinite_lights[k]], ray.d);
+      return beta * Le;
+    }
+    SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2);
+    Vec3 wo = -ray.d;
+    const TriangleInfo& info = s.triangles[hit.triangle];
+    if (info.light >= 0) {
+      const Light& l = s.lights[info.light];
+      if (l.two_sided || glm::dot(h.ng, wo) > 0.f) return beta * l.L;
+    }
+    BsdfParams bsdf;
+    if (!resolve_bsdf<kSpec>(s, info.material, h, wo, &bsdf)) {
+      ray.o = offset_ray_origin(h, ray.d);
+      continue;
+    }
+    Vec3 n_side = glm::dot(h.ng, wo) >= 0.f ? h.ng : -h.ng;
+    int32_t cell = guide_find_cell(g, h.p, n_side);
+    Float best = 0.f;
+    uint32_t best_bin = 0;
+    for (uint32_t j = 0; j < g.bins; ++j) {
+      Float v = guide_value(g, cell, j) * glm::max(0.f, glm::dot(g.bin_dirs[j], n_side));
+      if (v > best) {
+        best = v;
+        best_bin = j;
+      }
+    }
+    if (!(best > 0.f)) return Rgb(0.f);
+    // Shade with the albedo-like reflectance so materials stay recognisable.
+    beta *= bsdf.type == BsdfType::Diffuse || bsdf.type == BsdfType::CoatedDiffuse ? bsdf.reflectance : Rgb(1.f);
+    ray.d = g.bin_dirs[best_bin];
+    ray.o = offset_ray_origin(h, ray.d);
+  }
+  return Rgb(0.f);
+}
+
+}  // namespace tessera

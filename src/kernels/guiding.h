@@ -1,0 +1,60 @@
+// What the integrator needs from the guide cache beyond guidecache/guide_view.h:
+// mixture light selection (power-based + learned, with the true mixture pmf)
+// and the learning targets of Dahm & Keller's update rule.
+#pragma once
+
+#include "bsdf.h"
+#include "guidecache/guide_view.h"
+#include "scene_view.h"
+
+namespace tessera {
+
+// Probability of selecting light li for next-event estimation at a point in
+// `cell` (cell < 0 or no learned lights: the power-based distribution alone).
+TESSERA_HOST_DEVICE inline Float light_select_pmf(const SceneView& s, const GuideView* g, int32_t cell, uint32_t li) {
+  Float p_power = s.light_select.discrete_pmf(li);
+  if (!g || g->lights == 0 || cell < 0) return p_power;
+  Float lp = g->light_guide_prob;
+  return (1.f - lp) * p_power + lp * g->light_distribution(cell).discrete_pmf(li);
+}
+
+// Selects a light with one uniform number; *pmf is the mixture probability.
+TESSERA_HOST_DEVICE inline uint32_t select_light(const SceneView& s, const GuideView* g, int32_t cell, Float u,
+                                                 Float* pmf) {
+  if (!g || g->lights == 0 || cell < 0) return s.light_select.sample_discrete(u, pmf);
+  Float lp = g->light_guide_prob;
+  uint32_t li;
+  if (u < lp) {
+    li = g->light_distribution(cell).sample_discrete(glm::min(u / lp, 0x1.fffffep-1f), nullptr);
+  } else {
+    li = s.light_select.sample_discrete(glm::min((u - lp) / (1.f - lp), 0x1.fffffep-1f), nullptr);
+  }
+  *pmf = light_select_pmf(s, g, cell, li);
+  return li;
+}
+
+// The part of a learning target that looks beyond vertex y: an estimate of
+// the integral over incident directions of Q(y, wi) f(wo, wi) |cos| from y's
+// bins (expected SARSA), or of max Q(y) times the BSDF's albedo (Q-learning).
+//  - Lambertian y: closed forms over the cell, rho/pi * irradiance or rho * qmax.
+//  - Other non-delta BSDFs: one bin j drawn from y's guide distribution,
+//    Q_j f(w_j) |cos_j| dOmega / p_j, an unbiased estimate of the bin sum.
+// Delta BSDFs are handled by the caller with the direction actually sampled.
+// The BSDF is given in its local frame; w_j is taken to it by `to_local`.
+template <class ToLocal>
+TESSERA_HOST_DEVICE inline Float guide_bins_integral(const GuideView& g, int32_t cell, const BsdfParams& b, bool lambertian,
+                                                     const Vec3& wo_local, const ToLocal& to_local, Float u) {
+  if (lambertian) {
+    Float rho = luminance(b.reflectance);
+    return g.target == GuideTarget::QLearning ? rho * g.qmax[cell] : rho * kInvPi * g.irradiance[cell];
+  }
+  Float pmf = 0.f;
+  uint32_t j = g.dir_distribution(cell).sample_discrete(u, &pmf);
+  if (!(pmf > 0.f)) return 0.f;
+  Vec3 wi = to_local(g.bin_dirs[j]);
+  Float fc = luminance(bsdf_eval(b, wo_local, wi)) * glm::abs(wi.z) * g.bin_solid_angle() / pmf;
+  Float q = g.target == GuideTarget::QLearning ? g.qmax[cell] : guide_value(g, cell, j);
+  return q * fc;
+}
+
+}  // namespace tessera

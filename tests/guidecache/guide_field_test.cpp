@@ -1,0 +1,262 @@
+// The guide cache on its own: sampling matches its pdf, the pdf integrates to
+// one, folding is the running mean of the targets whatever their order,
+// degenerate fields stay usable, and serialisation round-trips exactly.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+#include "guidecache/guide_field.h"
+#include "kernels/rng.h"
+
+namespace tessera {
+namespace {
+
+GuideField make_field(GuideConfig cfg = {}, uint32_t lights = 0) {
+  return GuideField(cfg, Vec3(0.f), Vec3(1.f), lights, 1.f);
+}
+
+// Gives cell 0's bins a peaked, uneven radiance field and folds it in.
+void teach_peaked(GuideField& f, int32_t cell) {
+  GuideView g = f.view();
+  for (uint32_t b = 0; b < g.bins; ++b) {
+    Float target = (b % 7 == 0) ? 50.f : (b % 3 == 0 ? 1.f : 0.f);
+    guide_record(g, cell, b, target);
+  }
+  f.fold();
+}
+
+TEST(GuideSampling, PdfIntegratesToOneOverTheSphere) {
+  GuideField f = make_field();
+  int32_t cell = f.find_cell(Vec3(0.5f), Vec3(0, 0, 1));
+  teach_peaked(f, cell);
+  GuideView g = f.view();
+  // Midpoint rule on a fine equal-area grid: every point has weight 4 pi / N.
+  const int n = 400;
+  double sum = 0.0;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      Vec3 d = glm::normalize(equal_area_square_to_sphere(Vec2((x + 0.5f) / n, (y + 0.5f) / n)));
+      sum += guide_pdf(g, cell, d);
+    }
+  EXPECT_NEAR(sum * 4.0 * M_PI / (double(n) * n), 1.0, 1e-3);
+}
+
+// Pearson chi-square of guided samples binned on a grid finer than the
+// guide's own, against the expected counts from guide_pdf.
+TEST(GuideSampling, SamplesFollowThePdfChiSquare) {
+  GuideField f = make_field();
+  int32_t cell = f.find_cell(Vec3(0.5f), Vec3(0, 0, 1));
+  teach_peaked(f, cell);
+  GuideView g = f.view();
+  const int res = 24;  // 2x the guide's grid per side
+  const int samples = 400000;
+  std::vector<double> observed(res * res, 0.0), expected(res * res, 0.0);
+  Rng rng = Rng::for_sample(7, 0, 0);
+  for (int i = 0; i < samples; ++i) {
+    Vec3 d;
+    Float pdf;
+    uint32_t bin;
+    Float ub = rng.uniform();
+    Vec2 u = rng.uniform2();
+    ASSERT_TRUE(guide_sample(g, cell, ub, u, &d, &pdf, &bin));
+    ASSERT_GT(pdf, 0.f);
+    ASSERT_NEAR(pdf, guide_pdf(g, cell, d), 1e-6f * pdf);
+    Vec2 sq = equal_area_sphere_to_square(d);
+    int ix = std::min(res - 1, int(sq.x * res)), iy = std::min(res - 1, int(sq.y * res));
+    observed[iy * res + ix] += 1.0;
+  }
+  for (int y = 0; y < res; ++y)
+    for (int x = 0; x < res; ++x) {
+      Vec3 d = glm::normalize(equal_area_square_to_sphere(Vec2((x + 0.5f) / res, (y + 0.5f) / res)));
+      expected[y * res + x] = guide_pdf(g, cell, d) * (4.0 * M_PI / (res * res)) * samples;
+    }
+  double chi2 = 0.0;
+  int dof = -1;
+  for (int i = 0; i < res * res; ++i) {
+    if (expected[i] < 5.0) continue;
+    chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+    ++dof;
+  }
+  ASSERT_GT(dof, 100);
+  // Wilson-Hilferty: chi2 > dof + 4.5 sqrt(2 dof) has p < 1e-5 under H0.
+  EXPECT_LT(chi2, dof + 4.5 * std::sqrt(2.0 * dof)) << "dof " << dof;
+}
+
+TEST(GuideSampling, PeakedFieldPrefersBrightBinsFacingTheNormal) {
+  GuideField f = make_field();
+  int32_t cell = f.find_cell(Vec3(0.5f), Vec3(0, 0, 1));
+  GuideView g0 = f.view();
+  uint32_t up = guide_bin_of(g0, glm::normalize(Vec3(0.2f, 0.1f, 1.f)));
+  uint32_t down = guide_bin_of(g0, glm::normalize(Vec3(0.2f, 0.1f, -1.f)));
+  guide_record(g0, cell, up, 10.f);
+  guide_record(g0, cell, down, 10.f);
+  f.fold();
+  GuideView g = f.view();
+  // The bin below the surface gets only the floor: cos weighting about the normal.
+  EXPECT_GT(guide_bin_pdf(g, cell, up), 20.f * guide_bin_pdf(g, cell, down));
+  EXPECT_GT(guide_bin_pdf(g, cell, down), 0.f);
+}
+
+TEST(GuideField, AllZeroFieldSamplesUniformly) {
+  GuideField f = make_field();
+  GuideView g = f.view();
+  for (uint32_t b = 0; b < g.bins; ++b) EXPECT_NEAR(guide_bin_pdf(g, 0, b), 1.f / (4.f * kPi), 1e-5f);
+}
+
+TEST(GuideField, HugeBinKeepsEveryOtherBinPossible) {
+  GuideField f = make_field();
+  GuideView g = f.view();
+  uint32_t bright = guide_bin_of(g, Vec3(0, 0, 1));
+  ASSERT_TRUE(guide_record(g, 4, bright, 1e5f));  // within the fixed-point range of a scale-1 field
+  f.fold();
+  g = f.view();
+  for (uint32_t b = 0; b < g.bins; ++b) {
+    EXPECT_GT(guide_bin_pdf(g, 4, b), 0.f) << b;
+    EXPECT_TRUE(std::isfinite(guide_bin_pdf(g, 4, b)));
+  }
+}
+
+TEST(GuideField, NonFiniteAndOutOfRangeTargetsAreRejectedAndCounted) {
+  GuideField f = make_field();
+  GuideView g = f.view();
+  EXPECT_FALSE(guide_record(g, 0, 3, std::nanf("")));
+  EXPECT_FALSE(guide_record(g, 0, 3, INFINITY));
+  EXPECT_FALSE(guide_record(g, 0, 3, -1.f));
+  EXPECT_FALSE(guide_record(g, 0, 3, 1e8f));  // beyond 2^20 x the brightest emitter (1)
+  EXPECT_TRUE(guide_record(g, 0, 3, 2.f));
+  f.fold();
+  GuideFieldStats s = f.stats();
+  EXPECT_EQ(s.rejected_nonfinite, 3u);
+  EXPECT_EQ(s.rejected_large, 1u);
+  EXPECT_EQ(s.updates, 1u);
+  EXPECT_FLOAT_EQ(f.cell_values(0)[3], 2.f);
+}
+
+TEST(GuideField, FoldIsTheRunningMeanWithVisitCountLearningRate) {
+  GuideField f = make_field();
+  // Sequential updates Q += (t - Q) / (1 + visits) over two passes.
+  std::vector<std::vector<Float>> passes = {{1.f, 2.f, 6.f}, {3.f, 0.5f}};
+  double q = 0.0, visits = 0.0;
+  for (const auto& pass : passes) {
+    GuideView g = f.view();
+    for (Float t : pass) {
+      guide_record(g, 2, 10, t);
+      q += (t - q) / (1.0 + visits);
+      visits += 1.0;
+    }
+    f.fold();
+  }
+  EXPECT_NEAR(f.cell_values(2)[10], q, 1e-6);
+}
+
+TEST(GuideField, FoldDoesNotDependOnUpdateOrder) {
+  GuideField a = make_field(), b = make_field();
+  std::vector<Float> targets;
+  Rng rng = Rng::for_sample(1, 2, 3);
+  for (int i = 0; i < 5000; ++i) targets.push_back(rng.uniform() * 3.f);
+  GuideView ga = a.view(), gb = b.view();
+  for (size_t i = 0; i < targets.size(); ++i) guide_record(ga, 1, uint32_t(i % 144), targets[i]);
+  for (size_t i = targets.size(); i-- > 0;) guide_record(gb, 1, uint32_t(i % 144), targets[i]);
+  a.fold();
+  b.fold();
+  EXPECT_TRUE(a == b);
+}
+
+TEST(GuideField, BusyCellsSplitAndChildrenInheritValues) {
+  GuideConfig cfg;
+  cfg.split_updates = 100;
+  GuideField f = make_field(cfg);
+  int32_t cell = f.find_cell(Vec3(0.25f), Vec3(0, 0, 1));
+  GuideView g = f.view();
+  for (int i = 0; i < 200; ++i) guide_record(g, cell, 5, 4.f);
+  f.fold();
+  EXPECT_EQ(f.num_cells(), 6u + 7u);
+  EXPECT_EQ(f.stats().splits, 1u);
+  int32_t a = f.find_cell(Vec3(0.1f), Vec3(0, 0, 1)), b = f.find_cell(Vec3(0.9f), Vec3(0, 0, 1));
+  EXPECT_NE(a, b);
+  EXPECT_FLOAT_EQ(f.cell_values(a)[5], 4.f);
+  EXPECT_FLOAT_EQ(f.cell_values(b)[5], 4.f);
+  // Other normal classes are untouched.
+  EXPECT_EQ(f.find_cell(Vec3(0.1f), Vec3(0, 0, -1)), f.find_cell(Vec3(0.9f), Vec3(0, 0, -1)));
+}
+
+TEST(GuideField, SplittingStopsAtTheMemoryBudget) {
+  GuideConfig cfg;
+  cfg.split_updates = 10;
+  cfg.budget_bytes = 6 * 5000 + 8 * 5000;  // room for ~13 cells of ~4 KB at most
+  GuideField f = make_field(cfg);
+  for (int pass = 0; pass < 6; ++pass) {
+    GuideView g = f.view();
+    for (uint32_t c = 0; c < f.num_cells(); ++c)
+      for (int i = 0; i < 20; ++i) guide_record(g, int32_t(c), 0, 1.f);
+    f.fold();
+  }
+  EXPECT_TRUE(f.stats().budget_reached);
+  EXPECT_LE(f.stats().bytes, cfg.budget_bytes);
+}
+
+TEST(GuideField, OppositeNormalsNeverShareACell) {
+  GuideField f = make_field();
+  for (Vec3 n : {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)})
+    EXPECT_NE(f.find_cell(Vec3(0.5f), n), f.find_cell(Vec3(0.5f), -n));
+}
+
+TEST(GuideField, LearnedLightSelectionFollowsContributions) {
+  GuideField f = make_field({}, 3);
+  ASSERT_EQ(f.learned_lights(), 3u);
+  GuideView g = f.view();
+  guide_record(g, 0, g.bins + 0, 0.f);
+  guide_record(g, 0, g.bins + 1, 9.f);
+  guide_record(g, 0, g.bins + 2, 1.f);
+  f.fold();
+  g = f.view();
+  Distribution1DView d = g.light_distribution(0);
+  EXPECT_GT(d.discrete_pmf(1), 0.8f);
+  EXPECT_GT(d.discrete_pmf(0), 0.f);  // the floor: never impossible
+  EXPECT_NEAR(d.discrete_pmf(0) + d.discrete_pmf(1) + d.discrete_pmf(2), 1.f, 1e-6f);
+}
+
+TEST(GuideSerialisation, RoundTripIsExact) {
+  GuideConfig cfg;
+  cfg.split_updates = 50;
+  GuideField f = make_field(cfg, 2);
+  GuideView g = f.view();
+  Rng rng = Rng::for_sample(3, 1, 4);
+  for (int i = 0; i < 2000; ++i) guide_record(g, 0, uint32_t(rng.next_u32() % g.stride), rng.uniform() * 5.f);
+  f.fold();
+  std::stringstream ss;
+  f.save(ss, 1234);
+  GuideField back = GuideField::load(ss, 1234);
+  EXPECT_TRUE(back == f);
+  // Same distributions, bit for bit.
+  GuideView a = f.view(), b = back.view();
+  for (uint32_t c = 0; c < f.num_cells(); ++c)
+    for (uint32_t j = 0; j < a.bins; ++j) EXPECT_EQ(guide_bin_pdf(a, int32_t(c), j), guide_bin_pdf(b, int32_t(c), j));
+}
+
+TEST(GuideSerialisation, OtherSceneOrGarbageIsAClearError) {
+  GuideField f = make_field();
+  std::stringstream ss;
+  f.save(ss, 1);
+  try {
+    GuideField::load(ss, 2);
+    FAIL() << "loaded a cache made for another scene";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("another scene"), std::string::npos) << e.what();
+  }
+  std::stringstream junk("this is not a guide cache at all");
+  EXPECT_THROW(GuideField::load(junk, 1), std::runtime_error);
+  std::string bytes;
+  {
+    std::stringstream full;
+    f.save(full, 1);
+    bytes = full.str();
+  }
+  std::stringstream truncated(bytes.substr(0, bytes.size() / 2));
+  EXPECT_THROW(GuideField::load(truncated, 1), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace tessera
