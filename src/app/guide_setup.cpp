@@ -44,6 +44,7 @@ std::unique_ptr<GuideField> make_guide(const GuideArgs& a, const SceneData& scen
     if (!f) throw std::runtime_error("--guide-in: cannot open " + a.in);
     try {
       auto g = std::make_unique<GuideField>(GuideField::load(f, scene.fingerprint()));
+      if (a.mix) g->set_guide_prob(static_cast<Float>(*a.mix));
       *why = "loaded from " + a.in;
       return g;
     } catch (const std::exception& e) {
@@ -52,7 +53,7 @@ std::unique_ptr<GuideField> make_guide(const GuideArgs& a, const SceneData& scen
   }
   GuideConfig cfg;
   cfg.budget_bytes = static_cast<uint64_t>(std::llround(a.budget_mb * 1048576.0));
-  cfg.guide_prob = static_cast<Float>(a.mix);
+  if (a.mix) cfg.guide_prob = static_cast<Float>(*a.mix);
   cfg.split_updates = static_cast<uint64_t>(a.split);
   cfg.target = mode == "qlearning" ? GuideTarget::QLearning : GuideTarget::ExpectedSarsa;
   const Bounds& b = scene.bounds();

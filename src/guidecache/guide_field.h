@@ -68,6 +68,8 @@ class GuideField {
   std::vector<uint64_t>& accumulators() { return acc_; }
 
   const GuideConfig& config() const { return config_; }
+  // Sampling settings that do not change what was learned.
+  void set_guide_prob(Float p) { config_.guide_prob = p; }
   GuideFieldStats stats() const;
   uint32_t num_cells() const { return static_cast<uint32_t>(cell_updates_.size()); }
   uint32_t learned_lights() const { return lights_; }

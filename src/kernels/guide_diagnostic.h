@@ -1,7 +1,10 @@
 // The seed thesis' diagnostic render of a learned guide: every path follows,
-// at each vertex, the bin with the largest Q max(cos, 0). Where the guide has
-// learned well, these greedy paths run into the light sources; where they end
-// in darkness, the guide points nowhere useful. Not an estimator of anything.
+// at each vertex, the bin with the largest Q max(cos, 0), and shows what it
+// finds: a light it runs into, or at its last vertex the reflected radiance
+// the guide learned there (rho/pi times the cell's learned irradiance; with
+// NEE the field holds the radiance NEE does not deliver, so greedy paths run
+// to brightly lit surfaces rather than to the lights). Where a path ends in
+// darkness, the guide points nowhere useful. Not an estimator of anything.
 #pragma once
 
 #include "integrator.h"
@@ -13,7 +16,7 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g
                                           int32_t max_depth) {
   constexpr uint32_t kSpec = kSpecAll & ~kSpecGuiding;
   Rgb beta(1.f);
-  for (int32_t depth = 0; depth <= max_depth; ++depth) {
+  for (int32_t depth = 0;; ++depth) {
     TraceHit hit;
     if (!tracer.intersect(ray.o, ray.d, kInfinity, &hit)) {
       Rgb Le(0.f);
@@ -44,13 +47,12 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g
         best_bin = j;
       }
     }
-    if (!(best > 0.f)) return Rgb(0.f);
     // Shade with the albedo-like reflectance so materials stay recognisable.
     beta *= bsdf.type == BsdfType::Diffuse || bsdf.type == BsdfType::CoatedDiffuse ? bsdf.reflectance : Rgb(1.f);
+    if (!(best > 0.f) || depth == max_depth) return beta * (kInvPi * g.irradiance[cell]);
     ray.d = g.bin_dirs[best_bin];
     ray.o = offset_ray_origin(h, ray.d);
   }
-  return Rgb(0.f);
 }
 
 }  // namespace tessera

@@ -87,6 +87,13 @@ TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, const Vec3& wo, Fl
 // guide has learned. Each traced segment x -> y sends Dahm & Keller's target
 // Le(y) + (integral of Q f cos at y) to x's cell, and each shadow ray sends
 // its unoccluded contribution to the light-selection entry of x's cell.
+//
+// With next-event estimation the field learns the radiance NEE does not
+// deliver: emission that NEE samples is left out of the targets and the light
+// reflected at y directly is added from y's own (unweighted) NEE estimate.
+// Guided directions then go where indirect light comes from instead of
+// duplicating the light samples; Q stays the full reflected radiance, so
+// light that reaches x over several bounces is still learned.
 template <uint32_t Spec, class Tracer>
 TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray ray, Rng& rng,
                                    const PathSettings& settings, PathCounters& c) {
@@ -107,9 +114,10 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   int32_t prev_cell = -1;  // guide cell of the last scattering point (its light selection)
   Float eta_scale = 1.f;
   int32_t interface_skips = 0;
-  // Learning update waiting for the end of the current segment: into entry
-  // pend_bin of cell pend_cell. pend_le holds Le(y) while a delta vertex y
-  // waits for its sampled direction.
+  // Learning update waiting for the end of the current segment x -> y: into
+  // entry pend_bin of cell pend_cell. pend_le is the part of the target known
+  // at y's hit (emission NEE does not cover); the rest comes from y's NEE and
+  // bins, or, at a delta vertex, from the direction it takes.
   int32_t pend_cell = -1;
   uint32_t pend_bin = 0;
   Float pend_le = 0.f;
@@ -134,7 +142,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         }
       }
       if constexpr (kGuide) {
-        if (pend_cell >= 0 && !pend_at_delta && guide_record(g, pend_cell, pend_bin, luminance(Le_total))) ++c.guide_updates;
+        const bool counted = specular_bounce || !settings.nee;  // else NEE delivers the environment
+        if (pend_cell >= 0 && guide_record(g, pend_cell, pend_bin, counted ? luminance(Le_total) : 0.f)) ++c.guide_updates;
       }
       break;
     }
@@ -185,25 +194,18 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       Vec3 n_side = glm::dot(h.ng, wo) >= 0.f ? h.ng : -h.ng;
       cell = guide_find_cell(g, h.p, n_side);
       guide_record_normal(g, cell, n_side);
-      if (pend_cell >= 0) {
-        if (!delta_lobe) {
-          const bool lambertian = (Spec & kSpecNonDiffuse) == 0 || bsdf.type == BsdfType::Diffuse;
-          Float integral = guide_bins_integral(g, cell, bsdf, lambertian, wo_l,
-                                               [&](const Vec3& v) { return frame.to_local(v); }, rng.uniform());
-          if (guide_record(g, pend_cell, pend_bin, luminance(Le_hit) + integral)) ++c.guide_updates;
-          pend_cell = -1;
-        } else {
-          pend_le = luminance(Le_hit);  // finished once this vertex has sampled its direction
-          pend_at_delta = true;
-        }
-      }
+      // Emission the integrator weights by MIS is NEE's to deliver.
+      pend_le = (specular_bounce || !settings.nee) ? luminance(Le_hit) : 0.f;
+      pend_at_delta = delta_lobe;
     }
 
+    // A path ending here leaves its last target unfinished (no NEE at y): dropped.
     if (depth++ == settings.max_depth) break;
     if (wo_l.z == 0.f) break;
     const bool guided_vertex = kGuide && !delta_lobe;
 
     // Next-event estimation at non-specular vertices (pbrt-v4's SampleLd).
+    [[maybe_unused]] Float direct_estimate = 0.f;  // its unweighted estimate of light reflected here (guide targets)
     if (settings.nee && lobes_have_non_specular(lobes) && s.num_lights > 0) {
       Float u_select = rng.uniform();
       Vec2 u_light = rng.uniform2();
@@ -234,6 +236,16 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       }
       if constexpr (kGuide) {
         if (g.lights > 0 && pmf > 0.f) guide_record(g, cell, g.bins + li, learned);
+        direct_estimate = pmf > 0.f ? learned / pmf : 0.f;
+      }
+    }
+    if constexpr (kGuide) {
+      if (pend_cell >= 0 && !pend_at_delta) {
+        const bool lambertian = (Spec & kSpecNonDiffuse) == 0 || bsdf.type == BsdfType::Diffuse;
+        Float integral = guide_bins_integral(g, cell, bsdf, lambertian, wo_l,
+                                             [&](const Vec3& v) { return frame.to_local(v); }, rng.uniform());
+        if (guide_record(g, pend_cell, pend_bin, pend_le + direct_estimate + integral)) ++c.guide_updates;
+        pend_cell = -1;
       }
     }
 
