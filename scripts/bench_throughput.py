@@ -12,7 +12,8 @@ Reports, in one run:
     specialisation versus the integrator compiled for every effect.
 Samples/s of both renderers are measured the same way: wall-clock difference
 between a long and a short render, so start-up and scene loading cancel out.
-Each figure is the median of --repeats runs.
+Each figure is the median of --repeats runs. Guiding is off (--guide none):
+Embree's tutorial does not guide, and issue 3's benchmark measures guiding.
 """
 import argparse
 import json
@@ -60,7 +61,8 @@ def main():
 
     def ours(spp, extra=()):
         return [a.tessera, "render", "-q", "--no-preview", "--res", f"{a.res}x{a.res}", "--spp", str(spp),
-                "--max-depth", str(a.depth), "--threads", str(a.threads), "-o", os.path.join(tmp, "o.exr"), *extra]
+                "--max-depth", str(a.depth), "--threads", str(a.threads), "--guide", "none",
+                "-o", os.path.join(tmp, "o.exr"), *extra]
 
     # Our own stats (render loop only) for rays/s and path statistics.
     stats_runs = []

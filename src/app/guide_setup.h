@@ -14,7 +14,7 @@ namespace tessera {
 
 struct GuideArgs {
   std::string mode = "auto";  // auto | none | qtable | qlearning
-  double budget_mb = 64.0;
+  double budget_mb = 16.0;
   std::optional<double> mix;  // probability of sampling a direction from the guide (default 0.5)
   int64_t split = 0;          // updates before a cell splits (0 = the library's default)
   std::string in, out;

@@ -17,7 +17,7 @@ GuideField::GuideField(const GuideConfig& config, const Vec3& bounds_lo, const V
     : config_(config) {
   if (config_.grid < 2 || config_.grid > kMaxGrid) throw std::invalid_argument("guide: direction grid must be 2..64");
   bins_ = config_.grid * config_.grid;
-  lights_ = (num_lights >= 2 && num_lights <= config_.max_learned_lights) ? num_lights : 0;
+  lights_ = (num_lights >= 3 && num_lights <= config_.max_learned_lights) ? num_lights : 0;
   // A cube around the scene, padded so points on its faces fall inside.
   Vec3 size = bounds_hi - bounds_lo;
   Float e = std::max({size.x, size.y, size.z, 1e-6f});
@@ -85,13 +85,13 @@ GuideView GuideField::view() {
   g.stride = stride();
   g.bin_dirs = bin_dirs_.data();
   g.value = value_.data();
-  g.dir_cdf = dir_cdf_.data();
+  g.dir_pmf = dir_pmf_.data();
+  g.dir_alias = dir_alias_.data();
   g.light_cdf = light_cdf_.data();
   g.irradiance = irradiance_.data();
   g.qmax = qmax_.data();
   g.learn_normal = learn_normal_.data();
-  g.acc_sum = acc_.data();
-  g.acc_count = acc_.data() + acc_count_offset();
+  g.acc = acc_.data();
   g.acc_normal = acc_.data() + acc_normal_offset();
   g.rejected = acc_.data() + acc_rejected_offset();
   g.fixed_scale = fixed_scale_;
@@ -108,20 +108,20 @@ int32_t GuideField::find_cell(const Vec3& p, const Vec3& n) const {
 
 void GuideField::fold() {
   const size_t n = value_.size();
-  const uint64_t* sum = acc_.data();
-  const uint64_t* count = acc_.data() + acc_count_offset();
+  const uint64_t* acc = acc_.data();
   const uint64_t* normal = acc_.data() + acc_normal_offset();
   const uint64_t* rejected = acc_.data() + acc_rejected_offset();
   const double inv_scale = 1.0 / fixed_scale_;
   for (size_t i = 0; i < n; ++i) {
-    if (count[i] == 0) continue;
-    // Running mean: the same result as count[i] updates with alpha = 1/(1+visits).
-    const double v = visits_[i], c = static_cast<double>(count[i]);
-    const double mean_sum = static_cast<double>(sum[i]) * inv_scale;
-    value_[i] = static_cast<Float>((static_cast<double>(value_[i]) * v + mean_sum) / (v + c));
-    visits_[i] = static_cast<uint32_t>(std::min<uint64_t>(uint64_t(visits_[i]) + count[i], UINT32_MAX));
-    totals_.updates += count[i];
-    if (i % stride() < bins_) cell_updates_[i / stride()] += count[i];
+    const uint64_t count = acc[2 * i + 1];
+    if (count == 0) continue;
+    // Running mean: the same result as `count` updates with alpha = 1/(1+visits).
+    const double v = visits_[i], c = static_cast<double>(count);
+    const double sum = static_cast<double>(acc[2 * i]) * inv_scale;
+    value_[i] = static_cast<Float>((static_cast<double>(value_[i]) * v + sum) / (v + c));
+    visits_[i] = static_cast<uint32_t>(std::min<uint64_t>(uint64_t(visits_[i]) + count, UINT32_MAX));
+    totals_.updates += count;
+    if (i % stride() < bins_) cell_updates_[i / stride()] += count;
   }
   for (size_t i = 0; i < normal_sum_.size(); ++i) normal_sum_[i] += static_cast<int64_t>(normal[i]);
   totals_.rejected_nonfinite += rejected[0];
@@ -174,13 +174,41 @@ void GuideField::split(size_t node_index) {
 // (all zero) samples uniformly.
 void GuideField::build_distributions() {
   const size_t cells = num_cells(), s = stride();
-  dir_cdf_.assign(cells * (bins_ + 1), 0.f);
+  dir_pmf_.assign(cells * bins_, 0.f);
+  dir_alias_.assign(cells * bins_, GuideAlias{});
   light_cdf_.assign(cells * (lights_ + 1), 0.f);
   irradiance_.assign(cells, 0.f);
   qmax_.assign(cells, 0.f);
   learn_normal_.assign(cells, 0);
   std::vector<double> w(std::max(bins_, lights_));
   const double floor = std::clamp<double>(config_.floor, 0.0, 1.0);
+  // Vose's alias method over w[0..bins) (deterministic: fixed scan order).
+  std::vector<double> scaled(bins_);
+  std::vector<uint32_t> small, large;
+  auto build_alias = [&](double total, Float* pmf, GuideAlias* table) {
+    const uint32_t m = bins_;
+    small.clear();
+    large.clear();
+    for (uint32_t j = 0; j < m; ++j) {
+      const double p = total > 0.0 ? (1.0 - floor) * w[j] / total + floor / m : 1.0 / m;
+      pmf[j] = static_cast<Float>(p);
+      scaled[j] = p * m;
+      (scaled[j] < 1.0 ? small : large).push_back(j);
+    }
+    while (!small.empty() && !large.empty()) {
+      const uint32_t s = small.back(), l = large.back();
+      small.pop_back();
+      table[s] = GuideAlias{static_cast<Float>(scaled[s]), l};
+      scaled[l] -= 1.0 - scaled[s];
+      if (scaled[l] < 1.0) {
+        large.pop_back();
+        small.push_back(l);
+      }
+    }
+    // Leftovers are 1 up to rounding: keep themselves.
+    for (uint32_t j : small) table[j] = GuideAlias{1.f, j};
+    for (uint32_t j : large) table[j] = GuideAlias{1.f, j};
+  };
   auto build_cdf = [&](uint32_t m, double total, Float* cdf) {
     double acc = 0.0;
     cdf[0] = 0.f;
@@ -207,7 +235,7 @@ void GuideField::build_distributions() {
     }
     irradiance_[c] = static_cast<Float>(total * 4.0 * M_PI / bins_);
     qmax_[c] = static_cast<Float>(qmax);
-    build_cdf(bins_, total, &dir_cdf_[c * (bins_ + 1)]);
+    build_alias(total, &dir_pmf_[c * bins_], &dir_alias_[c * bins_]);
     if (lights_ > 0) {
       double lt = 0.0;
       for (uint32_t j = 0; j < lights_; ++j) lt += (w[j] = q[bins_ + j]);

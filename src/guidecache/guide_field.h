@@ -24,7 +24,9 @@ namespace tessera {
 
 struct GuideConfig {
   uint32_t grid = 12;                   // 12 x 12 = 144 direction bins, as in Dahm & Keller
-  uint64_t budget_bytes = 64ull << 20;  // cells stop splitting when the next split would exceed it
+  // Cells stop splitting when the next split would exceed it. 16 MB keeps the
+  // sampled part of the field (~1/4 of it) in a typical L3 cache.
+  uint64_t budget_bytes = 16ull << 20;
   uint64_t split_updates = 0;           // a leaf splits after this many updates; 0 = 24 per bin
   uint32_t max_depth = 20;              // octree levels below a root
   Float guide_prob = 0.5f;
@@ -50,7 +52,8 @@ class GuideField {
  public:
   GuideField() = default;
   // bounds_lo/hi: the scene's bounds; num_lights: learned light selection is
-  // on when 2 <= num_lights <= config.max_learned_lights; radiance_scale: the
+  // on when 3 <= num_lights <= config.max_learned_lights (a single quad light is
+  // two triangles: nothing to choose between); radiance_scale: the
   // brightest emitted radiance (sets the fixed-point range of targets).
   GuideField(const GuideConfig& config, const Vec3& bounds_lo, const Vec3& bounds_hi, uint32_t num_lights,
              Float radiance_scale);
@@ -64,7 +67,7 @@ class GuideField {
   void fold();
 
   // The pass's accumulators, laid out as one array for reduction across
-  // processes: sums, counts, normals, rejections (all 64-bit integers, summed).
+  // processes: (sum, count) pairs, normals, rejections (all 64-bit integers, summed).
   std::vector<uint64_t>& accumulators() { return acc_; }
 
   const GuideConfig& config() const { return config_; }
@@ -97,7 +100,6 @@ class GuideField {
   void build_distributions();
   void build_bin_dirs();
   // Offsets of the parts of acc_.
-  size_t acc_count_offset() const { return num_cells() * size_t(stride()); }
   size_t acc_normal_offset() const { return 2 * num_cells() * size_t(stride()); }
   size_t acc_rejected_offset() const { return acc_normal_offset() + 3 * size_t(num_cells()); }
   void resize_accumulators();
@@ -118,7 +120,8 @@ class GuideField {
 
   // Derived (rebuilt by build_distributions, not serialised).
   std::vector<Vec3> bin_dirs_;
-  std::vector<Float> dir_cdf_, light_cdf_, irradiance_, qmax_;
+  std::vector<Float> dir_pmf_, light_cdf_, irradiance_, qmax_;
+  std::vector<GuideAlias> dir_alias_;
   std::vector<uint8_t> learn_normal_;
   std::vector<uint64_t> acc_;
 };

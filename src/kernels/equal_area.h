@@ -3,6 +3,8 @@
 // preserves area, a density p(u,v) on the square is p / (4 pi) per steradian.
 #pragma once
 
+#include <cmath>
+
 #include "vecmath.h"
 
 namespace tessera {
@@ -16,8 +18,10 @@ TESSERA_HOST_DEVICE inline Vec3 equal_area_square_to_sphere(Vec2 p) {
   Float phi = (r == 0.f ? 1.f : (vp - up) / r + 1.f) * kPi / 4.f;
   Float z = glm::sign(signed_distance) * (1.f - r * r);
   if (signed_distance == 0.f) z = 0.f;
-  Float cos_phi = glm::abs(glm::cos(phi)) * (u < 0.f ? -1.f : 1.f);
-  Float sin_phi = glm::abs(glm::sin(phi)) * (v < 0.f ? -1.f : 1.f);
+  Float sin_p, cos_p;
+  sincosf(phi, &sin_p, &cos_p);  // one call for both (glibc and CUDA)
+  Float cos_phi = glm::abs(cos_p) * (u < 0.f ? -1.f : 1.f);
+  Float sin_phi = glm::abs(sin_p) * (v < 0.f ? -1.f : 1.f);
   Float s = r * safe_sqrt(2.f - r * r);
   return Vec3(cos_phi * s, sin_phi * s, z);
 }

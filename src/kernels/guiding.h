@@ -49,7 +49,7 @@ TESSERA_HOST_DEVICE inline Float guide_bins_integral(const GuideView& g, int32_t
     return g.target == GuideTarget::QLearning ? rho * g.qmax[cell] : rho * kInvPi * g.irradiance[cell];
   }
   Float pmf = 0.f;
-  uint32_t j = g.dir_distribution(cell).sample_discrete(u, &pmf);
+  uint32_t j = g.sample_bin(cell, u, &pmf);
   if (!(pmf > 0.f)) return 0.f;
   Vec3 wi = to_local(g.bin_dirs[j]);
   Float fc = luminance(bsdf_eval(b, wo_local, wi)) * glm::abs(wi.z) * g.bin_solid_angle() / pmf;

@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""Guiding benchmark (not a test): learned guiding versus plain path tracing
+at equal wall-clock time, per shipped scene.
+
+For each scene, every method renders with the same --time budget (training
+included: the guide learns during the timed render), NEE+MIS on in all, and
+is compared with a reference image:
+  none       plain path tracing
+  qtable     expected-SARSA Q-table guiding (Dahm & Keller), the default
+  qlearning  the Q-learning "max" rule, for the comparison the paper makes
+Reported per scene and method (median over --repeats seeds): relMSE against
+the reference, zero-contribution fraction, mean path length, time per sample.
+
+The reference of each scene is an unguided render of --ref-spp samples per
+pixel, cached under out/bench-guiding/ (its seed and time are recorded), so
+re-runs only pay for it once. Results: out/bench-guiding/results.json and a
+table on stdout with the issue-3 targets checked.
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCENES = ["cornell-box", "door-ajar", "shelter", "pillars", "glossy"]
+# relMSE(qtable) / relMSE(none) targets from issue 3.
+TARGETS = {"door-ajar": 0.25, "shelter": 0.5, "pillars": 0.5, "cornell-box": 1.1}
+
+
+def run(cmd):
+    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if r.returncode != 0:
+        sys.exit(f"failed: {' '.join(cmd)}\n{r.stderr}")
+    return r.stdout
+
+
+def compare(tessera, image, reference):
+    return json.loads(run([tessera, "compare", image, reference, "--json"]))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--tessera", default=os.path.join(ROOT, "build", "tessera"))
+    ap.add_argument("--scenes", nargs="*", default=SCENES)
+    ap.add_argument("--methods", nargs="*", default=["none", "qtable", "qlearning"])
+    ap.add_argument("--time", type=float, default=10.0, help="seconds per render")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--ref-spp", type=int, default=8192)
+    ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench-guiding"))
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    threads = ["--threads", str(a.threads)] if a.threads else []
+
+    results = {"time_budget_s": a.time, "repeats": a.repeats, "threads": a.threads or os.cpu_count(),
+               "ref_spp": a.ref_spp, "scenes": {}}
+    for scene in a.scenes:
+        path = os.path.join(ROOT, "scenes", scene + ".pbrt")
+        ref = os.path.join(a.out, f"{scene}-reference.exr")
+        ref_meta = ref + ".json"
+        if not (os.path.exists(ref) and os.path.exists(ref_meta) and json.load(open(ref_meta)).get("spp") == a.ref_spp):
+            print(f"[{scene}] reference: {a.ref_spp} spp unguided ...", flush=True)
+            t0 = time.perf_counter()
+            run([a.tessera, "render", path, "-q", "--no-preview", "--guide", "none", "--spp", str(a.ref_spp),
+                 "--seed", "987654321", "-o", ref, *threads])
+            json.dump({"spp": a.ref_spp, "seconds": time.perf_counter() - t0, "guide": "none", "seed": 987654321},
+                      open(ref_meta, "w"))
+        meta = json.load(open(ref_meta))
+        entry = {"reference": {"spp": meta["spp"], "seconds": meta["seconds"]}, "methods": {}}
+        for method in a.methods:
+            rows = []
+            for rep in range(a.repeats):
+                img = os.path.join(a.out, f"{scene}-{method}.exr")
+                st = os.path.join(a.out, f"{scene}-{method}.json")
+                run([a.tessera, "render", path, "-q", "--no-preview", "--guide", method, "--time", str(a.time),
+                     "--seed", str(rep + 1), "--stats", st, "-o", img, *threads])
+                s = json.load(open(st))
+                c = compare(a.tessera, img, ref)
+                pixels = s["width"] * s["height"]
+                rows.append({"relmse": c["relmse"], "spp": s["spp"], "seconds": s["seconds"],
+                             "zero_contribution_fraction": s["zero_contribution_fraction"],
+                             "mean_path_length": s["mean_path_length"],
+                             "ns_per_sample": s["seconds"] / max(1, s["spp"] * pixels) * 1e9})
+            med = {k: statistics.median(r[k] for r in rows) for k in rows[0]}
+            med["runs"] = rows
+            entry["methods"][method] = med
+            print(f"[{scene}] {method:9s} relMSE {med['relmse']:.5g}  spp {med['spp']:.0f}  "
+                  f"zero {med['zero_contribution_fraction']:.3f}  path {med['mean_path_length']:.2f}  "
+                  f"{med['ns_per_sample']:.0f} ns/sample", flush=True)
+        results["scenes"][scene] = entry
+
+    print("\nscene         relMSE qtable/none  target   time/sample qtable/none   qtable vs qlearning")
+    for scene, e in results["scenes"].items():
+        m = e["methods"]
+        if "none" not in m or "qtable" not in m:
+            continue
+        ratio = m["qtable"]["relmse"] / max(m["none"]["relmse"], 1e-30)
+        tps = m["qtable"]["ns_per_sample"] / max(m["none"]["ns_per_sample"], 1e-30)
+        target = TARGETS.get(scene)
+        verdict = "" if target is None else ("ok" if ratio <= target else "MISSED")
+        ql = ""
+        if "qlearning" in m:
+            ql = "sarsa better" if m["qtable"]["relmse"] < m["qlearning"]["relmse"] else "qlearning better"
+        e["ratio_relmse_qtable_vs_none"] = ratio
+        e["ratio_time_per_sample"] = tps
+        print(f"{scene:12s}  {ratio:8.3f}            {('<= ' + str(target)) if target else '   -   ':8s} {verdict:6s}"
+              f"  {tps:6.2f} (target <= 1.25)      {ql}")
+    with open(os.path.join(a.out, "results.json"), "w") as f:
+        json.dump(results, f, indent=2)
+    print(f"\nwrote {os.path.join(a.out, 'results.json')}")
+
+
+if __name__ == "__main__":
+    main()
