@@ -19,6 +19,8 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--guide-split", a.split, "Updates a cell takes before it splits (0 = 24 per direction bin)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
+  cmd->add_option("--guide-grid", a.grid, "Direction bins per side of the equal-area square (bins = grid^2)")
+      ->check(CLI::Range(2, 64));
   cmd->add_option("--guide-in", a.in, "Start from a guide cache saved by --guide-out (same scene only)");
   cmd->add_option("--guide-out", a.out, "Save the learned guide cache after rendering");
 }
@@ -55,6 +57,7 @@ std::unique_ptr<GuideField> make_guide(const GuideArgs& a, const SceneData& scen
   cfg.budget_bytes = static_cast<uint64_t>(std::llround(a.budget_mb * 1048576.0));
   if (a.mix) cfg.guide_prob = static_cast<Float>(*a.mix);
   cfg.split_updates = static_cast<uint64_t>(a.split);
+  cfg.grid = static_cast<uint32_t>(a.grid);
   cfg.target = mode == "qlearning" ? GuideTarget::QLearning : GuideTarget::ExpectedSarsa;
   const Bounds& b = scene.bounds();
   return std::make_unique<GuideField>(cfg, b.lo, b.hi, scene.view().num_lights, scene.max_emitted_radiance());

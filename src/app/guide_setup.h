@@ -16,7 +16,8 @@ struct GuideArgs {
   std::string mode = "auto";  // auto | none | qtable | qlearning
   double budget_mb = 16.0;
   std::optional<double> mix;  // probability of sampling a direction from the guide (default 0.5)
-  int64_t split = 0;          // updates before a cell splits (0 = the library's default)
+  int64_t split = 0;
+  int64_t grid = 12;          // direction bins per side of the equal-area square          // updates before a cell splits (0 = the library's default)
   std::string in, out;
 };
 
