@@ -33,6 +33,19 @@ TESSERA_HOST_DEVICE inline uint32_t select_light(const SceneView& s, const Guide
   return li;
 }
 
+// How often a vertex draws its direction from the guide. The guide samples
+// Q x cos, the product with a diffuse lobe: right for diffuse and rough
+// surfaces, wasteful for narrow glossy lobes, which BSDF sampling already
+// follows closely (taking half their samples away made the glossy scene
+// worse). The share fades from the full mixture weight at roughness alpha
+// >= 0.3 to nothing at alpha <= 0.05.
+TESSERA_HOST_DEVICE inline Float guide_probability(const GuideView& g, const BsdfParams& b, bool lambertian_only) {
+  if (lambertian_only || b.type == BsdfType::Diffuse) return g.guide_prob;
+  Float alpha = glm::sqrt(b.alpha_x * b.alpha_y);
+  if (b.type == BsdfType::CoatedDiffuse) alpha = glm::max(alpha, 0.3f);  // a rough coat over a diffuse base
+  return g.guide_prob * glm::clamp((alpha - 0.05f) / 0.25f, 0.f, 1.f);
+}
+
 // The part of a learning target that looks beyond vertex y: an estimate of
 // the integral over incident directions of Q(y, wi) f(wo, wi) |cos| from y's
 // bins (expected SARSA), or of max Q(y) times the BSDF's albedo (Q-learning).

@@ -202,7 +202,9 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     // A path ending here leaves its last target unfinished (no NEE at y): dropped.
     if (depth++ == settings.max_depth) break;
     if (wo_l.z == 0.f) break;
-    const bool guided_vertex = kGuide && !delta_lobe;
+    // Probability of drawing this vertex's direction from the guide (0: BSDF only).
+    const Float guide_p = kGuide && !delta_lobe ? guide_probability(g, bsdf, (Spec & kSpecNonDiffuse) == 0) : 0.f;
+    const bool guided_vertex = guide_p > 0.f;
 
     // Next-event estimation at non-specular vertices (pbrt-v4's SampleLd).
     [[maybe_unused]] Float direct_estimate = 0.f;  // its unweighted estimate of light reflected here (guide targets)
@@ -226,7 +228,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             Float w = 1.f;
             if (!ls.delta) {
               Float scatter_pdf = eval_pdf<Spec>(bsdf, wo_l, wi_l);
-              if (guided_vertex) scatter_pdf = g.guide_prob * guide_pdf(g, cell, ls.wi) + (1.f - g.guide_prob) * scatter_pdf;
+              if (guided_vertex) scatter_pdf = guide_p * guide_pdf(g, cell, ls.wi) + (1.f - guide_p) * scatter_pdf;
               w = power_heuristic(light_pdf, scatter_pdf);
             }
             L += beta * f * ls.L * (w / light_pdf);
@@ -259,7 +261,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     if (guided_vertex) {
       // One extra dimension picks the strategy; the mixture pdf weights either.
       ++c.guidable_vertices;
-      const Float p = g.guide_prob;
+      const Float p = guide_p;
       if (rng.uniform() < p) {
         ++c.guided_samples;
         Float guide_density;
