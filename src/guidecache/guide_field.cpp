@@ -53,10 +53,11 @@ size_t GuideField::add_cell() {
 
 uint64_t GuideField::bytes_per_cell() const {
   const uint64_t entry = sizeof(Float) + sizeof(uint32_t) + 2 * sizeof(uint64_t);  // value, visits, acc sum + count
-  const uint64_t cdfs = (bins_ + 1 + lights_ + 1) * sizeof(Float);
-  const uint64_t extras = 3 * sizeof(int64_t) + 3 * sizeof(uint64_t) + sizeof(uint64_t) + 2 * sizeof(Float);
+  const uint64_t tables = bins_ * sizeof(GuideAlias) + (lights_ + 1) * sizeof(Float);  // alias table, light cdf
+  // normal sum + its accumulator, update count, irradiance, qmax, learn-normal flag
+  const uint64_t extras = 3 * sizeof(int64_t) + 3 * sizeof(uint64_t) + sizeof(uint64_t) + 2 * sizeof(Float) + 1;
   const uint64_t node = (8 * sizeof(GuideNode) + 8) / 7 + 1;  // amortised share of the octree
-  return stride() * entry + cdfs + extras + node;
+  return stride() * entry + tables + extras + node;
 }
 
 uint64_t GuideField::split_threshold() const {
@@ -85,7 +86,6 @@ GuideView GuideField::view() {
   g.stride = stride();
   g.bin_dirs = bin_dirs_.data();
   g.value = value_.data();
-  g.dir_pmf = dir_pmf_.data();
   g.dir_alias = dir_alias_.data();
   g.light_cdf = light_cdf_.data();
   g.irradiance = irradiance_.data();
@@ -174,7 +174,6 @@ void GuideField::split(size_t node_index) {
 // (all zero) samples uniformly.
 void GuideField::build_distributions() {
   const size_t cells = num_cells(), s = stride();
-  dir_pmf_.assign(cells * bins_, 0.f);
   dir_alias_.assign(cells * bins_, GuideAlias{});
   light_cdf_.assign(cells * (lights_ + 1), 0.f);
   irradiance_.assign(cells, 0.f);
@@ -185,20 +184,21 @@ void GuideField::build_distributions() {
   // Vose's alias method over w[0..bins) (deterministic: fixed scan order).
   std::vector<double> scaled(bins_);
   std::vector<uint32_t> small, large;
-  auto build_alias = [&](double total, Float* pmf, GuideAlias* table) {
+  auto build_alias = [&](double total, GuideAlias* table) {
     const uint32_t m = bins_;
     small.clear();
     large.clear();
     for (uint32_t j = 0; j < m; ++j) {
       const double p = total > 0.0 ? (1.0 - floor) * w[j] / total + floor / m : 1.0 / m;
-      pmf[j] = static_cast<Float>(p);
+      table[j].pmf = static_cast<Float>(p);
       scaled[j] = p * m;
       (scaled[j] < 1.0 ? small : large).push_back(j);
     }
     while (!small.empty() && !large.empty()) {
       const uint32_t s = small.back(), l = large.back();
       small.pop_back();
-      table[s] = GuideAlias{static_cast<Float>(scaled[s]), l};
+      table[s].keep = static_cast<Float>(scaled[s]);
+      table[s].alias = l;
       scaled[l] -= 1.0 - scaled[s];
       if (scaled[l] < 1.0) {
         large.pop_back();
@@ -206,8 +206,9 @@ void GuideField::build_distributions() {
       }
     }
     // Leftovers are 1 up to rounding: keep themselves.
-    for (uint32_t j : small) table[j] = GuideAlias{1.f, j};
-    for (uint32_t j : large) table[j] = GuideAlias{1.f, j};
+    for (uint32_t j : small) table[j].keep = 1.f, table[j].alias = j;
+    for (uint32_t j : large) table[j].keep = 1.f, table[j].alias = j;
+    for (uint32_t j = 0; j < m; ++j) table[j].alias_pmf = table[table[j].alias].pmf;
   };
   auto build_cdf = [&](uint32_t m, double total, Float* cdf) {
     double acc = 0.0;
@@ -235,7 +236,7 @@ void GuideField::build_distributions() {
     }
     irradiance_[c] = static_cast<Float>(total * 4.0 * M_PI / bins_);
     qmax_[c] = static_cast<Float>(qmax);
-    build_alias(total, &dir_pmf_[c * bins_], &dir_alias_[c * bins_]);
+    build_alias(total, &dir_alias_[c * bins_]);
     if (lights_ > 0) {
       double lt = 0.0;
       for (uint32_t j = 0; j < lights_; ++j) lt += (w[j] = q[bins_ + j]);

@@ -120,7 +120,7 @@ class GuideField {
 
   // Derived (rebuilt by build_distributions, not serialised).
   std::vector<Vec3> bin_dirs_;
-  std::vector<Float> dir_pmf_, light_cdf_, irradiance_, qmax_;
+  std::vector<Float> light_cdf_, irradiance_, qmax_;
   std::vector<GuideAlias> dir_alias_;
   std::vector<uint8_t> learn_normal_;
   std::vector<uint64_t> acc_;

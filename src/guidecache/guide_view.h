@@ -31,12 +31,15 @@ struct GuideNode {
   int32_t cell = -1;
 };
 
-// Walker/Vose alias table entry: bin i is kept with probability `keep`,
-// otherwise `alias` is taken. O(1) sampling with two loads from one cell's
-// block, where a cdf search would chase ~8 dependent loads.
+// Walker/Vose alias table entry of bin i: i is kept with probability `keep`,
+// otherwise `alias` is taken. O(1) sampling where a cdf search would chase ~8
+// dependent loads; the entry also carries the probabilities of i and of its
+// alias, so a sample or a pdf lookup reads one 16-byte entry.
 struct GuideAlias {
   Float keep = 1.f;
   uint32_t alias = 0;
+  Float pmf = 0.f;        // probability of bin i
+  Float alias_pmf = 0.f;  // probability of bin `alias`
 };
 
 // Surface points are split by the dominant axis of their normal (+-x, +-y,
@@ -62,8 +65,7 @@ struct GuideView {
   // Frozen per cell: values (incident radiance per bin, contribution per light),
   // cdfs of the sampling distributions, and what targets need.
   const Float* value = nullptr;        // cells * stride
-  const Float* dir_pmf = nullptr;      // cells * bins: probability of each bin
-  const GuideAlias* dir_alias = nullptr;  // cells * bins: alias tables of the same distributions
+  const GuideAlias* dir_alias = nullptr;  // cells * bins: per-cell alias tables of the direction distributions
   const Float* light_cdf = nullptr;    // cells * (lights + 1)
   const Float* irradiance = nullptr;   // cells: sum over bins of Q max(cos, 0) dOmega about the cell normal
   const Float* qmax = nullptr;         // cells: largest Q over the bins above the cell's surface
@@ -82,16 +84,16 @@ struct GuideView {
 
   TESSERA_HOST_DEVICE Float bin_solid_angle() const { return 4.f * kPi / static_cast<Float>(bins); }
   TESSERA_HOST_DEVICE Float dir_pmf_of(int32_t cell, uint32_t bin) const {
-    return dir_pmf[static_cast<size_t>(cell) * bins + bin];
+    return dir_alias[static_cast<size_t>(cell) * bins + bin].pmf;
   }
   // Draws a bin with one uniform number (alias method); *pmf is its probability.
   TESSERA_HOST_DEVICE uint32_t sample_bin(int32_t cell, Float u, Float* pmf) const {
     Float x = u * static_cast<Float>(bins);
     uint32_t i = glm::min(static_cast<uint32_t>(x), bins - 1);
     const GuideAlias& a = dir_alias[static_cast<size_t>(cell) * bins + i];
-    uint32_t bin = (x - static_cast<Float>(i)) < a.keep ? i : a.alias;
-    *pmf = dir_pmf_of(cell, bin);
-    return bin;
+    const bool keep = (x - static_cast<Float>(i)) < a.keep;
+    *pmf = keep ? a.pmf : a.alias_pmf;
+    return keep ? i : a.alias;
   }
   TESSERA_HOST_DEVICE Distribution1DView light_distribution(int32_t cell) const {
     Distribution1DView d;
@@ -177,7 +179,8 @@ TESSERA_HOST_DEVICE inline bool guide_record(const GuideView& g, int32_t cell, u
     return false;
   }
   size_t i = static_cast<size_t>(cell) * g.stride + entry;
-  atomic_add_u64(&g.acc[2 * i], static_cast<uint64_t>(static_cast<double>(target) * g.fixed_scale + 0.5));
+  // float is exact enough here: targets are below 2^44 units, rounded to 24 bits.
+  atomic_add_u64(&g.acc[2 * i], static_cast<uint64_t>(target * g.fixed_scale + 0.5f));
   atomic_add_u64(&g.acc[2 * i + 1], 1);
   return true;
 }

@@ -5,6 +5,7 @@
 
 #include "bsdf.h"
 #include "guidecache/guide_view.h"
+#include "rng.h"
 #include "scene_view.h"
 
 namespace tessera {
@@ -56,13 +57,13 @@ TESSERA_HOST_DEVICE inline Float guide_probability(const GuideView& g, const Bsd
 // The BSDF is given in its local frame; w_j is taken to it by `to_local`.
 template <class ToLocal>
 TESSERA_HOST_DEVICE inline Float guide_bins_integral(const GuideView& g, int32_t cell, const BsdfParams& b, bool lambertian,
-                                                     const Vec3& wo_local, const ToLocal& to_local, Float u) {
+                                                     const Vec3& wo_local, const ToLocal& to_local, Rng& rng) {
   if (lambertian) {
     Float rho = luminance(b.reflectance);
     return g.target == GuideTarget::QLearning ? rho * g.qmax[cell] : rho * kInvPi * g.irradiance[cell];
   }
   Float pmf = 0.f;
-  uint32_t j = g.sample_bin(cell, u, &pmf);
+  uint32_t j = g.sample_bin(cell, rng.uniform(), &pmf);
   if (!(pmf > 0.f)) return 0.f;
   Vec3 wi = to_local(g.bin_dirs[j]);
   Float fc = luminance(bsdf_eval(b, wo_local, wi)) * glm::abs(wi.z) * g.bin_solid_angle() / pmf;

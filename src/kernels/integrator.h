@@ -245,7 +245,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       if (pend_cell >= 0 && !pend_at_delta) {
         const bool lambertian = (Spec & kSpecNonDiffuse) == 0 || bsdf.type == BsdfType::Diffuse;
         Float integral = guide_bins_integral(g, cell, bsdf, lambertian, wo_l,
-                                             [&](const Vec3& v) { return frame.to_local(v); }, rng.uniform());
+                                             [&](const Vec3& v) { return frame.to_local(v); }, rng);
         if (guide_record(g, pend_cell, pend_bin, pend_le + direct_estimate + integral)) ++c.guide_updates;
         pend_cell = -1;
       }
