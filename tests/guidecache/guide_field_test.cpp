@@ -88,6 +88,27 @@ TEST(GuideSampling, SamplesFollowThePdfChiSquare) {
   EXPECT_LT(chi2, dof + 4.5 * std::sqrt(2.0 * dof)) << "dof " << dof;
 }
 
+// The alias table realises exactly the probabilities it reports.
+TEST(GuideSampling, AliasTableRealisesItsProbabilities) {
+  GuideField f = make_field();
+  int32_t cell = f.find_cell(Vec3(0.5f), Vec3(0, 0, 1));
+  teach_peaked(f, cell);
+  GuideView g = f.view();
+  std::vector<double> realised(g.bins, 0.0);
+  const GuideAlias* t = g.dir_alias + size_t(cell) * g.bins;
+  for (uint32_t i = 0; i < g.bins; ++i) {
+    realised[i] += t[i].keep / g.bins;
+    realised[t[i].alias] += (1.0 - t[i].keep) / g.bins;
+    EXPECT_EQ(t[i].alias_pmf, t[t[i].alias].pmf);
+  }
+  double total = 0;
+  for (uint32_t i = 0; i < g.bins; ++i) {
+    EXPECT_NEAR(realised[i], t[i].pmf, 1e-6) << "bin " << i;
+    total += t[i].pmf;
+  }
+  EXPECT_NEAR(total, 1.0, 1e-5);
+}
+
 TEST(GuideSampling, PeakedFieldPrefersBrightBinsFacingTheNormal) {
   GuideField f = make_field();
   int32_t cell = f.find_cell(Vec3(0.5f), Vec3(0, 0, 1));
