@@ -26,8 +26,11 @@ struct GuidedSetup {
     return GuideField(cfg, scene.bounds().lo, scene.bounds().hi, scene.view().num_lights,
                       scene.max_emitted_radiance());
   }
+  // Unguided renders use another seed than guided ones, so that comparisons
+  // between them are between independent estimates.
   RenderResult run(GuideField* guide, RenderOptions opt = {}) const {
     opt.progress = false;
+    if (!guide) opt.seed += 1000003;
     opt.spp = static_cast<uint32_t>(scene.desc().spp);
     opt.max_depth = scene.desc().max_depth;
     return render(scene, embree, opt, guide);
@@ -35,19 +38,22 @@ struct GuidedSetup {
 };
 
 // Mean over pixels and channels and its standard error, from the per-pixel
-// variance of the mean that the film keeps (pixels are independent).
+// variance of the mean that the film keeps. Pixels are independent; the
+// channels of one pixel are not, so their errors add as if fully correlated
+// (the conservative bound).
 struct MeanAndError {
   double mean = 0, se = 0;
 };
 MeanAndError image_mean_and_error(const Film& film) {
   ImageRgb m = film_mean(film), v = film_variance_of_mean(film);
-  double sum = 0, var = 0;
+  double sum = 0, var[3] = {0, 0, 0};
   for (size_t i = 0; i < m.rgb.size(); ++i) {
     sum += m.rgb[i];
-    var += v.rgb[i];
+    var[i % 3] += v.rgb[i];
   }
-  const double n = static_cast<double>(m.rgb.size());
-  return {sum / n, std::sqrt(var) / n};
+  const double pixels = static_cast<double>(m.rgb.size() / 3);
+  const double se = (std::sqrt(var[0]) + std::sqrt(var[1]) + std::sqrt(var[2])) / (3.0 * pixels);
+  return {sum / (3.0 * pixels), se};
 }
 
 // Guided and unguided means agree within 4 combined standard errors
