@@ -22,27 +22,19 @@ RenderResult render_cornell(int threads, int tile, uint64_t seed) {
   return testing::render_desc(std::move(d), opt);
 }
 
-bool films_identical(const Film& a, const Film& b) {
-  if (a.width != b.width || a.height != b.height) return false;
-  for (size_t i = 0; i < a.pixels.size(); ++i) {
-    if (std::memcmp(&a.pixels[i], &b.pixels[i], sizeof(PixelAccum)) != 0) return false;
-  }
-  return true;
-}
-
 TEST(Determinism, BitIdenticalAcrossThreadCountsAndTiles) {
   RenderResult one = render_cornell(1, 16, 42);
   RenderResult two = render_cornell(2, 16, 42);
   RenderResult four = render_cornell(4, 7, 42);
-  EXPECT_TRUE(films_identical(one.film, two.film));
-  EXPECT_TRUE(films_identical(one.film, four.film));
+  EXPECT_TRUE(testing::films_identical(one.film, two.film));
+  EXPECT_TRUE(testing::films_identical(one.film, four.film));
   EXPECT_EQ(one.stats.counters.path.rays, four.stats.counters.path.rays);
 }
 
 TEST(Determinism, SeedChangesTheImage) {
   RenderResult a = render_cornell(2, 16, 1);
   RenderResult b = render_cornell(2, 16, 2);
-  EXPECT_FALSE(films_identical(a.film, b.film));
+  EXPECT_FALSE(testing::films_identical(a.film, b.film));
 }
 
 }  // namespace

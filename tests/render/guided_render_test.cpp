@@ -8,73 +8,16 @@
 #include <cstring>
 #include <sstream>
 
-#include "render_helpers.h"
+#include "guided_helpers.h"
 #include "scene/builtin_scenes.h"
 
 namespace tessera {
 namespace {
 
-// One scene + its Embree BVH, rendered with or without a guide.
-struct GuidedSetup {
-  SceneData scene;
-  EmbreeScene embree;
-  explicit GuidedSetup(SceneDesc d) : scene(std::move(d)), embree(scene) {}
+using namespace tessera::testing;
 
-  GuideField make_guide(GuideTarget target = GuideTarget::ExpectedSarsa) const {
-    GuideConfig cfg;
-    cfg.target = target;
-    return GuideField(cfg, scene.bounds().lo, scene.bounds().hi, scene.view().num_lights,
-                      scene.max_emitted_radiance());
-  }
-  // Unguided renders use another seed than guided ones, so that comparisons
-  // between them are between independent estimates.
-  RenderResult run(GuideField* guide, RenderOptions opt = {}) const {
-    opt.progress = false;
-    if (!guide) opt.seed += 1000003;
-    opt.spp = static_cast<uint32_t>(scene.desc().spp);
-    opt.max_depth = scene.desc().max_depth;
-    return render(scene, embree, opt, guide);
-  }
-};
-
-// Mean over pixels and channels and its standard error, from the per-pixel
-// variance of the mean that the film keeps. Pixels are independent; the
-// channels of one pixel are not, so their errors add as if fully correlated
-// (the conservative bound).
-struct MeanAndError {
-  double mean = 0, se = 0;
-};
-MeanAndError image_mean_and_error(const Film& film) {
-  ImageRgb m = film_mean(film), v = film_variance_of_mean(film);
-  double sum = 0, var[3] = {0, 0, 0};
-  for (size_t i = 0; i < m.rgb.size(); ++i) {
-    sum += m.rgb[i];
-    var[i % 3] += v.rgb[i];
-  }
-  const double pixels = static_cast<double>(m.rgb.size() / 3);
-  const double se = (std::sqrt(var[0]) + std::sqrt(var[1]) + std::sqrt(var[2])) / (3.0 * pixels);
-  return {sum / (3.0 * pixels), se};
-}
-
-// Guided and unguided means agree within 4 combined standard errors
-// (a false alarm has probability ~6e-5).
-void expect_agree(const MeanAndError& a, const MeanAndError& b) {
-  const double tol = 4.0 * std::sqrt(a.se * a.se + b.se * b.se);
-  EXPECT_NEAR(a.mean, b.mean, tol) << "standard errors " << a.se << ", " << b.se;
-}
-
-bool all_finite(const Film& film) {
-  for (float v : film_mean(film).rgb)
-    if (!std::isfinite(v)) return false;
-  return true;
-}
-
-bool films_identical(const Film& a, const Film& b) {
-  if (a.width != b.width || a.height != b.height) return false;
-  for (size_t i = 0; i < a.pixels.size(); ++i)
-    if (std::memcmp(&a.pixels[i], &b.pixels[i], sizeof(PixelAccum)) != 0) return false;
-  return true;
-}
+// Unguided renders compared with guided ones use another seed (independent estimates).
+constexpr uint64_t kUnguidedSeed = 1000003;
 
 SceneDesc furnace(double rho, int max_depth) {
   char buf[1024];
@@ -92,27 +35,18 @@ Shape "sphere" "float radius" [ 10 ]
   return load_pbrt_string(buf, "<furnace>", ".");
 }
 
-SceneDesc shipped(const char* name, int w, int h, int spp, int max_depth) {
-  SceneDesc d = load_pbrt_file(testing::source_dir() + "/scenes/" + name + ".pbrt");
-  d.film.xres = w;
-  d.film.yres = h;
-  d.spp = spp;
-  d.max_depth = max_depth;
-  return d;
-}
-
 TEST(GuidedFurnace, ClosedSphereMatchesTheAnalyticValue) {
   // L = Le * sum_{k=0..5} 0.5^k with pbrt's depth counting.
   const double expected = 1.96875;
-  GuidedSetup s(furnace(0.5, 5));
+  GuidedScene s(furnace(0.5, 5));
   for (GuideTarget target : {GuideTarget::ExpectedSarsa, GuideTarget::QLearning}) {
     for (bool nee : {true, false}) {
-      GuideField guide = s.make_guide(target);
+      GuideField guide = s.make_guide(config_with(target));
       RenderOptions opt;
       opt.nee = nee;
       RenderResult r = s.run(&guide, opt);
-      MeanAndError m = image_mean_and_error(r.film);
-      EXPECT_NEAR(m.mean, expected, 0.01 * expected) << "nee " << nee;
+      ChannelStats m = channel_stats(r.film);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.mean[c], expected, 0.01 * expected) << "nee " << nee;
       EXPECT_GT(r.stats.counters.path.guided_samples, 0u);
       EXPECT_GT(r.stats.guide.updates, 0u);
       EXPECT_EQ(r.stats.counters.rejected_nonfinite, 0u);
@@ -125,14 +59,13 @@ TEST(GuidedFurnace, ClosedSphereMatchesTheAnalyticValue) {
 TEST(GuidedUnbiased, DoorAjarAndShelterAgreeWithUnguided) {
   for (const char* name : {"door-ajar", "shelter"}) {
     SCOPED_TRACE(name);
-    GuidedSetup s(shipped(name, 40, 30, 192, 8));
+    GuidedScene s(shipped(name, 40, 30, 192, 8));
     GuideField guide = s.make_guide();
     RenderResult g = s.run(&guide);
-    RenderResult u = s.run(nullptr);
-    MeanAndError mg = image_mean_and_error(g.film), mu = image_mean_and_error(u.film);
-    ASSERT_GT(mu.mean, 0.0);
-    ASSERT_LT(mu.se, 0.05 * mu.mean) << "test too noisy to mean anything";
-    expect_agree(mg, mu);
+    RenderResult u = s.run(nullptr, seeded(kUnguidedSeed));
+    ChannelStats mu = channel_stats(u.film);
+    expect_precise(mu, 0.05, name);
+    expect_agree(channel_stats(g.film), mu, name);
     EXPECT_TRUE(all_finite(g.film));
     EXPECT_GT(g.stats.guide.splits, 0u) << "the field never refined";
   }
@@ -162,18 +95,18 @@ AttributeBegin
     "integer indices" [ 0 1 2 0 2 3 ]
 AttributeEnd
 )";
-  GuidedSetup s(load_pbrt_string(scene, "<glossy-box>", "."));
+  GuidedScene s(load_pbrt_string(scene, "<glossy-box>", "."));
   GuideField guide = s.make_guide();
   RenderResult g = s.run(&guide);
-  RenderResult u = s.run(nullptr);
+  RenderResult u = s.run(nullptr, seeded(kUnguidedSeed));
   EXPECT_GT(g.stats.counters.path.guided_samples, 0u);
-  MeanAndError mu = image_mean_and_error(u.film);
-  ASSERT_GT(mu.mean, 0.0);
-  expect_agree(image_mean_and_error(g.film), mu);
+  ChannelStats mu = channel_stats(u.film);
+  expect_precise(mu, 0.05, "glossy box");
+  expect_agree(channel_stats(g.film), mu, "glossy box");
 }
 
 TEST(GuidedDeterminism, BitIdenticalImageAndCacheAcrossThreadCounts) {
-  GuidedSetup s(shipped("shelter", 32, 24, 12, 6));
+  GuidedScene s(shipped("shelter", 32, 24, 12, 6));
   RenderResult results[3];
   GuideField guides[3] = {s.make_guide(), s.make_guide(), s.make_guide()};
   const int threads[3] = {1, 2, 4}, tiles[3] = {16, 8, 5};
@@ -192,7 +125,7 @@ TEST(GuidedDeterminism, BitIdenticalImageAndCacheAcrossThreadCounts) {
 }
 
 TEST(GuidedCacheRoundTrip, SavedCacheRendersTheSameImage) {
-  GuidedSetup s(shipped("door-ajar", 24, 18, 8, 6));
+  GuidedScene s(shipped("door-ajar", 24, 18, 8, 6));
   GuideField guide = s.make_guide();
   s.run(&guide);
   std::stringstream bytes;
@@ -212,7 +145,7 @@ TEST(GuideDegenerate, HugeBinEverywhereStaysFiniteAndUnbiased) {
   d.film.xres = 32;
   d.film.yres = 32;
   d.spp = 96;
-  GuidedSetup s(std::move(d));
+  GuidedScene s(std::move(d));
   GuideField guide = s.make_guide();
   {
     GuideView g = guide.view();
@@ -221,10 +154,10 @@ TEST(GuideDegenerate, HugeBinEverywhereStaysFiniteAndUnbiased) {
     guide.fold();
   }
   RenderResult g = s.run(&guide);
-  RenderResult u = s.run(nullptr);
+  RenderResult u = s.run(nullptr, seeded(kUnguidedSeed));
   EXPECT_EQ(g.stats.counters.rejected_nonfinite, 0u);
   EXPECT_TRUE(all_finite(g.film));
-  expect_agree(image_mean_and_error(g.film), image_mean_and_error(u.film));
+  expect_agree(channel_stats(g.film), channel_stats(u.film), "huge bins");
 }
 
 TEST(GuideDegenerate, InjectedNonFiniteTargetsAreRejectedAndCounted) {
@@ -232,7 +165,7 @@ TEST(GuideDegenerate, InjectedNonFiniteTargetsAreRejectedAndCounted) {
   d.film.xres = 16;
   d.film.yres = 16;
   d.spp = 4;
-  GuidedSetup s(std::move(d));
+  GuidedScene s(std::move(d));
   GuideField guide = s.make_guide();
   {
     GuideView g = guide.view();
@@ -266,16 +199,16 @@ AttributeBegin
     "integer indices" [ 0 1 2 0 2 3 ]
 AttributeEnd
 )";
-  GuidedSetup s(load_pbrt_string(scene, "<tiny-light>", "."));
+  GuidedScene s(load_pbrt_string(scene, "<tiny-light>", "."));
   GuideField guide = s.make_guide();
   RenderResult g = s.run(&guide);
-  RenderResult u = s.run(nullptr);
+  RenderResult u = s.run(nullptr, seeded(kUnguidedSeed));
   EXPECT_EQ(g.stats.counters.rejected_nonfinite, 0u);
   EXPECT_EQ(g.stats.guide.rejected_nonfinite + g.stats.guide.rejected_large, 0u);
   EXPECT_TRUE(all_finite(g.film));
-  MeanAndError mu = image_mean_and_error(u.film);
-  ASSERT_GT(mu.mean, 0.0);
-  expect_agree(image_mean_and_error(g.film), mu);
+  ChannelStats mu = channel_stats(u.film);
+  for (int c = 0; c < 3; ++c) ASSERT_GT(mu.mean[c], 0.0);
+  expect_agree(channel_stats(g.film), mu, "tiny light");
 }
 
 }  // namespace

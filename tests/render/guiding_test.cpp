@@ -23,95 +23,13 @@
 #include <string>
 #include <vector>
 
-#include "render_helpers.h"
+#include "guided_helpers.h"
 #include "scene/builtin_scenes.h"
 
 namespace tessera {
 namespace {
 
-// One scene + its BVH, rendered with or without a guide.
-struct GuidedScene {
-  SceneData scene;
-  EmbreeScene embree;
-  explicit GuidedScene(SceneDesc d) : scene(std::move(d)), embree(scene) {}
-
-  GuideField make_guide(const GuideConfig& cfg = {}) const {
-    return GuideField(cfg, scene.bounds().lo, scene.bounds().hi, scene.view().num_lights, scene.max_emitted_radiance());
-  }
-  RenderResult run(GuideField* guide, RenderOptions opt = {}) const {
-    opt.progress = false;
-    opt.spp = static_cast<uint32_t>(scene.desc().spp);
-    opt.max_depth = scene.desc().max_depth;
-    return render(scene, embree, opt, guide);
-  }
-};
-
-GuideConfig config_with(GuideTarget target, Float guide_prob = 0.5f) {
-  GuideConfig cfg;
-  cfg.target = target;
-  cfg.guide_prob = guide_prob;
-  return cfg;
-}
-
-// Per-channel image means and their standard errors. Pixels are independent
-// given the guide, and each pass's samples are unbiased given the field they
-// were drawn with, so the variance of a channel's mean over N pixels is
-// sum_i var_i / N^2 with var_i the variance of pixel i's mean. Channels are
-// compared separately: the three channels of one path are strongly
-// correlated, and pooling them as if independent would understate the error.
-struct ChannelStats {
-  double mean[3] = {0, 0, 0};
-  double se[3] = {0, 0, 0};
-};
-
-ChannelStats channel_stats(const Film& film) {
-  const ImageRgb m = film_mean(film), v = film_variance_of_mean(film);
-  const double n = static_cast<double>(film.pixels.size());
-  ChannelStats s;
-  for (int c = 0; c < 3; ++c) {
-    double sum = 0, var = 0;
-    for (size_t i = 0; i < film.pixels.size(); ++i) {
-      sum += m.rgb[3 * i + c];
-      var += v.rgb[3 * i + c];
-    }
-    s.mean[c] = sum / n;
-    s.se[c] = std::sqrt(var) / n;
-  }
-  return s;
-}
-
-// Two independent estimates of the same image agree when every channel's
-// means differ by less than 4 combined standard errors: for one channel a
-// false alarm has probability ~6e-5 (normal approximation, fine at > 10^4
-// samples per image), ~2e-4 for the three.
-void expect_agree(const ChannelStats& a, const ChannelStats& b, const std::string& what) {
-  for (int c = 0; c < 3; ++c) {
-    const double tol = 4.0 * std::sqrt(a.se[c] * a.se[c] + b.se[c] * b.se[c]);
-    EXPECT_NEAR(a.mean[c], b.mean[c], tol)
-        << what << ", channel " << c << ", standard errors " << a.se[c] << " and " << b.se[c];
-  }
-}
-
-// The comparison means something only if it can see a bias of a few percent.
-void expect_precise(const ChannelStats& s, double rel, const std::string& what) {
-  for (int c = 0; c < 3; ++c) {
-    ASSERT_GT(s.mean[c], 0.0) << what;
-    EXPECT_LT(s.se[c], rel * s.mean[c]) << what << ": too noisy to detect a bias, channel " << c;
-  }
-}
-
-bool all_finite(const Film& film) {
-  for (float v : film_mean(film).rgb)
-    if (!std::isfinite(v)) return false;
-  return true;
-}
-
-bool films_identical(const Film& a, const Film& b) {
-  if (a.width != b.width || a.height != b.height || a.pixels.size() != b.pixels.size()) return false;
-  for (size_t i = 0; i < a.pixels.size(); ++i)
-    if (std::memcmp(&a.pixels[i], &b.pixels[i], sizeof(PixelAccum)) != 0) return false;
-  return true;
-}
+using namespace tessera::testing;
 
 // What every guided render must show: guiding ran and learned, and no
 // estimate or target was NaN, infinite or negative.
@@ -126,14 +44,6 @@ void expect_clean_guided_run(const RenderResult& r, const std::string& what) {
   EXPECT_TRUE(all_finite(r.film)) << what;
 }
 
-SceneDesc shipped(const char* name, int w, int h, int spp, int max_depth) {
-  SceneDesc d = load_pbrt_file(testing::source_dir() + "/scenes/" + name + ".pbrt");
-  d.film.xres = w;
-  d.film.yres = h;
-  d.spp = spp;
-  d.max_depth = max_depth;
-  return d;
-}
 
 // L = Le * sum_{k=0..D} rho^k inside any closed emitter of uniform Le and
 // albedo rho (pbrt's depth counting).
@@ -329,14 +239,6 @@ Shape "sphere" "float radius" [ 1 ]
 
 // --- Agreement with unguided renders ---------------------------------------------
 
-// Seeds for renders that are compared statistically: guided and unguided
-// renders with the same seed share their first random numbers (camera ray,
-// first light sample) and would be correlated.
-RenderOptions seeded(uint64_t seed) {
-  RenderOptions opt;
-  opt.seed = seed;
-  return opt;
-}
 
 // Glossy: rough conductors and a rough dielectric are guided (bin-sampled
 // learning targets, guided transmission), the smooth glass sphere exercises

@@ -1,6 +1,7 @@
 // Helpers for tests that render through the library (no subprocess).
 #pragma once
 
+#include <cstring>
 #include <string>
 
 #include "master/film.h"
@@ -29,6 +30,14 @@ inline double image_mean(const ImageRgb& img) {
   double s = 0;
   for (float v : img.rgb) s += v;
   return s / img.rgb.size();
+}
+
+// Bit-for-bit equality of two films (sums, second moments, counts).
+inline bool films_identical(const Film& a, const Film& b) {
+  if (a.width != b.width || a.height != b.height || a.pixels.size() != b.pixels.size()) return false;
+  for (size_t i = 0; i < a.pixels.size(); ++i)
+    if (std::memcmp(&a.pixels[i], &b.pixels[i], sizeof(PixelAccum)) != 0) return false;
+  return true;
 }
 
 inline std::string source_dir() { return TESSERA_SOURCE_DIR; }

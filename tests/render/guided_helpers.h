@@ -1,0 +1,109 @@
+// Helpers for the guided-rendering tests: a scene with its BVH rendered with
+// or without a guide, and statistical comparison of two renders.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "render_helpers.h"
+
+namespace tessera::testing {
+
+// One scene + its BVH, rendered with or without a guide.
+struct GuidedScene {
+  SceneData scene;
+  EmbreeScene embree;
+  explicit GuidedScene(SceneDesc d) : scene(std::move(d)), embree(scene) {}
+
+  GuideField make_guide(const GuideConfig& cfg = {}) const {
+    return GuideField(cfg, scene.bounds().lo, scene.bounds().hi, scene.view().num_lights, scene.max_emitted_radiance());
+  }
+  RenderResult run(GuideField* guide, RenderOptions opt = {}) const {
+    opt.progress = false;
+    opt.spp = static_cast<uint32_t>(scene.desc().spp);
+    opt.max_depth = scene.desc().max_depth;
+    return render(scene, embree, opt, guide);
+  }
+};
+
+inline GuideConfig config_with(GuideTarget target, Float guide_prob = 0.5f) {
+  GuideConfig cfg;
+  cfg.target = target;
+  cfg.guide_prob = guide_prob;
+  return cfg;
+}
+
+// Per-channel image means and their standard errors. Pixels are independent
+// given the guide, and each pass's samples are unbiased given the field they
+// were drawn with, so the variance of a channel's mean over N pixels is
+// sum_i var_i / N^2 with var_i the variance of pixel i's mean. Channels are
+// compared separately: the three channels of one path are strongly
+// correlated, and pooling them as if independent would understate the error.
+struct ChannelStats {
+  double mean[3] = {0, 0, 0};
+  double se[3] = {0, 0, 0};
+};
+
+inline ChannelStats channel_stats(const Film& film) {
+  const ImageRgb m = film_mean(film), v = film_variance_of_mean(film);
+  const double n = static_cast<double>(film.pixels.size());
+  ChannelStats s;
+  for (int c = 0; c < 3; ++c) {
+    double sum = 0, var = 0;
+    for (size_t i = 0; i < film.pixels.size(); ++i) {
+      sum += m.rgb[3 * i + c];
+      var += v.rgb[3 * i + c];
+    }
+    s.mean[c] = sum / n;
+    s.se[c] = std::sqrt(var) / n;
+  }
+  return s;
+}
+
+// Two independent estimates of the same image agree when every channel's
+// means differ by less than 4 combined standard errors: for one channel a
+// false alarm has probability ~6e-5 (normal approximation, fine at > 10^4
+// samples per image), ~2e-4 for the three.
+inline void expect_agree(const ChannelStats& a, const ChannelStats& b, const std::string& what) {
+  for (int c = 0; c < 3; ++c) {
+    const double tol = 4.0 * std::sqrt(a.se[c] * a.se[c] + b.se[c] * b.se[c]);
+    EXPECT_NEAR(a.mean[c], b.mean[c], tol)
+        << what << ", channel " << c << ", standard errors " << a.se[c] << " and " << b.se[c];
+  }
+}
+
+// The comparison means something only if it can see a bias of a few percent.
+inline void expect_precise(const ChannelStats& s, double rel, const std::string& what) {
+  for (int c = 0; c < 3; ++c) {
+    ASSERT_GT(s.mean[c], 0.0) << what;
+    EXPECT_LT(s.se[c], rel * s.mean[c]) << what << ": too noisy to detect a bias, channel " << c;
+  }
+}
+
+inline bool all_finite(const Film& film) {
+  for (float v : film_mean(film).rgb)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+inline SceneDesc shipped(const char* name, int w, int h, int spp, int max_depth) {
+  SceneDesc d = load_pbrt_file(testing::source_dir() + "/scenes/" + name + ".pbrt");
+  d.film.xres = w;
+  d.film.yres = h;
+  d.spp = spp;
+  d.max_depth = max_depth;
+  return d;
+}
+
+// Seeds for renders that are compared statistically: guided and unguided
+// renders with the same seed share their first random numbers (camera ray,
+// first light sample) and would be correlated.
+inline RenderOptions seeded(uint64_t seed) {
+  RenderOptions opt;
+  opt.seed = seed;
+  return opt;
+}
+
+}  // namespace tessera::testing
