@@ -40,7 +40,10 @@ std::unique_ptr<GuideField> make_guide(const GuideArgs& a, const SceneData& scen
   } else {
     *why = "--guide " + mode;
   }
-  if (mode == "none" && a.in.empty()) return nullptr;
+  if (mode == "none") {
+    if (!a.in.empty()) throw std::runtime_error("--guide none and --guide-in " + a.in + " contradict each other");
+    return nullptr;
+  }
   if (!a.in.empty()) {
     std::ifstream f(a.in, std::ios::binary);
     if (!f) throw std::runtime_error("--guide-in: cannot open " + a.in);

@@ -181,6 +181,10 @@ void GuideField::build_distributions() {
   learn_normal_.assign(cells, 0);
   std::vector<double> w(std::max(bins_, lights_));
   const double floor = std::clamp<double>(config_.floor, 0.0, 1.0);
+  // Probability of entry j of m: its weight's share, mixed with the uniform floor.
+  auto mixed = [&](uint32_t j, uint32_t m, double total) {
+    return total > 0.0 ? (1.0 - floor) * w[j] / total + floor / m : 1.0 / m;
+  };
   // Vose's alias method over w[0..bins) (deterministic: fixed scan order).
   std::vector<double> scaled(bins_);
   std::vector<uint32_t> small, large;
@@ -189,7 +193,7 @@ void GuideField::build_distributions() {
     small.clear();
     large.clear();
     for (uint32_t j = 0; j < m; ++j) {
-      const double p = total > 0.0 ? (1.0 - floor) * w[j] / total + floor / m : 1.0 / m;
+      const double p = mixed(j, m, total);
       table[j].pmf = static_cast<Float>(p);
       scaled[j] = p * m;
       (scaled[j] < 1.0 ? small : large).push_back(j);
@@ -214,7 +218,7 @@ void GuideField::build_distributions() {
     double acc = 0.0;
     cdf[0] = 0.f;
     for (uint32_t j = 0; j < m; ++j) {
-      acc += total > 0.0 ? (1.0 - floor) * w[j] / total + floor / m : 1.0 / m;
+      acc += mixed(j, m, total);
       cdf[j + 1] = static_cast<Float>(acc);
     }
     cdf[m] = 1.f;
