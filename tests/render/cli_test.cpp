@@ -172,6 +172,30 @@ TEST_F(CliTest, BadOptionValues) {
   EXPECT_NE(run("render --spp -3").exit_code, 0);
 }
 
+// Saving and loading a guide cache from the command line, and the one-line
+// errors for a cache that cannot be used.
+TEST_F(CliTest, GuideCacheOptions) {
+  const std::string cache = (dir_ / "cornell.guide").string(), out = (dir_ / "o.exr").string();
+  RunResult saved = run("render -q --res 16x16 --spp 4 --guide qtable --guide-out " + cache + " -o " + out);
+  ASSERT_EQ(saved.exit_code, 0) << saved.output;
+  ASSERT_TRUE(fs::exists(cache));
+  RunResult loaded = run("render -q --res 16x16 --spp 2 --guide-in " + cache + " -o " + out);
+  EXPECT_EQ(loaded.exit_code, 0) << loaded.output;
+  EXPECT_NE(loaded.output.find("loaded from"), std::string::npos) << loaded.output;
+
+  RunResult contradict = run("render -q --spp 1 --guide none --guide-in " + cache + " -o " + out);
+  EXPECT_NE(contradict.exit_code, 0);
+  EXPECT_NE(contradict.output.find("contradict"), std::string::npos) << contradict.output;
+  const std::string other_scene = write("other.pbrt", std::string(kHeader) + "Shape \"sphere\"\n");
+  RunResult other = run("render " + other_scene + " -q --spp 1 --guide-in " + cache + " -o " + out);
+  EXPECT_NE(other.exit_code, 0);
+  EXPECT_NE(other.output.find("another scene"), std::string::npos) << other.output;
+  RunResult junk = run("render -q --spp 1 --guide-in " + write("junk.guide", "not a cache") + " -o " + out);
+  EXPECT_NE(junk.exit_code, 0);
+  EXPECT_NE(junk.output.find("not a Tessera guide cache"), std::string::npos) << junk.output;
+  EXPECT_NE(run("render --guide bogus").exit_code, 0);
+}
+
 TEST_F(CliTest, InfoPrintsEffects) {
   RunResult r = run("info");
   EXPECT_EQ(r.exit_code, 0);
