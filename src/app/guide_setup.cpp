@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "kernels/effects.h"
+#include "master/renderer.h"
 
 namespace tessera {
 
@@ -21,8 +22,19 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
       ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
   cmd->add_option("--guide-grid", a.grid, "Direction bins per side of the equal-area square (bins = grid^2)")
       ->check(CLI::Range(2, 64));
+  cmd->add_option("--guide-learn-spp", a.learn_spp,
+                  "Every sample trains the guide up to this many samples per pixel")
+      ->check(CLI::Range(int64_t(0), int64_t(1) << 30));
+  cmd->add_option("--guide-learn-every", a.learn_every,
+                  "After --guide-learn-spp, every N-th sample per pixel trains the guide (0 = none do)")
+      ->check(CLI::Range(int64_t(0), int64_t(1) << 30));
   cmd->add_option("--guide-in", a.in, "Start from a guide cache saved by --guide-out (same scene only)");
   cmd->add_option("--guide-out", a.out, "Save the learned guide cache after rendering");
+}
+
+void apply_guide_schedule(const GuideArgs& a, RenderOptions* opt) {
+  opt->guide_learn_all_spp = static_cast<uint32_t>(a.learn_spp);
+  opt->guide_learn_every = static_cast<uint32_t>(a.learn_every);
 }
 
 bool guiding_helps(uint32_t effects) {

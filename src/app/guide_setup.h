@@ -8,6 +8,7 @@
 #include <string>
 
 #include "guidecache/guide_field.h"
+#include "master/renderer.h"
 #include "worker/scene_data.h"
 
 namespace tessera {
@@ -17,11 +18,18 @@ struct GuideArgs {
   double budget_mb = 16.0;
   std::optional<double> mix;  // probability of sampling a direction from the guide (default 0.5)
   int64_t split = 0;
-  int64_t grid = 12;          // direction bins per side of the equal-area square          // updates before a cell splits (0 = the library's default)
+  int64_t grid = 12;          // direction bins per side of the equal-area square
+  // Learning schedule: every sample trains the guide up to learn_spp samples
+  // per pixel, then every learn_every-th sample does.
+  int64_t learn_spp = kGuideLearnAllSpp;
+  int64_t learn_every = kGuideLearnEvery;
   std::string in, out;
 };
 
 void add_guide_options(CLI::App* cmd, GuideArgs& args);
+
+// Copies the learning schedule (--guide-learn-spp / --guide-learn-every) into a render's options.
+void apply_guide_schedule(const GuideArgs& args, RenderOptions* options);
 
 // The effects set decides "auto": guiding needs a surface that scatters
 // non-specularly (diffuse or glossy) lit by some light.

@@ -39,6 +39,10 @@ struct PathSettings {
   int32_t max_depth = 5;
   bool nee = true;  // false: emitters are found by BSDF sampling only (for tests and comparisons)
   GuideView guide;  // read and updated by the kSpecGuiding specialisation only
+  // Whether this path's targets train the guide (kSpecGuiding only). A path
+  // that does not learn still samples from the guide; it skips the learning
+  // work, which costs as much as guided sampling itself.
+  bool learn = true;
 };
 
 namespace detail {
@@ -82,9 +86,13 @@ TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, const Vec3& wo, Fl
 //
 // With kSpecGuiding, directions at vertices without a delta lobe are drawn
 // from a mixture of the BSDF and the learned guide (probability
-// guide.guide_prob), weighted by the mixture pdf, which also stands in for the
-// BSDF pdf in every MIS weight: the estimator stays unbiased whatever the
-// guide has learned. Each traced segment x -> y sends Dahm & Keller's target
+// guide.guide_prob), weighted by the mixture pdf: the estimator stays unbiased
+// whatever the guide has learned. MIS between light sampling and scattering
+// weighs both strategies with the BSDF's own pdf, guided or not: the two
+// weights of every path still sum to one (so the sum stays unbiased), and NEE
+// needs no guide lookup. The guide learns the light NEE does not deliver, so
+// its density towards emitters is small and the mixture pdf would change the
+// weights little. Each traced segment x -> y sends Dahm & Keller's target
 // Le(y) + (integral of Q f cos at y) to x's cell, and each shadow ray sends
 // its unoccluded contribution to the light-selection entry of x's cell.
 //
@@ -98,6 +106,7 @@ template <uint32_t Spec, class Tracer>
 TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray ray, Rng& rng,
                                    const PathSettings& settings, PathCounters& c) {
   constexpr bool kGuide = (Spec & kSpecGuiding) != 0;
+  const bool learn = kGuide && settings.learn;
   const GuideView& g = settings.guide;
   const GuideView* guide = kGuide ? &g : nullptr;
   Rgb L(0.f), beta(1.f);
@@ -109,7 +118,9 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   Rgb rr_beta(1.f);
   int32_t depth = 0;
   bool specular_bounce = false;
-  Float prev_scatter_pdf = 0.f;  // pdf of the last sampled direction (the mixture's when guided)
+  // The BSDF's own pdf of the last direction taken: what MIS weighs emitter
+  // hits by (see the note on guided MIS above).
+  Float prev_bsdf_pdf = 0.f;
   Vec3 prev_p(0.f);  // last scattering point: MIS on emitter hits measures from it, as NEE does
   int32_t prev_cell = -1;  // guide cell of the last scattering point (its light selection)
   Float eta_scale = 1.f;
@@ -137,7 +148,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             L += beta * Le;
           } else {
             Float light_pdf = light_select_pmf(s, guide, prev_cell, li) * environment_pdf(s, li, ray.d);
-            L += beta * Le * power_heuristic(prev_scatter_pdf, light_pdf);
+            L += beta * Le * power_heuristic(prev_bsdf_pdf, light_pdf);
           }
         }
       }
@@ -164,7 +175,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           } else {
             Float light_pdf = light_select_pmf(s, guide, prev_cell, static_cast<uint32_t>(info.light)) *
                               area_light_pdf(l.area, glm::length(h.p - prev_p), cos_l);
-            L += beta * l.L * power_heuristic(prev_scatter_pdf, light_pdf);
+            L += beta * l.L * power_heuristic(prev_bsdf_pdf, light_pdf);
           }
         }
       }
@@ -193,10 +204,12 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       // The side the path is on: the two faces of a wall never share a cell.
       Vec3 n_side = glm::dot(h.ng, wo) >= 0.f ? h.ng : -h.ng;
       cell = guide_find_cell(g, h.p, n_side);
-      guide_record_normal(g, cell, n_side);
-      // Emission the integrator weights by MIS is NEE's to deliver.
-      pend_le = (specular_bounce || !settings.nee) ? luminance(Le_hit) : 0.f;
-      pend_at_delta = delta_lobe;
+      if (learn) {
+        guide_record_normal(g, cell, n_side);
+        // Emission the integrator weights by MIS is NEE's to deliver.
+        pend_le = (specular_bounce || !settings.nee) ? luminance(Le_hit) : 0.f;
+        pend_at_delta = delta_lobe;
+      }
     }
 
     // A path ending here leaves its last target unfinished (no NEE at y): dropped.
@@ -227,21 +240,19 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           if (light_pdf > 0.f && !tracer.occluded(o, ls.wi, tmax)) {
             Float w = 1.f;
             if (!ls.delta) {
-              Float scatter_pdf = eval_pdf<Spec>(bsdf, wo_l, wi_l);
-              if (guided_vertex) scatter_pdf = guide_p * guide_pdf(g, cell, ls.wi) + (1.f - guide_p) * scatter_pdf;
-              w = power_heuristic(light_pdf, scatter_pdf);
+              w = power_heuristic(light_pdf, eval_pdf<Spec>(bsdf, wo_l, wi_l));
             }
             L += beta * f * ls.L * (w / light_pdf);
             learned = luminance(f * ls.L) / ls.pdf;
           }
         }
       }
-      if constexpr (kGuide) {
+      if (learn) {
         if (g.lights > 0 && pmf > 0.f) guide_record(g, cell, g.bins + li, learned);
         direct_estimate = pmf > 0.f ? learned / pmf : 0.f;
       }
     }
-    if constexpr (kGuide) {
+    if (learn) {
       if (pend_cell >= 0 && !pend_at_delta) {
         const bool lambertian = (Spec & kSpecNonDiffuse) == 0 || bsdf.type == BsdfType::Diffuse;
         Float integral = guide_bins_integral(g, cell, bsdf, lambertian, wo_l,
@@ -284,11 +295,11 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       if (!sample_f<Spec>(bsdf, wo_l, uc, u, &bs) || !(bs.pdf > 0.f)) break;
       wi = frame.to_world(bs.wi);
       scatter_pdf = bsdf_pdf = bs.pdf;
-      if constexpr (kGuide) wi_bin = guide_bin_of(g, wi);
+      if (learn) wi_bin = guide_bin_of(g, wi);
     }
     if (!(scatter_pdf > 0.f)) break;
     const Rgb weight = bs.f * (abs_cos_theta(bs.wi) / scatter_pdf);
-    if constexpr (kGuide) {
+    if (learn) {
       // A delta vertex's integral is the direction it actually took.
       if (pend_at_delta && pend_cell >= 0 &&
           guide_record(g, pend_cell, pend_bin, pend_le + guide_value(g, cell, wi_bin) * luminance(weight)))
@@ -299,7 +310,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     }
     beta *= weight;
     rr_beta *= bsdf_pdf > 0.f ? bs.f * (abs_cos_theta(bs.wi) / bsdf_pdf) : weight;
-    prev_scatter_pdf = scatter_pdf;
+    prev_bsdf_pdf = bsdf_pdf;
     prev_cell = cell;
     specular_bounce = (bs.lobe & kLobeSpecular) != 0;
     if (bs.lobe & kLobeTransmission) eta_scale *= sqr(bs.eta);

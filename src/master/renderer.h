@@ -14,6 +14,13 @@
 
 namespace tessera {
 
+// Default guide learning schedule (see TileSettings): every sample trains the
+// guide for the first 16 samples per pixel, then every 4th does. Learning
+// costs about as much per vertex as guided sampling; past the first passes
+// the field changes little, so most samples just use it.
+constexpr uint32_t kGuideLearnAllSpp = 16;
+constexpr uint32_t kGuideLearnEvery = 4;
+
 struct RenderOptions {
   uint32_t spp = 16;            // 0 = unlimited (then time_budget_s must be set)
   double time_budget_s = 0.0;   // 0 = none; whole passes are rendered until it is spent
@@ -23,6 +30,8 @@ struct RenderOptions {
   int32_t threads = 0;          // 0 = all cores
   int32_t tile_size = 16;
   uint32_t max_pass_spp = 8;
+  uint32_t guide_learn_all_spp = kGuideLearnAllSpp;  // see TileSettings
+  uint32_t guide_learn_every = kGuideLearnEvery;
   bool force_full_specialisation = false;  // benchmark switch: ignore the effects set
   bool progress = true;
 };

@@ -10,6 +10,7 @@ template <uint32_t Spec>
 TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, const TileSettings& settings,
                               const TileJob& job, Film& film) {
   TileCounters tc;
+  PathSettings path = settings.path;
   for (int32_t y = job.y0; y < job.y1; ++y) {
     for (int32_t x = job.x0; x < job.x1; ++x) {
       const uint64_t pixel_index = static_cast<uint64_t>(y) * static_cast<uint64_t>(film.width) + x;
@@ -19,7 +20,8 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
         Vec2 offset = sample_filter_offset(s.filter, rng.uniform2());
         Vec2 p_film(x + 0.5f + offset.x, y + 0.5f + offset.y);
         Ray ray = generate_camera_ray(s.camera, p_film);
-        Rgb L = trace_path<Spec>(s, tracer, ray, rng, settings.path, tc.path);
+        path.learn = si < settings.learn_all_spp || (settings.learn_every > 0 && si % settings.learn_every == 0);
+        Rgb L = trace_path<Spec>(s, tracer, ray, rng, path, tc.path);
         if (!is_finite(L)) {
           ++tc.rejected_nonfinite;
           L = Rgb(0.f);

@@ -18,6 +18,11 @@ struct TileJob {
 struct TileSettings {
   uint64_t seed = 0;
   PathSettings path;
+  // Guide learning schedule, by sample index (so it is the same on every
+  // thread and rank): sample si trains the guide when si < learn_all_spp or
+  // si % learn_every == 0 (learn_every 0: never after learn_all_spp).
+  uint32_t learn_all_spp = UINT32_MAX;
+  uint32_t learn_every = 1;
   uint32_t specialisation = kSpecAll;
 };
 
