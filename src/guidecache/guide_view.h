@@ -70,6 +70,7 @@ struct GuideView {
   const Float* irradiance = nullptr;   // cells: sum over bins of Q max(cos, 0) dOmega about the cell normal
   const Float* qmax = nullptr;         // cells: largest Q over the bins above the cell's surface
   const uint8_t* learn_normal = nullptr;  // cells: 1 while the cell's mean normal is still being estimated
+  const Float* cell_guide_prob = nullptr;  // cells: mixture weight of guided sampling there (0: BSDF only)
 
   // Accumulators for the running pass (relaxed atomics).
   uint64_t* acc = nullptr;         // cells * stride pairs (sum in fixed point = target * fixed_scale, count)
@@ -78,7 +79,6 @@ struct GuideView {
   Float fixed_scale = 1.f;
   Float max_target = 1e30f;        // larger targets are rejected (and counted), never clamped
 
-  Float guide_prob = 0.5f;         // mixture weight of guided direction sampling
   Float light_guide_prob = 0.5f;   // mixture weight of learned light selection
   GuideTarget target = GuideTarget::ExpectedSarsa;
 

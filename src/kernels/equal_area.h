@@ -32,14 +32,16 @@ TESSERA_HOST_DEVICE inline Vec2 equal_area_sphere_to_square(Vec3 d) {
   Float a = glm::max(x, y), b = glm::min(x, y);
   b = a == 0.f ? 0.f : b / a;
   // atan(b) * 2/pi for b in [0,1]: pbrt-v4's 6th-degree minimax polynomial
-  // (what pbrt itself evaluates, and no libm call on the guiding hot path).
-  Float phi = 0.406758566246788489601959989e-5f +
-              b * (0.636226545274016134946890922156f +
-                   b * (0.61572017898280213493197203466e-2f +
-                        b * (-0.247333733281268944196501420480f +
-                             b * (0.881770664775316294736387951347e-1f +
-                                  b * (0.419038818029165735901852432784e-1f +
-                                       b * -0.251390972343483509333252996350e-1f)))));
+  // (what pbrt itself evaluates, and no libm call on the guiding hot path),
+  // in Estrin's form: independent pairs instead of one chain of six
+  // multiply-adds, about half the latency on the guide's hot path.
+  const Float b2 = b * b;
+  const Float c01 = 0.406758566246788489601959989e-5f + b * 0.636226545274016134946890922156f;
+  const Float c23 = 0.61572017898280213493197203466e-2f + b * -0.247333733281268944196501420480f;
+  const Float c45 = 0.881770664775316294736387951347e-1f + b * 0.419038818029165735901852432784e-1f;
+  const Float c6 = -0.251390972343483509333252996350e-1f;
+  const Float b4 = b2 * b2;
+  Float phi = (c01 + b2 * c23) + b4 * (c45 + b2 * c6);
   if (x < y) phi = 1.f - phi;
   Float v = phi * r;
   Float u = r - v;

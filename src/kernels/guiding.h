@@ -43,12 +43,14 @@ TESSERA_HOST_DEVICE inline uint32_t select_light(const SceneView& s, const Guide
 // Dielectrics are not guided: the field weights bins by max(cos, 0) about the
 // surface it was learned on, so guided samples would almost never go through
 // (measured: ~3x the variance behind a rough glass slab).
-TESSERA_HOST_DEVICE inline Float guide_probability(const GuideView& g, const BsdfParams& b, bool lambertian_only) {
-  if (lambertian_only || b.type == BsdfType::Diffuse) return g.guide_prob;
+TESSERA_HOST_DEVICE inline Float guide_probability(const GuideView& g, int32_t cell, const BsdfParams& b,
+                                                   bool lambertian_only) {
+  const Float p = g.cell_guide_prob[cell];
+  if (lambertian_only || b.type == BsdfType::Diffuse) return p;
   if (b.type == BsdfType::Dielectric) return 0.f;
   Float alpha = glm::sqrt(b.alpha_x * b.alpha_y);
   if (b.type == BsdfType::CoatedDiffuse) alpha = glm::max(alpha, 0.3f);  // a rough coat over a diffuse base
-  return g.guide_prob * glm::clamp((alpha - 0.05f) / 0.25f, 0.f, 1.f);
+  return p * glm::clamp((alpha - 0.05f) / 0.25f, 0.f, 1.f);
 }
 
 // The part of a learning target that looks beyond vertex y: an estimate of

@@ -86,7 +86,7 @@ TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, const Vec3& wo, Fl
 //
 // With kSpecGuiding, directions at vertices without a delta lobe are drawn
 // from a mixture of the BSDF and the learned guide (probability
-// guide.guide_prob), weighted by the mixture pdf: the estimator stays unbiased
+// the cell's guide.cell_guide_prob), weighted by the mixture pdf: the estimator stays unbiased
 // whatever the guide has learned. MIS between light sampling and scattering
 // weighs both strategies with the BSDF's own pdf, guided or not: the two
 // weights of every path still sum to one (so the sum stays unbiased), and NEE
@@ -216,7 +216,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     if (depth++ == settings.max_depth) break;
     if (wo_l.z == 0.f) break;
     // Probability of drawing this vertex's direction from the guide (0: BSDF only).
-    const Float guide_p = kGuide && !delta_lobe ? guide_probability(g, bsdf, (Spec & kSpecNonDiffuse) == 0) : 0.f;
+    const Float guide_p = kGuide && !delta_lobe ? guide_probability(g, cell, bsdf, (Spec & kSpecNonDiffuse) == 0) : 0.f;
     const bool guided_vertex = guide_p > 0.f;
 
     // Next-event estimation at non-specular vertices (pbrt-v4's SampleLd).

@@ -130,6 +130,28 @@ TEST(GuideField, AllZeroFieldSamplesUniformly) {
   for (uint32_t b = 0; b < g.bins; ++b) EXPECT_NEAR(guide_bin_pdf(g, 0, b), 1.f / (4.f * kPi), 1e-5f);
 }
 
+// A cell samples from the guide only once it has learned some light above
+// its surface; light learned only behind it does not count.
+TEST(GuideField, CellsGuideOnlyAfterLearningLightAboveTheSurface) {
+  GuideConfig cfg;
+  cfg.guide_prob = 0.7f;
+  GuideField f = make_field(cfg);
+  const int32_t up = f.find_cell(Vec3(0.5f), Vec3(0, 0, 1)), down = f.find_cell(Vec3(0.5f), Vec3(0, 0, -1));
+  EXPECT_EQ(f.view().cell_guide_prob[up], 0.f);
+  GuideView g = f.view();
+  const uint32_t below = guide_bin_of(g, Vec3(0, 0, -1)), above = guide_bin_of(g, Vec3(0, 0, 1));
+  guide_record(g, up, below, 5.f);
+  f.fold();
+  EXPECT_EQ(f.view().cell_guide_prob[up], 0.f);
+  g = f.view();
+  guide_record(g, up, above, 5.f);
+  f.fold();
+  EXPECT_EQ(f.view().cell_guide_prob[up], 0.7f);
+  EXPECT_EQ(f.view().cell_guide_prob[down], 0.f);
+  f.set_guide_prob(0.25f);
+  EXPECT_EQ(f.view().cell_guide_prob[up], 0.25f);
+}
+
 TEST(GuideField, HugeBinKeepsEveryOtherBinPossible) {
   GuideField f = make_field();
   GuideView g = f.view();
