@@ -51,11 +51,13 @@ def main():
     ap.add_argument("--ref-spp", type=int, default=8192)
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench-guiding"))
+    ap.add_argument("--results", default="results.json", help="file name of the results, in --out")
+    ap.add_argument("--guide-args", default="", help="extra options for the guided methods, e.g. '--guide-budget 4'")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     threads = ["--threads", str(a.threads)] if a.threads else []
 
-    results = {"time_budget_s": a.time, "repeats": a.repeats, "threads": a.threads or os.cpu_count(),
+    results = {"guide_args": a.guide_args, "time_budget_s": a.time, "repeats": a.repeats, "threads": a.threads or os.cpu_count(),
                "ref_spp": a.ref_spp, "scenes": {}}
     for scene in a.scenes:
         path = os.path.join(ROOT, "scenes", scene + ".pbrt")
@@ -75,8 +77,9 @@ def main():
             for rep in range(a.repeats):
                 img = os.path.join(a.out, f"{scene}-{method}.exr")
                 st = os.path.join(a.out, f"{scene}-{method}.json")
+                extra = a.guide_args.split() if method != "none" else []
                 run([a.tessera, "render", path, "-q", "--no-preview", "--guide", method, "--time", str(a.time),
-                     "--seed", str(rep + 1), "--stats", st, "-o", img, *threads])
+                     "--seed", str(rep + 1), "--stats", st, "-o", img, *threads, *extra])
                 s = json.load(open(st))
                 c = compare(a.tessera, img, ref)
                 pixels = s["width"] * s["height"]
@@ -108,9 +111,9 @@ def main():
         e["ratio_time_per_sample"] = tps
         print(f"{scene:12s}  {ratio:8.3f}            {('<= ' + str(target)) if target else '   -   ':8s} {verdict:6s}"
               f"  {tps:6.2f} (target <= 1.25)      {ql}")
-    with open(os.path.join(a.out, "results.json"), "w") as f:
+    with open(os.path.join(a.out, a.results), "w") as f:
         json.dump(results, f, indent=2)
-    print(f"\nwrote {os.path.join(a.out, 'results.json')}")
+    print(f"\nwrote {os.path.join(a.out, a.results)}")
 
 
 if __name__ == "__main__":

@@ -15,7 +15,7 @@ namespace tessera {
 
 struct GuideArgs {
   std::string mode = "auto";  // auto | none | qtable | qlearning
-  double budget_mb = 16.0;
+  double budget_mb = 4.0;
   std::optional<double> mix;  // probability of sampling a direction from the guide (default 0.5)
   int64_t split = 0;
   int64_t grid = 12;          // direction bins per side of the equal-area square

@@ -24,14 +24,18 @@ namespace tessera {
 
 struct GuideConfig {
   uint32_t grid = 12;                   // 12 x 12 = 144 direction bins, as in Dahm & Keller
-  // Cells stop splitting when the next split would exceed it. 16 MB keeps the
-  // sampled part of the field (~1/4 of it) in a typical L3 cache.
-  uint64_t budget_bytes = 16ull << 20;
+  // Cells stop splitting when the next split would exceed it. Every guided
+  // vertex reads the field at random: measured at equal time on the shipped
+  // scenes, 4 MB beat 16 MB on four of five (the cache misses cost more than
+  // the finer cells gain) and lost 3 % on the fifth.
+  uint64_t budget_bytes = 4ull << 20;
   uint64_t split_updates = 0;           // a leaf splits after this many updates; 0 = 24 per bin
   uint32_t max_depth = 20;              // octree levels below a root
   Float guide_prob = 0.5f;
   Float light_guide_prob = 0.5f;
-  Float floor = 0.05f;                  // share of each distribution spread uniformly: no impossible bin
+  // Share of each distribution spread uniformly: no impossible bin. 2 % gave
+  // 2-4 % lower error than 5 % on every shipped scene at equal samples, 10 % was worse.
+  Float floor = 0.02f;
   GuideTarget target = GuideTarget::ExpectedSarsa;
   uint32_t max_learned_lights = 256;    // more lights than this: light selection stays power-based
 

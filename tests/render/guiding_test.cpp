@@ -181,6 +181,7 @@ TEST(GuidedFurnace, SphereWithNonDefaultFieldSettings) {
       GuideField guide = s.make_guide(c.cfg);
       RenderOptions opt;
       opt.nee = nee;
+      opt.guide_learn_all_spp = UINT32_MAX;  // these field settings learn from every sample
       RenderResult r = s.run(&guide, opt);
       expect_furnace(r, expected, 0.01, 0.003, what);
       if (c.cfg.split_updates == 64) {
