@@ -45,6 +45,8 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
   ts_settings.specialisation = stats.specialisation;
   ts_settings.learn_all_spp = opt.guide_learn_all_spp;
   ts_settings.learn_every = opt.guide_learn_every;
+  stats.guide_learn_all_spp = opt.guide_learn_all_spp;
+  stats.guide_learn_every = opt.guide_learn_every;
   const EmbreeTracer tracer = embree.tracer();
 
   const uint64_t pixels = static_cast<uint64_t>(w) * h;

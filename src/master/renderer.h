@@ -61,6 +61,8 @@ struct RenderStats {
   std::string guide_mode = "none";  // none | qtable | qlearning
   GuideFieldStats guide;            // as the field stood at the end (when guided)
   double guide_fold_seconds = 0.0;
+  uint32_t guide_learn_all_spp = 0;  // the learning schedule the render ran with
+  uint32_t guide_learn_every = 0;
 };
 
 struct RenderResult {

@@ -196,6 +196,31 @@ TEST_F(CliTest, GuideCacheOptions) {
   EXPECT_NE(run("render --guide bogus").exit_code, 0);
 }
 
+// The learning schedule reaches the render and its stats; fewer learning
+// samples mean fewer guide updates; bad values are refused.
+TEST_F(CliTest, GuideLearningScheduleOptions) {
+  const std::string out = (dir_ / "s.exr").string();
+  auto updates = [&](const std::string& args, const std::string& name) -> std::string {
+    const std::string stats = (dir_ / name).string();
+    RunResult r = run("render -q --res 16x16 --spp 12 --seed 2 --guide qtable " + args + " -o " + out + " --stats " + stats);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream js(stats);
+    return std::string((std::istreambuf_iterator<char>(js)), {});
+  };
+  const std::string some = updates("--guide-learn-spp 2 --guide-learn-every 3", "some.json");
+  EXPECT_NE(some.find("\"guide_learn_spp\": 2,"), std::string::npos) << some;
+  EXPECT_NE(some.find("\"guide_learn_every\": 3,"), std::string::npos) << some;
+  const std::string all = updates("--guide-learn-spp 100", "all.json");
+  auto count = [](const std::string& json) {
+    const size_t k = json.find("\"guide_updates\": ");
+    return k == std::string::npos ? 0ull : std::stoull(json.substr(k + 17));
+  };
+  EXPECT_GT(count(some), 0ull);
+  EXPECT_LT(count(some), count(all));
+  EXPECT_NE(run("render --guide-learn-every -1").exit_code, 0);
+  EXPECT_NE(run("render --guide-learn-spp x").exit_code, 0);
+}
+
 TEST_F(CliTest, InfoPrintsEffects) {
   RunResult r = run("info");
   EXPECT_EQ(r.exit_code, 0);
