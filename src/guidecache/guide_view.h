@@ -104,7 +104,7 @@ struct GuideView {
 };
 
 TESSERA_HOST_DEVICE inline uint32_t guide_normal_class(const Vec3& n) {
-  Vec3 a = glm::abs(n);
+  Vec3 a = abs3(n);
   if (a.x >= a.y && a.x >= a.z) return n.x >= 0.f ? 0u : 1u;
   if (a.y >= a.z) return n.y >= 0.f ? 2u : 3u;
   return n.z >= 0.f ? 4u : 5u;

@@ -11,7 +11,7 @@ namespace tessera {
 
 namespace bsdf_detail {
 
-TESSERA_HOST_DEVICE inline bool finite_f(Float x) { return glm::abs(x) <= 3.4e38f; }
+TESSERA_HOST_DEVICE inline bool finite_f(Float x) { return fabsf(x) <= 3.4e38f; }
 TESSERA_HOST_DEVICE inline Rgb finite_or_zero(const Rgb& c) { return is_finite(c) ? c : Rgb(0.f); }
 TESSERA_HOST_DEVICE inline Float finite_or_zero(Float x) { return finite_f(x) ? x : 0.f; }
 TESSERA_HOST_DEVICE inline Vec3 face_forward_z(const Vec3& v) { return v.z < 0.f ? -v : v; }
@@ -49,7 +49,7 @@ TESSERA_HOST_DEVICE inline Rgb conductor_f(const BsdfParams& b, const Vec3& wo, 
   Vec3 wm = wi + wo;
   if (len2(wm) == 0.f) return Rgb(0.f);
   wm = glm::normalize(wm);
-  Rgb F = fr_complex(glm::abs(glm::dot(wo, wm)), b.eta, b.k);
+  Rgb F = fr_complex(fabsf(glm::dot(wo, wm)), b.eta, b.k);
   return finite_or_zero(d.D(wm) * F * d.G(wo, wi) / (4.f * cos_i * cos_o));
 }
 TESSERA_HOST_DEVICE inline Float conductor_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
@@ -59,7 +59,7 @@ TESSERA_HOST_DEVICE inline Float conductor_pdf(const BsdfParams& b, const Vec3& 
   Vec3 wm = wo + wi;
   if (len2(wm) == 0.f) return 0.f;
   wm = face_forward_z(glm::normalize(wm));
-  Float dot_om = glm::abs(glm::dot(wo, wm));
+  Float dot_om = fabsf(glm::dot(wo, wm));
   if (dot_om == 0.f) return 0.f;
   return finite_or_zero(d.pdf(wo, wm) / (4.f * dot_om));
 }
@@ -78,7 +78,7 @@ TESSERA_HOST_DEVICE inline bool conductor_sample(const BsdfParams& b, const Vec3
   Vec3 wm = d.sample_wm(wo, u);
   Vec3 wi = reflect(wo, wm);
   if (!same_hemisphere(wo, wi)) return false;
-  Float dot_om = glm::abs(glm::dot(wo, wm));
+  Float dot_om = fabsf(glm::dot(wo, wm));
   Float cos_o = abs_cos_theta(wo), cos_i = abs_cos_theta(wi);
   if (dot_om == 0.f || cos_i == 0.f || cos_o == 0.f) return false;
   s->wi = wi;
@@ -125,11 +125,11 @@ TESSERA_HOST_DEVICE inline Rgb dielectric_f(const BsdfParams& b, const Vec3& wo,
   if (!dielectric_half_vector(eta, wo, wi, &wm, &etap, &refl)) return Rgb(0.f);
   Float F = fr_dielectric(glm::dot(wo, wm), eta);
   Float cos_o = cos_theta(wo), cos_i = cos_theta(wi);
-  if (refl) return Rgb(finite_or_zero(d.D(wm) * d.G(wo, wi) * F / glm::abs(4.f * cos_i * cos_o)));
+  if (refl) return Rgb(finite_or_zero(d.D(wm) * d.G(wo, wi) * F / fabsf(4.f * cos_i * cos_o)));
   Float dim = glm::dot(wi, wm), dom = glm::dot(wo, wm);
   Float denom = sqr(dim + dom / etap) * cos_i * cos_o;
   if (denom == 0.f) return Rgb(0.f);
-  Float ft = d.D(wm) * (1.f - F) * d.G(wo, wi) * glm::abs(dim * dom / denom);
+  Float ft = d.D(wm) * (1.f - F) * d.G(wo, wi) * fabsf(dim * dom / denom);
   ft /= sqr(etap);  // radiance transport
   return Rgb(finite_or_zero(ft));
 }
@@ -146,13 +146,13 @@ TESSERA_HOST_DEVICE inline Float dielectric_pdf(const BsdfParams& b, const Vec3&
   if (!(R + T > 0.f)) return 0.f;
   Float pdf;
   if (refl) {
-    Float dom = glm::abs(glm::dot(wo, wm));
+    Float dom = fabsf(glm::dot(wo, wm));
     if (dom == 0.f) return 0.f;
     pdf = d.pdf(wo, wm) / (4.f * dom) * R / (R + T);
   } else {
     Float denom = sqr(glm::dot(wi, wm) + glm::dot(wo, wm) / etap);
     if (denom == 0.f) return 0.f;
-    Float dwm_dwi = glm::abs(glm::dot(wi, wm)) / denom;
+    Float dwm_dwi = fabsf(glm::dot(wi, wm)) / denom;
     pdf = d.pdf(wo, wm) * dwm_dwi * T / (R + T);
   }
   return finite_or_zero(pdf);
@@ -192,7 +192,7 @@ TESSERA_HOST_DEVICE inline bool dielectric_sample(const BsdfParams& b, const Vec
   if (uc < R / (R + T)) {
     Vec3 wi = reflect(wo, wm);
     if (!same_hemisphere(wo, wi)) return false;
-    Float adom = glm::abs(dom);
+    Float adom = fabsf(dom);
     Float cc = cos_theta(wi) * cos_theta(wo);
     if (adom == 0.f || cc == 0.f) return false;
     s->wi = wi;
@@ -210,10 +210,10 @@ TESSERA_HOST_DEVICE inline bool dielectric_sample(const BsdfParams& b, const Vec
   Float denom = sqr(dim + dom / etap);
   Float cc = cos_theta(wi) * cos_theta(wo);
   if (denom == 0.f || cc == 0.f) return false;
-  Float dwm_dwi = glm::abs(dim) / denom;
+  Float dwm_dwi = fabsf(dim) / denom;
   s->wi = wi;
   s->pdf = d.pdf(wo, wm) * dwm_dwi * T / (R + T);
-  s->f = Rgb(T * d.D(wm) * d.G(wo, wi) * glm::abs(dim * dom / (cc * denom)) / sqr(etap));
+  s->f = Rgb(T * d.D(wm) * d.G(wo, wi) * fabsf(dim * dom / (cc * denom)) / sqr(etap));
   s->lobe = kLobeTransmission | kLobeGlossy;
   s->eta = etap;
   return true;

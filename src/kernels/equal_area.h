@@ -11,23 +11,23 @@ namespace tessera {
 
 TESSERA_HOST_DEVICE inline Vec3 equal_area_square_to_sphere(Vec2 p) {
   Float u = 2.f * p.x - 1.f, v = 2.f * p.y - 1.f;
-  Float up = glm::abs(u), vp = glm::abs(v);
+  Float up = fabsf(u), vp = fabsf(v);
   Float signed_distance = 1.f - (up + vp);
-  Float d = glm::abs(signed_distance);
+  Float d = fabsf(signed_distance);
   Float r = 1.f - d;
   Float phi = (r == 0.f ? 1.f : (vp - up) / r + 1.f) * kPi / 4.f;
   Float z = glm::sign(signed_distance) * (1.f - r * r);
   if (signed_distance == 0.f) z = 0.f;
   Float sin_p, cos_p;
   sincosf(phi, &sin_p, &cos_p);  // one call for both (glibc and CUDA)
-  Float cos_phi = glm::abs(cos_p) * (u < 0.f ? -1.f : 1.f);
-  Float sin_phi = glm::abs(sin_p) * (v < 0.f ? -1.f : 1.f);
+  Float cos_phi = fabsf(cos_p) * (u < 0.f ? -1.f : 1.f);
+  Float sin_phi = fabsf(sin_p) * (v < 0.f ? -1.f : 1.f);
   Float s = r * safe_sqrt(2.f - r * r);
   return Vec3(cos_phi * s, sin_phi * s, z);
 }
 
 TESSERA_HOST_DEVICE inline Vec2 equal_area_sphere_to_square(Vec3 d) {
-  Float x = glm::abs(d.x), y = glm::abs(d.y), z = glm::abs(d.z);
+  Float x = fabsf(d.x), y = fabsf(d.y), z = fabsf(d.z);
   Float r = safe_sqrt(1.f - z);
   Float a = glm::max(x, y), b = glm::min(x, y);
   b = a == 0.f ? 0.f : b / a;

@@ -33,10 +33,10 @@ TESSERA_HOST_DEVICE inline Complexf complex_div(Complexf a, Complexf b, bool* ok
 TESSERA_HOST_DEVICE inline Complexf complex_sqrt(Complexf z) {
   Float n = glm::sqrt(complex_norm(z));
   if (n == 0.f) return Complexf(0.f, 0.f);
-  Float t1 = glm::sqrt(0.5f * (n + glm::abs(z.re)));
+  Float t1 = glm::sqrt(0.5f * (n + fabsf(z.re)));
   Float t2 = 0.5f * z.im / t1;
   if (z.re >= 0.f) return Complexf(t1, t2);
-  return Complexf(glm::abs(t2), z.im >= 0.f ? t1 : -t1);
+  return Complexf(fabsf(t2), z.im >= 0.f ? t1 : -t1);
 }
 
 // Unpolarised Fresnel reflectance of a dielectric interface; eta = n_t / n_i

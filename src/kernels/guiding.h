@@ -72,7 +72,7 @@ TESSERA_HOST_DEVICE inline Float guide_bins_integral(const GuideView& g, int32_t
   uint32_t j = g.sample_bin(cell, rng.uniform(), &pmf);
   if (!(pmf > 0.f)) return 0.f;
   Vec3 wi = to_local(g.bin_dirs[j]);
-  Float fc = luminance(bsdf_eval(b, wo_local, wi)) * glm::abs(wi.z) * g.bin_solid_angle() / pmf;
+  Float fc = luminance(bsdf_eval(b, wo_local, wi)) * fabsf(wi.z) * g.bin_solid_angle() / pmf;
   Float q = g.target == GuideTarget::QLearning ? g.qmax[cell] : guide_value(g, cell, j);
   return q * fc;
 }

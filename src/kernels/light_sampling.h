@@ -27,7 +27,7 @@ TESSERA_HOST_DEVICE inline Rgb environment_radiance(const SceneView& s, const Li
 // Solid-angle pdf of sampling a point on an area light (triangle of area
 // `area`) at distance dist, seen under cos_l = dot(n_light, -w).
 TESSERA_HOST_DEVICE inline Float area_light_pdf(Float area, Float dist, Float cos_l) {
-  Float c = glm::abs(cos_l);
+  Float c = fabsf(cos_l);
   if (!(area > 0.f) || !(c > 0.f)) return 0.f;
   return dist * dist / (c * area);
 }

@@ -50,7 +50,7 @@ struct TrowbridgeReitz {
   TESSERA_HOST_DEVICE Float D_visible(const Vec3& w, const Vec3& wm) const {
     Float c = abs_cos_theta(w);
     if (c == 0.f) return 0.f;
-    return G1(w) / c * D(wm) * glm::abs(glm::dot(w, wm));
+    return G1(w) / c * D(wm) * fabsf(glm::dot(w, wm));
   }
   TESSERA_HOST_DEVICE Float pdf(const Vec3& w, const Vec3& wm) const { return D_visible(w, wm); }
 

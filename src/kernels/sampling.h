@@ -9,7 +9,7 @@ TESSERA_HOST_DEVICE inline Vec2 sample_uniform_disk_concentric(Vec2 u) {
   Vec2 o = 2.f * u - Vec2(1.f);
   if (o.x == 0.f && o.y == 0.f) return Vec2(0.f);
   Float r, theta;
-  if (glm::abs(o.x) > glm::abs(o.y)) {
+  if (fabsf(o.x) > fabsf(o.y)) {
     r = o.x;
     theta = (kPi / 4.f) * (o.y / o.x);
   } else {

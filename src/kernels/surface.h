@@ -28,7 +28,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& 
   h.p = b0 * p0 + b1 * p1 + b2 * p2;
   // pbrt-v4: gamma(7) * sum |b_i p_i| bounds the rounding error of h.p.
   constexpr Float kGamma7 = 7.f * 0x1p-24f / (1.f - 7.f * 0x1p-24f);
-  h.p_error = kGamma7 * (glm::abs(b0 * p0) + glm::abs(b1 * p1) + glm::abs(b2 * p2));
+  h.p_error = kGamma7 * (abs3(b0 * p0) + abs3(b1 * p1) + abs3(b2 * p2));
   h.ng = s.face_normals[tri];
   h.ns = h.ng;
   if (info.flags & kTriHasNormals) {
@@ -54,7 +54,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& 
 // a scene modelled in millimetres or in kilometres gets the same relative offset.
 TESSERA_HOST_DEVICE TESSERA_INLINE Vec3 offset_ray_origin(const Vec3& p, const Vec3& p_error, const Vec3& ng, const Vec3& w) {
   constexpr Float kSafety = 16.f;
-  Float d = kSafety * glm::dot(glm::abs(ng), p_error) + 1e-30f;
+  Float d = kSafety * glm::dot(abs3(ng), p_error) + 1e-30f;
   Vec3 off = d * ng;
   return glm::dot(w, ng) >= 0.f ? p + off : p - off;
 }
@@ -76,7 +76,7 @@ TESSERA_HOST_DEVICE inline Vec3 surface_dpdu(const SceneView& s, uint32_t tri) {
   Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
   Vec3 dp02 = s.positions[idx[0]] - s.positions[idx[2]], dp12 = s.positions[idx[1]] - s.positions[idx[2]];
   Float det = duv02.x * duv12.y - duv02.y * duv12.x;
-  if (glm::abs(det) < 1e-9f) return Frame::from_z(s.face_normals[tri]).s;
+  if (fabsf(det) < 1e-9f) return Frame::from_z(s.face_normals[tri]).s;
   Vec3 dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
   if (!(glm::dot(dpdu, dpdu) > 0.f) || !is_finite(dpdu)) return Frame::from_z(s.face_normals[tri]).s;
   return dpdu;

@@ -34,7 +34,9 @@ using namespace tessera::testing;
 // What every guided render must show: guiding ran (unless nothing was there
 // to learn) and learned, and no estimate or target was NaN, infinite or negative.
 void expect_clean_guided_run(const RenderResult& r, const std::string& what, bool expect_guided_samples = true) {
-  if (expect_guided_samples) EXPECT_GT(r.stats.counters.path.guided_samples, 0u) << what;
+  if (expect_guided_samples) {
+    EXPECT_GT(r.stats.counters.path.guided_samples, 0u) << what;
+  }
   EXPECT_GT(r.stats.counters.path.guide_updates, 0u) << what;
   EXPECT_GT(r.stats.guide.updates, 0u) << what;
   EXPECT_EQ(r.stats.counters.rejected_nonfinite, 0u) << what;
@@ -220,7 +222,9 @@ Shape "sphere" "float radius" [ 1 ]
       // sees itself: every target is 0, no cell learns any light, and a cell
       // that has learned nothing samples the BSDF only.
       expect_clean_guided_run(r, what, !nee);
-      if (nee) EXPECT_EQ(r.stats.counters.path.guided_samples, 0u) << what;
+      if (nee) {
+        EXPECT_EQ(r.stats.counters.path.guided_samples, 0u) << what;
+      }
       const ImageRgb img = film_mean(r.film), var = film_variance_of_mean(r.film);
       // The central 8x8 pixels lie on the sphere (it spans ~ +-0.2 rad of the
       // 0.35 rad field of view). Their mean must be rho within 4 standard
