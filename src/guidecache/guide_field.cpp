@@ -54,8 +54,8 @@ size_t GuideField::add_cell() {
 uint64_t GuideField::bytes_per_cell() const {
   const uint64_t entry = sizeof(Float) + sizeof(uint32_t) + 2 * sizeof(uint64_t);  // value, visits, acc sum + count
   const uint64_t tables = bins_ * sizeof(GuideAlias) + (lights_ + 1) * sizeof(Float);  // alias table, light cdf
-  // normal sum + its accumulator, update count, irradiance, qmax, guide share, learn-normal flag
-  const uint64_t extras = 3 * sizeof(int64_t) + 3 * sizeof(uint64_t) + sizeof(uint64_t) + 3 * sizeof(Float) + 1;
+  // normal sum + its accumulator, update count, irradiance, qmax, guide and light shares, learn-normal flag
+  const uint64_t extras = 3 * sizeof(int64_t) + 3 * sizeof(uint64_t) + sizeof(uint64_t) + 4 * sizeof(Float) + 1;
   const uint64_t node = (8 * sizeof(GuideNode) + 8) / 7 + 1;  // amortised share of the octree
   return stride() * entry + tables + extras + node;
 }
@@ -92,12 +92,12 @@ GuideView GuideField::view() {
   g.qmax = qmax_.data();
   g.learn_normal = learn_normal_.data();
   g.cell_guide_prob = cell_guide_prob_.data();
+  g.cell_light_prob = cell_light_prob_.data();
   g.acc = acc_.data();
   g.acc_normal = acc_.data() + acc_normal_offset();
   g.rejected = acc_.data() + acc_rejected_offset();
   g.fixed_scale = fixed_scale_;
   g.max_target = max_target_;
-  g.light_guide_prob = lights_ > 0 ? config_.light_guide_prob : 0.f;
   g.target = config_.target;
   return g;
 }
@@ -180,6 +180,7 @@ void GuideField::build_distributions() {
   qmax_.assign(cells, 0.f);
   learn_normal_.assign(cells, 0);
   cell_guide_prob_.assign(cells, 0.f);
+  cell_light_prob_.assign(cells, 0.f);
   std::vector<double> w(std::max(bins_, lights_));
   const double floor = std::clamp<double>(config_.floor, 0.0, 1.0);
   // Probability of entry j of m: its weight's share, mixed with the uniform floor.
@@ -250,6 +251,8 @@ void GuideField::build_distributions() {
       double lt = 0.0;
       for (uint32_t j = 0; j < lights_; ++j) lt += (w[j] = q[bins_ + j]);
       build_cdf(lights_, lt, &light_cdf_[c * (lights_ + 1)]);
+      // Until a cell has seen light, its table is uniform: selection by power does better.
+      cell_light_prob_[c] = lt > 0.0 ? config_.light_guide_prob : 0.f;
     }
   }
 }

@@ -32,7 +32,11 @@ struct GuideConfig {
   uint64_t split_updates = 0;           // a leaf splits after this many updates; 0 = 24 per bin
   uint32_t max_depth = 20;              // octree levels below a root
   Float guide_prob = 0.5f;
-  Float light_guide_prob = 0.5f;
+  // Learned light selection's share against power-based selection (in cells
+  // that have learned some light). On shelter (6 lights) 0.9 gave 24 % lower
+  // error than 0.5 at equal samples; the power-based tenth and the floor keep
+  // every light possible.
+  Float light_guide_prob = 0.9f;
   // Share of each distribution spread uniformly: no impossible bin. 2 % gave
   // 2-4 % lower error than 5 % on every shipped scene at equal samples, 10 % was worse.
   Float floor = 0.02f;
@@ -127,7 +131,7 @@ class GuideField {
   std::vector<Float> light_cdf_, irradiance_, qmax_;
   std::vector<GuideAlias> dir_alias_;
   std::vector<uint8_t> learn_normal_;
-  std::vector<Float> cell_guide_prob_;
+  std::vector<Float> cell_guide_prob_, cell_light_prob_;
   std::vector<uint64_t> acc_;
 };
 

@@ -71,6 +71,7 @@ struct GuideView {
   const Float* qmax = nullptr;         // cells: largest Q over the bins above the cell's surface
   const uint8_t* learn_normal = nullptr;  // cells: 1 while the cell's mean normal is still being estimated
   const Float* cell_guide_prob = nullptr;  // cells: mixture weight of guided sampling there (0: BSDF only)
+  const Float* cell_light_prob = nullptr;  // cells: mixture weight of learned light selection (0: power only)
 
   // Accumulators for the running pass (relaxed atomics).
   uint64_t* acc = nullptr;         // cells * stride pairs (sum in fixed point = target * fixed_scale, count)
@@ -79,7 +80,6 @@ struct GuideView {
   Float fixed_scale = 1.f;
   Float max_target = 1e30f;        // larger targets are rejected (and counted), never clamped
 
-  Float light_guide_prob = 0.5f;   // mixture weight of learned light selection
   GuideTarget target = GuideTarget::ExpectedSarsa;
 
   TESSERA_HOST_DEVICE Float bin_solid_angle() const { return 4.f * kPi / static_cast<Float>(bins); }

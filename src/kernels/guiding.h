@@ -15,15 +15,15 @@ namespace tessera {
 TESSERA_HOST_DEVICE inline Float light_select_pmf(const SceneView& s, const GuideView* g, int32_t cell, uint32_t li) {
   Float p_power = s.light_select.discrete_pmf(li);
   if (!g || g->lights == 0 || cell < 0) return p_power;
-  Float lp = g->light_guide_prob;
+  const Float lp = g->cell_light_prob[cell];
   return (1.f - lp) * p_power + lp * g->light_distribution(cell).discrete_pmf(li);
 }
 
 // Selects a light with one uniform number; *pmf is the mixture probability.
 TESSERA_HOST_DEVICE inline uint32_t select_light(const SceneView& s, const GuideView* g, int32_t cell, Float u,
                                                  Float* pmf) {
-  if (!g || g->lights == 0 || cell < 0) return s.light_select.sample_discrete(u, pmf);
-  Float lp = g->light_guide_prob;
+  const Float lp = g && g->lights > 0 && cell >= 0 ? g->cell_light_prob[cell] : 0.f;
+  if (lp <= 0.f) return s.light_select.sample_discrete(u, pmf);
   uint32_t li;
   if (u < lp) {
     li = g->light_distribution(cell).sample_discrete(glm::min(u / lp, 0x1.fffffep-1f), nullptr);

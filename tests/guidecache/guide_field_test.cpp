@@ -265,6 +265,23 @@ TEST(GuideField, LearnedLightSelectionFollowsContributions) {
   EXPECT_NEAR(d.discrete_pmf(0) + d.discrete_pmf(1) + d.discrete_pmf(2), 1.f, 1e-6f);
 }
 
+// Learned light selection takes its share only in cells that have learned
+// some light; elsewhere selection stays power-based.
+TEST(GuideField, LearnedLightShareOnlyWhereLightWasLearned) {
+  GuideConfig cfg;
+  cfg.light_guide_prob = 0.8f;
+  GuideField f = make_field(cfg, 3);
+  GuideView g = f.view();
+  EXPECT_EQ(g.cell_light_prob[0], 0.f);
+  EXPECT_EQ(g.cell_light_prob[1], 0.f);
+  guide_record(g, 0, g.bins + 2, 4.f);
+  guide_record(g, 1, g.bins + 2, 0.f);  // an occluded light teaches nothing
+  f.fold();
+  g = f.view();
+  EXPECT_EQ(g.cell_light_prob[0], 0.8f);
+  EXPECT_EQ(g.cell_light_prob[1], 0.f);
+}
+
 TEST(GuideSerialisation, RoundTripIsExact) {
   GuideConfig cfg;
   cfg.split_updates = 50;
