@@ -33,8 +33,7 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
 }
 
 void apply_guide_schedule(const GuideArgs& a, RenderOptions* opt) {
-  opt->guide_learn_all_spp = static_cast<uint32_t>(a.learn_spp);
-  opt->guide_learn_every = static_cast<uint32_t>(a.learn_every);
+  opt->guide_learn = {static_cast<uint32_t>(a.learn_spp), static_cast<uint32_t>(a.learn_every)};
 }
 
 bool guiding_helps(uint32_t effects) {

@@ -21,8 +21,8 @@ struct GuideArgs {
   int64_t grid = 12;          // direction bins per side of the equal-area square
   // Learning schedule: every sample trains the guide up to learn_spp samples
   // per pixel, then every learn_every-th sample does.
-  int64_t learn_spp = kGuideLearnAllSpp;
-  int64_t learn_every = kGuideLearnEvery;
+  int64_t learn_spp = GuideLearnSchedule{}.all_spp;
+  int64_t learn_every = GuideLearnSchedule{}.every;
   std::string in, out;
 };
 

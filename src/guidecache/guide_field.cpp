@@ -54,8 +54,8 @@ size_t GuideField::add_cell() {
 uint64_t GuideField::bytes_per_cell() const {
   const uint64_t entry = sizeof(Float) + sizeof(uint32_t) + 2 * sizeof(uint64_t);  // value, visits, acc sum + count
   const uint64_t tables = bins_ * sizeof(GuideAlias) + (lights_ + 1) * sizeof(Float);  // alias table, light cdf
-  // normal sum + its accumulator, update count, irradiance, qmax, guide and light shares, learn-normal flag
-  const uint64_t extras = 3 * sizeof(int64_t) + 3 * sizeof(uint64_t) + sizeof(uint64_t) + 4 * sizeof(Float) + 1;
+  // normal sum + its accumulator, update count, irradiance, qmax, light share, learn-normal flag
+  const uint64_t extras = 3 * sizeof(int64_t) + 3 * sizeof(uint64_t) + sizeof(uint64_t) + 3 * sizeof(Float) + 1;
   const uint64_t node = (8 * sizeof(GuideNode) + 8) / 7 + 1;  // amortised share of the octree
   return stride() * entry + tables + extras + node;
 }
@@ -91,13 +91,13 @@ GuideView GuideField::view() {
   g.irradiance = irradiance_.data();
   g.qmax = qmax_.data();
   g.learn_normal = learn_normal_.data();
-  g.cell_guide_prob = cell_guide_prob_.data();
   g.cell_light_prob = cell_light_prob_.data();
   g.acc = acc_.data();
   g.acc_normal = acc_.data() + acc_normal_offset();
   g.rejected = acc_.data() + acc_rejected_offset();
   g.fixed_scale = fixed_scale_;
   g.max_target = max_target_;
+  g.guide_prob = config_.guide_prob;
   g.target = config_.target;
   return g;
 }
@@ -179,7 +179,6 @@ void GuideField::build_distributions() {
   irradiance_.assign(cells, 0.f);
   qmax_.assign(cells, 0.f);
   learn_normal_.assign(cells, 0);
-  cell_guide_prob_.assign(cells, 0.f);
   cell_light_prob_.assign(cells, 0.f);
   std::vector<double> w(std::max(bins_, lights_));
   const double floor = std::clamp<double>(config_.floor, 0.0, 1.0);
@@ -243,10 +242,6 @@ void GuideField::build_distributions() {
     irradiance_[c] = static_cast<Float>(total * 4.0 * M_PI / bins_);
     qmax_[c] = static_cast<Float>(qmax);
     build_alias(total, &dir_alias_[c * bins_]);
-    // Nothing learned above the surface yet: the guide would sample the
-    // whole sphere uniformly, half of it behind the surface. BSDF sampling
-    // does better until the cell has seen light.
-    cell_guide_prob_[c] = total > 0.0 ? config_.guide_prob : 0.f;
     if (lights_ > 0) {
       double lt = 0.0;
       for (uint32_t j = 0; j < lights_; ++j) lt += (w[j] = q[bins_ + j]);
@@ -255,11 +250,6 @@ void GuideField::build_distributions() {
       cell_light_prob_[c] = lt > 0.0 ? config_.light_guide_prob : 0.f;
     }
   }
-}
-
-void GuideField::set_guide_prob(Float p) {
-  config_.guide_prob = p;
-  build_distributions();  // the per-cell mixture weights follow it
 }
 
 GuideFieldStats GuideField::stats() const {

@@ -80,7 +80,7 @@ class GuideField {
 
   const GuideConfig& config() const { return config_; }
   // Sampling settings that do not change what was learned.
-  void set_guide_prob(Float p);
+  void set_guide_prob(Float p) { config_.guide_prob = p; }
   GuideFieldStats stats() const;
   uint32_t num_cells() const { return static_cast<uint32_t>(cell_updates_.size()); }
   uint32_t learned_lights() const { return lights_; }
@@ -131,7 +131,7 @@ class GuideField {
   std::vector<Float> light_cdf_, irradiance_, qmax_;
   std::vector<GuideAlias> dir_alias_;
   std::vector<uint8_t> learn_normal_;
-  std::vector<Float> cell_guide_prob_, cell_light_prob_;
+  std::vector<Float> cell_light_prob_;
   std::vector<uint64_t> acc_;
 };
 

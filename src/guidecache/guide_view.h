@@ -70,7 +70,6 @@ struct GuideView {
   const Float* irradiance = nullptr;   // cells: sum over bins of Q max(cos, 0) dOmega about the cell normal
   const Float* qmax = nullptr;         // cells: largest Q over the bins above the cell's surface
   const uint8_t* learn_normal = nullptr;  // cells: 1 while the cell's mean normal is still being estimated
-  const Float* cell_guide_prob = nullptr;  // cells: mixture weight of guided sampling there (0: BSDF only)
   const Float* cell_light_prob = nullptr;  // cells: mixture weight of learned light selection (0: power only)
 
   // Accumulators for the running pass (relaxed atomics).
@@ -80,7 +79,13 @@ struct GuideView {
   Float fixed_scale = 1.f;
   Float max_target = 1e30f;        // larger targets are rejected (and counted), never clamped
 
+  Float guide_prob = 0.5f;         // mixture weight of guided direction sampling
   GuideTarget target = GuideTarget::ExpectedSarsa;
+
+  // Mixture weight of guided sampling in a cell. A cell that has learned no
+  // light above its surface would sample the whole sphere uniformly, half of
+  // it behind the surface: BSDF sampling does better until it has.
+  TESSERA_HOST_DEVICE Float cell_guide_prob(int32_t cell) const { return irradiance[cell] > 0.f ? guide_prob : 0.f; }
 
   TESSERA_HOST_DEVICE Float bin_solid_angle() const { return 4.f * kPi / static_cast<Float>(bins); }
   TESSERA_HOST_DEVICE Float dir_pmf_of(int32_t cell, uint32_t bin) const {

@@ -45,7 +45,7 @@ TESSERA_HOST_DEVICE inline uint32_t select_light(const SceneView& s, const Guide
 // (measured: ~3x the variance behind a rough glass slab).
 TESSERA_HOST_DEVICE inline Float guide_probability(const GuideView& g, int32_t cell, const BsdfParams& b,
                                                    bool lambertian_only) {
-  const Float p = g.cell_guide_prob[cell];
+  const Float p = g.cell_guide_prob(cell);
   if (lambertian_only || b.type == BsdfType::Diffuse) return p;
   if (b.type == BsdfType::Dielectric) return 0.f;
   Float alpha = glm::sqrt(b.alpha_x * b.alpha_y);

@@ -86,7 +86,7 @@ TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, const Vec3& wo, Fl
 //
 // With kSpecGuiding, directions at vertices without a delta lobe are drawn
 // from a mixture of the BSDF and the learned guide (probability
-// the cell's guide.cell_guide_prob), weighted by the mixture pdf, which also
+// guide.cell_guide_prob(cell)), weighted by the mixture pdf, which also
 // stands in for the BSDF pdf in every MIS weight: the estimator stays unbiased
 // whatever the guide has learned. (Weighing MIS by the BSDF pdf alone, which
 // saves NEE a guide lookup, measured 5 % worse on shelter at equal samples

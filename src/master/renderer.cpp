@@ -43,10 +43,7 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
   ts_settings.path.max_depth = opt.max_depth;
   ts_settings.path.nee = opt.nee;
   ts_settings.specialisation = stats.specialisation;
-  ts_settings.learn_all_spp = opt.guide_learn_all_spp;
-  ts_settings.learn_every = opt.guide_learn_every;
-  stats.guide_learn_all_spp = opt.guide_learn_all_spp;
-  stats.guide_learn_every = opt.guide_learn_every;
+  ts_settings.learn = stats.guide_learn = opt.guide_learn;
   const EmbreeTracer tracer = embree.tracer();
 
   const uint64_t pixels = static_cast<uint64_t>(w) * h;

@@ -14,14 +14,6 @@
 
 namespace tessera {
 
-// Default guide learning schedule (see TileSettings): every sample trains the
-// guide for the first 16 samples per pixel, then every 8th does. Learning
-// costs about as much per vertex as guided sampling; past the first passes
-// the field changes little, so most samples just use it (measured at equal
-// time: every 8th and every 4th gave the same error, every 8th is faster).
-constexpr uint32_t kGuideLearnAllSpp = 16;
-constexpr uint32_t kGuideLearnEvery = 8;
-
 struct RenderOptions {
   uint32_t spp = 16;            // 0 = unlimited (then time_budget_s must be set)
   double time_budget_s = 0.0;   // 0 = none; whole passes are rendered until it is spent
@@ -31,8 +23,7 @@ struct RenderOptions {
   int32_t threads = 0;          // 0 = all cores
   int32_t tile_size = 16;
   uint32_t max_pass_spp = 8;
-  uint32_t guide_learn_all_spp = kGuideLearnAllSpp;  // see TileSettings
-  uint32_t guide_learn_every = kGuideLearnEvery;
+  GuideLearnSchedule guide_learn;
   bool force_full_specialisation = false;  // benchmark switch: ignore the effects set
   bool progress = true;
 };
@@ -61,8 +52,7 @@ struct RenderStats {
   std::string guide_mode = "none";  // none | qtable | qlearning
   GuideFieldStats guide;            // as the field stood at the end (when guided)
   double guide_fold_seconds = 0.0;
-  uint32_t guide_learn_all_spp = 0;  // the learning schedule the render ran with
-  uint32_t guide_learn_every = 0;
+  GuideLearnSchedule guide_learn;  // the learning schedule the render ran with
 };
 
 struct RenderResult {

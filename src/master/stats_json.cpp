@@ -78,8 +78,8 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
     j.add("guide_targets_rejected_nonfinite", s.guide.rejected_nonfinite);
     j.add("guide_targets_rejected_large", s.guide.rejected_large);
     j.add("guide_fold_seconds", s.guide_fold_seconds);
-    j.add("guide_learn_spp", uint64_t{s.guide_learn_all_spp});
-    j.add("guide_learn_every", uint64_t{s.guide_learn_every});
+    j.add("guide_learn_spp", uint64_t{s.guide_learn.all_spp});
+    j.add("guide_learn_every", uint64_t{s.guide_learn.every});
     j.add("guided_sample_fraction",
           c.path.guidable_vertices > 0 ? double(c.path.guided_samples) / double(c.path.guidable_vertices) : 0.0);
   }

@@ -20,7 +20,7 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
         Vec2 offset = sample_filter_offset(s.filter, rng.uniform2());
         Vec2 p_film(x + 0.5f + offset.x, y + 0.5f + offset.y);
         Ray ray = generate_camera_ray(s.camera, p_film);
-        path.learn = si < settings.learn_all_spp || (settings.learn_every > 0 && si % settings.learn_every == 0);
+        path.learn = settings.learn.learns(si);
         Rgb L = trace_path<Spec>(s, tracer, ray, rng, path, tc.path);
         if (!is_finite(L)) {
           ++tc.rejected_nonfinite;

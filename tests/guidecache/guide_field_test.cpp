@@ -137,19 +137,19 @@ TEST(GuideField, CellsGuideOnlyAfterLearningLightAboveTheSurface) {
   cfg.guide_prob = 0.7f;
   GuideField f = make_field(cfg);
   const int32_t up = f.find_cell(Vec3(0.5f), Vec3(0, 0, 1)), down = f.find_cell(Vec3(0.5f), Vec3(0, 0, -1));
-  EXPECT_EQ(f.view().cell_guide_prob[up], 0.f);
+  EXPECT_EQ(f.view().cell_guide_prob(up), 0.f);
   GuideView g = f.view();
   const uint32_t below = guide_bin_of(g, Vec3(0, 0, -1)), above = guide_bin_of(g, Vec3(0, 0, 1));
   guide_record(g, up, below, 5.f);
   f.fold();
-  EXPECT_EQ(f.view().cell_guide_prob[up], 0.f);
+  EXPECT_EQ(f.view().cell_guide_prob(up), 0.f);
   g = f.view();
   guide_record(g, up, above, 5.f);
   f.fold();
-  EXPECT_EQ(f.view().cell_guide_prob[up], 0.7f);
-  EXPECT_EQ(f.view().cell_guide_prob[down], 0.f);
+  EXPECT_EQ(f.view().cell_guide_prob(up), 0.7f);
+  EXPECT_EQ(f.view().cell_guide_prob(down), 0.f);
   f.set_guide_prob(0.25f);
-  EXPECT_EQ(f.view().cell_guide_prob[up], 0.25f);
+  EXPECT_EQ(f.view().cell_guide_prob(up), 0.25f);
 }
 
 TEST(GuideField, HugeBinKeepsEveryOtherBinPossible) {

@@ -219,13 +219,13 @@ TEST(GuidedLearningSchedule, SubsampledLearningStaysUnbiasedAndDeterministic) {
   GuidedScene s(shipped("shelter", 32, 24, 24, 6));
   RenderOptions all;
   all.seed = 7;
-  all.guide_learn_all_spp = UINT32_MAX;
+  all.guide_learn.all_spp = UINT32_MAX;
   RenderOptions sub = all;
-  sub.guide_learn_all_spp = 4;
-  sub.guide_learn_every = 5;
+  sub.guide_learn.all_spp = 4;
+  sub.guide_learn.every = 5;
   RenderOptions frozen = all;
-  frozen.guide_learn_all_spp = 4;
-  frozen.guide_learn_every = 0;
+  frozen.guide_learn.all_spp = 4;
+  frozen.guide_learn.every = 0;
 
   GuideField g_all = s.make_guide(), g_sub = s.make_guide(), g_sub2 = s.make_guide(), g_frozen = s.make_guide();
   RenderResult r_all = s.run(&g_all, all), r_sub = s.run(&g_sub, sub), r_frozen = s.run(&g_frozen, frozen);

@@ -183,7 +183,7 @@ TEST(GuidedFurnace, SphereWithNonDefaultFieldSettings) {
       GuideField guide = s.make_guide(c.cfg);
       RenderOptions opt;
       opt.nee = nee;
-      opt.guide_learn_all_spp = UINT32_MAX;  // these field settings learn from every sample
+      opt.guide_learn.all_spp = UINT32_MAX;  // these field settings learn from every sample
       RenderResult r = s.run(&guide, opt);
       expect_furnace(r, expected, 0.01, 0.003, what);
       if (c.cfg.split_updates == 64) {
@@ -559,7 +559,7 @@ TEST(GuidedLearning, FewerZeroRadiancePathsOnHardScenes) {
     GuidedScene s(shipped(name, 48, 36, 64, 8));
     RenderOptions opt;
     opt.seed = 1;
-    opt.guide_learn_all_spp = UINT32_MAX;  // this tiny image learns from every sample
+    opt.guide_learn.all_spp = UINT32_MAX;  // this tiny image learns from every sample
     GuideField guide = s.make_guide();
     RenderResult g = s.run(&guide, opt), u = s.run(nullptr, opt);
     const PassStats &pg = g.stats.pass_stats.back(), &pu = u.stats.pass_stats.back();
