@@ -28,12 +28,17 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
   cmd->add_option("--guide-learn-every", a.learn_every,
                   "After --guide-learn-spp, every N-th sample per pixel trains the guide (0 = none do)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 30));
+  cmd->add_option("--guide-roulette", a.roulette,
+                  "Russian roulette of guided renders: guided (by the guide's prediction of what a path will "
+                  "bring) or throughput (pbrt-v4's rule)")
+      ->check(CLI::IsMember({"guided", "throughput"}));
   cmd->add_option("--guide-in", a.in, "Start from a guide cache saved by --guide-out (same scene only)");
   cmd->add_option("--guide-out", a.out, "Save the learned guide cache after rendering");
 }
 
 void apply_guide_schedule(const GuideArgs& a, RenderOptions* opt) {
   opt->guide_learn = {static_cast<uint32_t>(a.learn_spp), static_cast<uint32_t>(a.learn_every)};
+  opt->guide_roulette = a.roulette == "guided";
 }
 
 bool guiding_helps(uint32_t effects) {

@@ -23,12 +23,14 @@ struct GuideArgs {
   // per pixel, then every learn_every-th sample does.
   int64_t learn_spp = GuideLearnSchedule{}.all_spp;
   int64_t learn_every = GuideLearnSchedule{}.every;
+  std::string roulette = "guided";  // guided | throughput
   std::string in, out;
 };
 
 void add_guide_options(CLI::App* cmd, GuideArgs& args);
 
-// Copies the learning schedule (--guide-learn-spp / --guide-learn-every) into a render's options.
+// Copies the learning schedule (--guide-learn-spp / --guide-learn-every) and
+// the roulette rule (--guide-roulette) into a render's options.
 void apply_guide_schedule(const GuideArgs& args, RenderOptions* options);
 
 // The effects set decides "auto": guiding needs a surface that scatters

@@ -85,7 +85,10 @@ struct GuideView {
   // Mixture weight of guided sampling in a cell. A cell that has learned no
   // light above its surface would sample the whole sphere uniformly, half of
   // it behind the surface: BSDF sampling does better until it has.
-  TESSERA_HOST_DEVICE Float cell_guide_prob(int32_t cell) const { return irradiance[cell] > 0.f ? guide_prob : 0.f; }
+  TESSERA_HOST_DEVICE Float cell_guide_prob(int32_t cell) const { return learned(cell) ? guide_prob : 0.f; }
+  // Whether a cell has learned any light above its surface (else it samples,
+  // and predicts, nothing).
+  TESSERA_HOST_DEVICE bool learned(int32_t cell) const { return irradiance[cell] > 0.f; }
 
   TESSERA_HOST_DEVICE Float bin_solid_angle() const { return 4.f * kPi / static_cast<Float>(bins); }
   TESSERA_HOST_DEVICE Float dir_pmf_of(int32_t cell, uint32_t bin) const {

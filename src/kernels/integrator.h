@@ -33,6 +33,7 @@ struct PathCounters {
   uint64_t guidable_vertices = 0;  // vertices where the guide could be used (no delta lobe)
   uint64_t guided_samples = 0;     // directions drawn from the guide
   uint64_t guide_updates = 0;      // direction targets accepted by the guide
+  uint64_t guided_roulette = 0;    // roulette decisions taken by the guide's prediction
 };
 
 struct PathSettings {
@@ -43,6 +44,9 @@ struct PathSettings {
   // that does not learn still samples from the guide; it skips the learning
   // work, which costs as much as guided sampling itself.
   bool learn = true;
+  // Guide-driven Russian roulette (kSpecGuiding only; see guided_survival).
+  // Off: pbrt-v4's throughput rule everywhere.
+  bool guided_roulette = true;
 };
 
 namespace detail {
@@ -114,6 +118,14 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   // paths guiding worked to find. Any survival probability keeps the
   // estimator unbiased, as the weight is divided by it.
   Rgb rr_beta(1.f);
+  // Guide-driven roulette compares each continuation with the radiance the
+  // guide predicted for the whole path at its first vertex where it predicted
+  // any (0: not yet; roulette then follows the throughput alone). Learning
+  // paths use it too: a target needs only the segment x -> y and y's own
+  // estimate, so the roulette changes how often a bin is updated, never what
+  // it learns.
+  const bool guide_roulette = kGuide && settings.guided_roulette;
+  Float path_expected = 0.f;
   int32_t depth = 0;
   bool specular_bounce = false;
   Float prev_scatter_pdf = 0.f;  // pdf of the last sampled direction (the mixture's when guided)
@@ -216,7 +228,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     const bool guided_vertex = guide_p > 0.f;
 
     // Next-event estimation at non-specular vertices (pbrt-v4's SampleLd).
-    [[maybe_unused]] Float direct_estimate = 0.f;  // its unweighted estimate of light reflected here (guide targets)
+    Float direct_estimate = 0.f;  // its unweighted estimate of light reflected here (guide targets)
     if (settings.nee && lobes_have_non_specular(lobes) && s.num_lights > 0) {
       Float u_select = rng.uniform();
       Vec2 u_light = rng.uniform2();
@@ -245,19 +257,23 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           }
         }
       }
-      if (learn) {
-        if (g.lights > 0 && pmf > 0.f) guide_record(g, cell, g.bins + li, learned);
-        direct_estimate = pmf > 0.f ? learned / pmf : 0.f;
-      }
+      if (learn && g.lights > 0 && pmf > 0.f) guide_record(g, cell, g.bins + li, learned);
+      direct_estimate = pmf > 0.f ? learned / pmf : 0.f;
     }
-    if (learn) {
-      if (pend_cell >= 0 && !pend_at_delta) {
-        const bool lambertian = (Spec & kSpecNonDiffuse) == 0 || bsdf.type == BsdfType::Diffuse;
-        Float integral = guide_bins_integral(g, cell, bsdf, lambertian, wo_l,
-                                             [&](const Vec3& v) { return frame.to_local(v); }, rng);
-        if (guide_record(g, pend_cell, pend_bin, pend_le + direct_estimate + integral)) ++c.guide_updates;
+    // Radiance the guide expects y to reflect towards x: NEE's unweighted
+    // estimate plus the learned integral. It completes the pending target, and
+    // gives guide-driven roulette the path's expected radiance.
+    const bool completes_target = learn && pend_cell >= 0 && !pend_at_delta;
+    const bool sets_expectation = guide_roulette && !(path_expected > 0.f) && !delta_lobe && g.learned(cell);
+    if (completes_target || sets_expectation) {
+      const bool lambertian = (Spec & kSpecNonDiffuse) == 0 || bsdf.type == BsdfType::Diffuse;
+      const Float reflected = direct_estimate + guide_bins_integral(g, cell, bsdf, lambertian, wo_l,
+                                                                    [&](const Vec3& v) { return frame.to_local(v); }, rng);
+      if (completes_target) {
+        if (guide_record(g, pend_cell, pend_bin, pend_le + reflected)) ++c.guide_updates;
         pend_cell = -1;
       }
+      if (sets_expectation) path_expected = luminance(beta) * reflected;
     }
 
     Float uc = rng.uniform();
@@ -293,7 +309,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       if (!sample_f<Spec>(bsdf, wo_l, uc, u, &bs) || !(bs.pdf > 0.f)) break;
       wi = frame.to_world(bs.wi);
       scatter_pdf = bsdf_pdf = bs.pdf;
-      if (learn) wi_bin = guide_bin_of(g, wi);
+      if (learn || guide_roulette) wi_bin = guide_bin_of(g, wi);
     }
     if (!(scatter_pdf > 0.f)) break;
     const Rgb weight = bs.f * (abs_cos_theta(bs.wi) / scatter_pdf);
@@ -316,14 +332,21 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     ray.d = wi;
     prev_p = h.p;
 
-    // Russian roulette (pbrt-v4): after the second bounce, on throughput
-    // corrected for radiance scaling at refractive boundaries.
-    Float m = max_component(rr_beta * eta_scale);
-    if (m < 1.f && depth > 1) {
-      Float q = glm::max(0.f, 1.f - m);
-      if (rng.uniform() < q) break;
-      beta /= 1.f - q;
-      rr_beta /= 1.f - q;
+    // Russian roulette after the second bounce: pbrt-v4's rule, on throughput
+    // corrected for radiance scaling at refractive boundaries; where the guide
+    // has learned and predicted this path's radiance, a path it expects to
+    // bring light survives more often.
+    if (depth > 1) {
+      Float survive = glm::min(1.f, max_component(rr_beta * eta_scale));
+      if (kGuide && path_expected > 0.f && g.learned(cell)) {
+        survive = glm::max(survive, guided_survival(g, cell, wi_bin, luminance(beta), path_expected));
+        ++c.guided_roulette;
+      }
+      if (survive < 1.f) {
+        if (rng.uniform() < 1.f - survive) break;
+        beta /= survive;
+        rr_beta /= survive;
+      }
     }
     if (is_black(beta)) break;
   }

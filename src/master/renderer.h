@@ -24,6 +24,7 @@ struct RenderOptions {
   int32_t tile_size = 16;
   uint32_t max_pass_spp = 8;
   GuideLearnSchedule guide_learn;
+  bool guide_roulette = true;   // guide-driven Russian roulette (guided renders)
   bool force_full_specialisation = false;  // benchmark switch: ignore the effects set
   bool progress = true;
 };
@@ -53,6 +54,7 @@ struct RenderStats {
   GuideFieldStats guide;            // as the field stood at the end (when guided)
   double guide_fold_seconds = 0.0;
   GuideLearnSchedule guide_learn;  // the learning schedule the render ran with
+  bool guide_roulette = false;     // whether guide-driven roulette was on
 };
 
 struct RenderResult {

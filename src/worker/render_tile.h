@@ -51,6 +51,7 @@ struct TileCounters {
     path.guidable_vertices += o.path.guidable_vertices;
     path.guided_samples += o.path.guided_samples;
     path.guide_updates += o.path.guide_updates;
+    path.guided_roulette += o.path.guided_roulette;
     samples += o.samples;
     zero_radiance += o.zero_radiance;
     rejected_nonfinite += o.rejected_nonfinite;
