@@ -86,7 +86,8 @@ def main():
                 rows.append({"relmse": c["relmse"], "spp": s["spp"], "seconds": s["seconds"],
                              "zero_contribution_fraction": s["zero_contribution_fraction"],
                              "mean_path_length": s["mean_path_length"],
-                             "ns_per_sample": s["seconds"] / max(1, s["spp"] * pixels) * 1e9})
+                             "ns_per_sample": s["seconds"] / max(1, s["spp"] * pixels) * 1e9,
+                             "ns_per_vertex": s["seconds"] / max(1e-30, s["spp"] * pixels * s["mean_path_length"]) * 1e9})
             med = {k: statistics.median(r[k] for r in rows) for k in rows[0]}
             med["runs"] = rows
             entry["methods"][method] = med
@@ -95,13 +96,16 @@ def main():
                   f"{med['ns_per_sample']:.0f} ns/sample", flush=True)
         results["scenes"][scene] = entry
 
-    print("\nscene         relMSE qtable/none  target   time/sample qtable/none   qtable vs qlearning")
+    # Time per sample also grows with path length: guided roulette keeps paths
+    # that find light alive longer. Time per path vertex shows the guide's own cost.
+    print("\nscene         relMSE qtable/none  target   time/sample qtable/none   time/vertex   qtable vs qlearning")
     for scene, e in results["scenes"].items():
         m = e["methods"]
         if "none" not in m or "qtable" not in m:
             continue
         ratio = m["qtable"]["relmse"] / max(m["none"]["relmse"], 1e-30)
         tps = m["qtable"]["ns_per_sample"] / max(m["none"]["ns_per_sample"], 1e-30)
+        tpv = m["qtable"]["ns_per_vertex"] / max(m["none"]["ns_per_vertex"], 1e-30)
         target = TARGETS.get(scene)
         verdict = "" if target is None else ("ok" if ratio <= target else "MISSED")
         ql = ""
@@ -109,8 +113,9 @@ def main():
             ql = "sarsa better" if m["qtable"]["relmse"] < m["qlearning"]["relmse"] else "qlearning better"
         e["ratio_relmse_qtable_vs_none"] = ratio
         e["ratio_time_per_sample"] = tps
+        e["ratio_time_per_vertex"] = tpv
         print(f"{scene:12s}  {ratio:8.3f}            {('<= ' + str(target)) if target else '   -   ':8s} {verdict:6s}"
-              f"  {tps:6.2f} (target <= 1.25)      {ql}")
+              f"  {tps:6.2f} (target <= 1.25)      {tpv:6.2f}        {ql}")
     with open(os.path.join(a.out, a.results), "w") as f:
         json.dump(results, f, indent=2)
     print(f"\nwrote {os.path.join(a.out, a.results)}")

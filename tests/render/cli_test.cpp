@@ -221,6 +221,31 @@ TEST_F(CliTest, GuideLearningScheduleOptions) {
   EXPECT_NE(run("render --guide-learn-spp x").exit_code, 0);
 }
 
+// --guide-roulette reaches the render: the stats say which rule ran, and only
+// the guided one lets the guide take roulette decisions; bad values are refused.
+TEST_F(CliTest, GuideRouletteOption) {
+  const std::string out = (dir_ / "r.exr").string();
+  auto stats_of = [&](const std::string& args, const std::string& name) -> std::string {
+    const std::string stats = (dir_ / name).string();
+    RunResult r = run("render -q --res 24x24 --spp 16 --seed 3 --guide qtable " + args + " -o " + out + " --stats " + stats);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream js(stats);
+    return std::string((std::istreambuf_iterator<char>(js)), {});
+  };
+  auto fraction = [](const std::string& json) {
+    const size_t k = json.find("\"guided_roulette_fraction\": ");
+    return k == std::string::npos ? -1.0 : std::stod(json.substr(k + 28));
+  };
+  const std::string guided = stats_of("", "guided.json"), thr = stats_of("--guide-roulette throughput", "thr.json");
+  EXPECT_NE(guided.find("\"guide_roulette\": \"guided\""), std::string::npos) << guided;
+  EXPECT_NE(thr.find("\"guide_roulette\": \"throughput\""), std::string::npos) << thr;
+  EXPECT_GT(fraction(guided), 0.0) << guided;
+  EXPECT_EQ(fraction(thr), 0.0) << thr;
+  RunResult bad = run("render --guide-roulette sometimes");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--guide-roulette"), std::string::npos) << bad.output;
+}
+
 TEST_F(CliTest, InfoPrintsEffects) {
   RunResult r = run("info");
   EXPECT_EQ(r.exit_code, 0);
