@@ -48,6 +48,15 @@ class CliTest : public ::testing::Test {
     std::ofstream(dir_ / name) << text;
     return (dir_ / name).string();
   }
+  // Renders the built-in scene with `args` (which must succeed) and returns
+  // its stats JSON, written to `name` in the test's folder.
+  std::string render_stats(const std::string& args, const std::string& name) {
+    const std::string stats = (dir_ / name).string(), out = (dir_ / "render.exr").string();
+    RunResult r = run("render -q " + args + " -o " + out + " --stats " + stats);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream js(stats);
+    return std::string((std::istreambuf_iterator<char>(js)), {});
+  }
   fs::path dir_;
 };
 
@@ -199,13 +208,8 @@ TEST_F(CliTest, GuideCacheOptions) {
 // The learning schedule reaches the render and its stats; fewer learning
 // samples mean fewer guide updates; bad values are refused.
 TEST_F(CliTest, GuideLearningScheduleOptions) {
-  const std::string out = (dir_ / "s.exr").string();
-  auto updates = [&](const std::string& args, const std::string& name) -> std::string {
-    const std::string stats = (dir_ / name).string();
-    RunResult r = run("render -q --res 16x16 --spp 12 --seed 2 --guide qtable " + args + " -o " + out + " --stats " + stats);
-    EXPECT_EQ(r.exit_code, 0) << r.output;
-    std::ifstream js(stats);
-    return std::string((std::istreambuf_iterator<char>(js)), {});
+  auto updates = [&](const std::string& args, const std::string& name) {
+    return render_stats("--res 16x16 --spp 12 --seed 2 --guide qtable " + args, name);
   };
   const std::string some = updates("--guide-learn-spp 2 --guide-learn-every 3", "some.json");
   EXPECT_NE(some.find("\"guide_learn_spp\": 2,"), std::string::npos) << some;
@@ -224,13 +228,8 @@ TEST_F(CliTest, GuideLearningScheduleOptions) {
 // --guide-roulette reaches the render: the stats say which rule ran, and only
 // the guided one lets the guide take roulette decisions; bad values are refused.
 TEST_F(CliTest, GuideRouletteOption) {
-  const std::string out = (dir_ / "r.exr").string();
-  auto stats_of = [&](const std::string& args, const std::string& name) -> std::string {
-    const std::string stats = (dir_ / name).string();
-    RunResult r = run("render -q --res 24x24 --spp 16 --seed 3 --guide qtable " + args + " -o " + out + " --stats " + stats);
-    EXPECT_EQ(r.exit_code, 0) << r.output;
-    std::ifstream js(stats);
-    return std::string((std::istreambuf_iterator<char>(js)), {});
+  auto stats_of = [&](const std::string& args, const std::string& name) {
+    return render_stats("--res 24x24 --spp 16 --seed 3 --guide qtable " + args, name);
   };
   auto fraction = [](const std::string& json) {
     const size_t k = json.find("\"guided_roulette_fraction\": ");
