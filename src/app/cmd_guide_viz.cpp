@@ -101,7 +101,7 @@ int run_guide_viz(VizArgs a) {
     opt.max_depth = scene.desc().max_depth;
     opt.seed = static_cast<uint64_t>(a.seed);
     opt.progress = false;
-    apply_guide_schedule(a.guide, &opt);
+    apply_guide_render_options(a.guide, &opt);
     render(scene, embree, opt, field.get());
     std::printf("trained the guide with %lld spp (%u cells)\n", static_cast<long long>(a.train_spp), field->num_cells());
   }

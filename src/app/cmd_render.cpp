@@ -51,7 +51,7 @@ int run_render(const RenderArgs& a) {
   opt.tile_size = static_cast<int32_t>(a.tile);
   opt.progress = !a.quiet;
   opt.force_full_specialisation = a.full_specialisation;
-  apply_guide_schedule(a.guide, &opt);
+  apply_guide_render_options(a.guide, &opt);
   if (opt.spp == 0 && opt.time_budget_s <= 0) throw std::runtime_error("--spp 0 needs a --time budget");
 
   std::string out = a.output;

@@ -36,7 +36,7 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
   cmd->add_option("--guide-out", a.out, "Save the learned guide cache after rendering");
 }
 
-void apply_guide_schedule(const GuideArgs& a, RenderOptions* opt) {
+void apply_guide_render_options(const GuideArgs& a, RenderOptions* opt) {
   opt->guide_learn = {static_cast<uint32_t>(a.learn_spp), static_cast<uint32_t>(a.learn_every)};
   opt->guide_roulette = a.roulette == "guided";
 }

@@ -31,7 +31,7 @@ void add_guide_options(CLI::App* cmd, GuideArgs& args);
 
 // Copies the learning schedule (--guide-learn-spp / --guide-learn-every) and
 // the roulette rule (--guide-roulette) into a render's options.
-void apply_guide_schedule(const GuideArgs& args, RenderOptions* options);
+void apply_guide_render_options(const GuideArgs& args, RenderOptions* options);
 
 // The effects set decides "auto": guiding needs a surface that scatters
 // non-specularly (diffuse or glossy) lit by some light.

@@ -33,7 +33,7 @@ struct PathCounters {
   uint64_t guidable_vertices = 0;  // vertices where the guide could be used (no delta lobe)
   uint64_t guided_samples = 0;     // directions drawn from the guide
   uint64_t guide_updates = 0;      // direction targets accepted by the guide
-  uint64_t guided_roulette = 0;    // roulette decisions taken by the guide's prediction
+  uint64_t guided_roulette = 0;    // roulette decisions the guide's prediction took part in
 };
 
 struct PathSettings {
@@ -309,7 +309,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       if (!sample_f<Spec>(bsdf, wo_l, uc, u, &bs) || !(bs.pdf > 0.f)) break;
       wi = frame.to_world(bs.wi);
       scatter_pdf = bsdf_pdf = bs.pdf;
-      if (learn || guide_roulette) wi_bin = guide_bin_of(g, wi);
+      if (learn || (path_expected > 0.f && g.learned(cell))) wi_bin = guide_bin_of(g, wi);
     }
     if (!(scatter_pdf > 0.f)) break;
     const Rgb weight = bs.f * (abs_cos_theta(bs.wi) / scatter_pdf);

@@ -46,7 +46,6 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
   ts_settings.learn = stats.guide_learn = opt.guide_learn;
   ts_settings.path.guided_roulette = opt.guide_roulette;
   stats.guide_roulette = guide != nullptr && opt.guide_roulette;
-
   const EmbreeTracer tracer = embree.tracer();
 
   const uint64_t pixels = static_cast<uint64_t>(w) * h;
