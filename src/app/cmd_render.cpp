@@ -1,15 +1,25 @@
 // tessera render [SCENE.pbrt] ...
+// Runs locally, or as a farm when started by mpirun (rank 0 = master).
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <regex>
+#include <sstream>
 
 #include "app/commands.h"
 #include "app/guide_setup.h"
 #include "app/scene_loading.h"
+#include "comm/farm_protocol.h"
+#include "comm/mpi_transport.h"
+#include "comm/scene_wire.h"
+#include "master/checkpoint.h"
+#include "master/farm_master.h"
 #include "master/image_output.h"
 #include "master/renderer.h"
 #include "master/stats_json.h"
 #include "scene/scene_effects.h"
+#include "worker/cpu_affinity.h"
+#include "worker/farm_worker.h"
 
 namespace tessera {
 namespace {
@@ -20,6 +30,9 @@ struct RenderArgs {
   int64_t seed = -1;
   double time = 0.0;
   bool quiet = false, no_preview = false, full_specialisation = false;
+  std::string checkpoint, resume;
+  double checkpoint_every = 60.0;
+  std::string guide_sync = "pass";
   GuideArgs guide;
 };
 
@@ -35,13 +48,19 @@ void parse_resolution(const std::string& res, SceneDesc& d) {
   d.film.yres = static_cast<int32_t>(h);
 }
 
-int run_render(const RenderArgs& a) {
+// The scene as the command line amends it (resolution, depth, spp, seed).
+SceneDesc load_desc(const RenderArgs& a) {
   SceneDesc desc = load_scene_or_builtin(a.scene);
   if (!a.res.empty()) parse_resolution(a.res, desc);
   if (a.max_depth >= 0) desc.max_depth = static_cast<int32_t>(a.max_depth);
   if (a.spp >= 0) desc.spp = static_cast<int32_t>(a.spp);
   if (a.seed >= 0) desc.seed = static_cast<uint64_t>(a.seed);
+  return desc;
+}
 
+// A function of the arguments and the (amended) scene only: every rank of a
+// farm derives the same options from the scene the master sends.
+RenderOptions make_options(const RenderArgs& a, const SceneDesc& desc) {
   RenderOptions opt;
   opt.spp = (a.spp < 0 && a.time > 0) ? 0u : static_cast<uint32_t>(desc.spp);
   opt.time_budget_s = a.time;
@@ -53,54 +72,122 @@ int run_render(const RenderArgs& a) {
   opt.force_full_specialisation = a.full_specialisation;
   apply_guide_render_options(a.guide, &opt);
   if (opt.spp == 0 && opt.time_budget_s <= 0) throw std::runtime_error("--spp 0 needs a --time budget");
+  return opt;
+}
 
-  std::string out = a.output;
-  if (out.empty()) {
+struct OutputPaths {
+  std::string exr, preview;
+};
+
+OutputPaths output_paths(const RenderArgs& a, const SceneDesc& desc) {
+  OutputPaths o{a.output, a.preview};
+  if (o.exr.empty()) {
     // The scene's Film filename, made an EXR (pbrt scenes often name a PNG).
     std::filesystem::path f = std::filesystem::path(desc.film.filename.empty() ? "tessera.exr" : desc.film.filename).filename();
-    out = f.replace_extension(".exr").string();
+    o.exr = f.replace_extension(".exr").string();
   }
-  if (std::filesystem::path(out).extension() != ".exr") throw std::runtime_error("-o: output must end in .exr, got '" + out + "'");
-  std::string preview = a.preview;
-  if (preview.empty() && !a.no_preview) preview = std::filesystem::path(out).replace_extension(".png").string();
+  if (std::filesystem::path(o.exr).extension() != ".exr") throw std::runtime_error("-o: output must end in .exr, got '" + o.exr + "'");
+  if (o.preview.empty() && !a.no_preview) o.preview = std::filesystem::path(o.exr).replace_extension(".png").string();
+  return o;
+}
 
-  SceneData scene(std::move(desc));
+Bytes guide_bytes(const GuideField& guide, const SceneData& scene) {
+  std::ostringstream s(std::ios::binary);
+  guide.save(s, scene.fingerprint());
+  const std::string str = s.str();
+  return Bytes(str.begin(), str.end());
+}
+
+std::unique_ptr<GuideField> guide_from_bytes(const Bytes& bytes, const SceneData& scene) {
+  std::istringstream s(std::string(bytes.begin(), bytes.end()), std::ios::binary);
+  return std::make_unique<GuideField>(GuideField::load(s, scene.fingerprint()));
+}
+
+// Everything rank 0 (or a local run) decides before rendering.
+struct MasterSetup {
+  std::unique_ptr<SceneData> scene;
+  RenderOptions opt;
+  OutputPaths out;
+  std::unique_ptr<GuideField> guide;
   std::string guide_why;
-  std::unique_ptr<GuideField> guide = make_guide(a.guide, scene, &guide_why);
-  const uint32_t spec = effective_specialisation(scene, opt, guide != nullptr);
+  std::optional<Checkpoint> resume;
+  uint64_t options_fingerprint = 0;
+};
+
+MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
+  MasterSetup m;
+  SceneDesc desc = load_desc(a);
+  m.opt = make_options(a, desc);
+  m.out = output_paths(a, desc);
+  if (scene_bytes) *scene_bytes = encode_scene(desc);
+  m.scene = std::make_unique<SceneData>(std::move(desc));
+  m.guide = make_guide(a.guide, *m.scene, &m.guide_why);
+  m.options_fingerprint = render_options_fingerprint(m.opt, m.scene->view().camera.width, m.scene->view().camera.height,
+                                                     m.guide ? (m.guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable") : "none");
+  if (!a.resume.empty()) {
+    if (!a.guide.in.empty()) throw std::runtime_error("--resume and --guide-in contradict each other (the checkpoint holds the guide)");
+    m.resume = read_checkpoint(a.resume, m.scene->fingerprint(), m.options_fingerprint);
+    if (m.guide) {
+      try {
+        m.guide = guide_from_bytes(m.resume->guide, *m.scene);
+      } catch (const std::exception& e) {
+        throw std::runtime_error("--resume " + a.resume + ": " + e.what());
+      }
+      if (a.guide.mix) m.guide->set_guide_prob(static_cast<Float>(*a.guide.mix));
+      m.guide_why = "resumed from " + a.resume;
+    }
+  }
+  return m;
+}
+
+void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks) {
+  const SceneData& scene = *m.scene;
   std::fprintf(stderr, "tessera: %s: %zu triangles, %u lights, %dx%d, %s, max depth %d\n",
                scene.desc().source.c_str(), scene.num_triangles(), scene.view().num_lights, scene.view().camera.width,
                scene.view().camera.height,
-               opt.spp > 0 ? (std::to_string(opt.spp) + " spp").c_str() : "unlimited spp", opt.max_depth);
+               m.opt.spp > 0 ? (std::to_string(m.opt.spp) + " spp").c_str() : "unlimited spp", m.opt.max_depth);
   std::fprintf(stderr, "tessera: effects: %s; integrator specialisation: %s\n", describe_effects(scene.effects()).c_str(),
                describe_specialisation(spec).c_str());
-  if (guide) {
+  if (m.guide) {
     std::fprintf(stderr, "tessera: guiding: %s (%s), %u direction bins, %s light selection, budget %.0f MB\n",
-                 guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable", guide_why.c_str(),
-                 guide->config().grid * guide->config().grid, guide->learned_lights() ? "learned" : "power-based",
-                 guide->config().budget_bytes / 1048576.0);
+                 m.guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable", m.guide_why.c_str(),
+                 m.guide->config().grid * m.guide->config().grid, m.guide->learned_lights() ? "learned" : "power-based",
+                 m.guide->config().budget_bytes / 1048576.0);
   } else {
-    std::fprintf(stderr, "tessera: guiding: none (%s)\n", guide_why.c_str());
+    std::fprintf(stderr, "tessera: guiding: none (%s)\n", m.guide_why.c_str());
   }
-  EmbreeScene embree(scene);
-  RenderResult r = render(scene, embree, opt, guide.get());
-  if (guide) save_guide(a.guide, *guide, scene);
+  if (ranks > 1) std::fprintf(stderr, "tessera: farm: %d ranks (rank 0 schedules and renders)\n", ranks);
+  if (m.resume)
+    std::fprintf(stderr, "tessera: resuming at %u spp (%u passes) from checkpoint\n", m.resume->so_far.stats.spp,
+                 m.resume->so_far.stats.passes);
+}
 
+// Temp file + rename: a failed or killed write never replaces a good file.
+template <class Write>
+void write_atomically(const std::string& path, Write write) {
+  const std::string tmp = std::filesystem::path(path).replace_extension(".partial" + std::filesystem::path(path).extension().string()).string();
+  write(tmp);
+  std::filesystem::rename(tmp, path);
+}
+
+void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult& r, uint32_t spec) {
+  const SceneData& scene = *m.scene;
   ImageRgb mean = film_mean(r.film), var = film_variance_of_mean(r.film);
   ExrMetadata meta;
   meta.numbers["spp"] = r.stats.spp;
   meta.numbers["seconds"] = r.stats.seconds;
-  meta.strings["seed"] = std::to_string(opt.seed);
+  meta.numbers["ranks"] = r.stats.ranks;
+  meta.strings["seed"] = std::to_string(m.opt.seed);
   meta.strings["effects"] = describe_effects(scene.effects());
   meta.strings["specialisation"] = describe_specialisation(spec);
   meta.strings["guide"] = r.stats.guide_mode;
   meta.strings["software"] = "tessera " TESSERA_VERSION;
   meta.strings["scene"] = scene.desc().source;
-  write_exr(out, mean, &var, meta);
-  std::printf("wrote %s\n", out.c_str());
-  if (!preview.empty()) {
-    write_png_preview(preview, mean);
-    std::printf("wrote %s\n", preview.c_str());
+  write_atomically(m.out.exr, [&](const std::string& p) { write_exr(p, mean, &var, meta); });
+  std::printf("wrote %s\n", m.out.exr.c_str());
+  if (!m.out.preview.empty()) {
+    write_atomically(m.out.preview, [&](const std::string& p) { write_png_preview(p, mean); });
+    std::printf("wrote %s\n", m.out.preview.c_str());
   }
   const TileCounters& c = r.stats.counters;
   std::fprintf(stderr, "tessera: %u spp in %.2fs (%.2f Msamples/s, %.2f Mrays/s), stopped by %s",
@@ -110,25 +197,128 @@ int run_render(const RenderArgs& a) {
     std::fprintf(stderr, "; rejected %llu NaN/Inf and %llu negative samples",
                  static_cast<unsigned long long>(c.rejected_nonfinite), static_cast<unsigned long long>(c.rejected_negative));
   std::fputc('\n', stderr);
-  if (guide) {
+  if (m.guide) {
     const GuideFieldStats& g = r.stats.guide;
     std::fprintf(stderr, "tessera: guide: %llu cells, %.1f MB, %llu updates, %llu targets rejected%s\n",
                  static_cast<unsigned long long>(g.cells), g.bytes / 1048576.0, static_cast<unsigned long long>(g.updates),
                  static_cast<unsigned long long>(g.rejected_nonfinite + g.rejected_large),
                  g.budget_reached ? ", memory budget reached" : "");
+    if (r.stats.ranks > 1 && r.stats.guide_syncs > 0)
+      std::fprintf(stderr, "tessera: guide sync: %u all-reductions of %.2f MB, %.3fs (%.1f%% of the render)\n",
+                   r.stats.guide_syncs, r.stats.guide_sync_bytes / 1048576.0, r.stats.guide_sync_seconds,
+                   100.0 * r.stats.guide_sync_seconds / std::max(r.stats.seconds, 1e-9));
   }
   if (!a.stats.empty()) {
-    write_text_file(a.stats, stats_to_json(r.stats, scene.desc().source, mean.width, mean.height, opt.seed));
+    write_atomically(a.stats, [&](const std::string& p) {
+      write_text_file(p, stats_to_json(r.stats, scene.desc().source, mean.width, mean.height, m.opt.seed));
+    });
     std::printf("wrote %s\n", a.stats.c_str());
   }
+}
+
+// Renders on this process (executor: its threads, or the farm) and writes
+// the outputs; checkpoints after passes when asked.
+RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, const EmbreeScene& embree, PassExecutor* executor,
+                              const std::function<void(RenderStats&)>& add_stats = {}) {
+  const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide != nullptr);
+  log_setup(m, spec, executor ? executor->ranks() : 1);
+  double last_checkpoint = m.resume ? m.resume->so_far.stats.seconds : 0.0;
+  PassEndHook hook;
+  if (!a.checkpoint.empty()) {
+    hook = [&](const RenderResult& so_far, const GuideField* guide) {
+      if (so_far.stats.seconds - last_checkpoint < a.checkpoint_every) return;
+      write_checkpoint(a.checkpoint, so_far, guide, m.scene->fingerprint(), m.options_fingerprint);
+      last_checkpoint = so_far.stats.seconds;
+    };
+  }
+  RenderResult r = render(*m.scene, embree, m.opt, m.guide.get(), executor, m.resume ? &m.resume->so_far : nullptr, hook);
+  // The finished render is a checkpoint too: --resume with a larger --spp continues it.
+  if (!a.checkpoint.empty()) write_checkpoint(a.checkpoint, r, m.guide.get(), m.scene->fingerprint(), m.options_fingerprint);
+  if (add_stats) add_stats(r.stats);
+  if (m.guide) save_guide(a.guide, *m.guide, *m.scene);
+  write_outputs(a, m, r, spec);
+  return r;
+}
+
+int run_render_local(const RenderArgs& a) {
+  MasterSetup m = prepare_master(a, nullptr);
+  EmbreeScene embree(*m.scene);
+  render_and_write(a, m, embree, nullptr);
   return 0;
 }
+
+// mpirun -np N tessera render ...: rank 0 parses the scene, sends it and the
+// starting guide to every rank, schedules tiles, renders too, and writes
+// all outputs; the other ranks render tiles.
+int run_render_farm(const RenderArgs& a) {
+  MpiSession mpi;
+  std::unique_ptr<Transport> t = mpi.world();
+  const bool master = t->rank() == 0;
+  const bool sync = a.guide_sync == "pass";
+
+  FarmSetup setup;
+  MasterSetup m;
+  if (master) {
+    try {
+      m = prepare_master(a, &setup.scene);
+      if (m.guide) setup.guide = guide_bytes(*m.guide, *m.scene);
+    } catch (const std::exception& e) {
+      setup = FarmSetup{e.what(), {}, {}};
+      Bytes b = encode(setup);
+      t->broadcast(b, 0);  // the workers stop too
+      throw;
+    }
+  }
+  Bytes b = master ? encode(setup) : Bytes{};
+  t->broadcast(b, 0);
+  try {
+    setup = decode<FarmSetup>(b);
+    if (!setup.error.empty()) return 1;  // the master reports it
+    if (!master) {
+      SceneDesc desc = decode_scene(setup.scene);
+      m.opt = make_options(a, desc);
+      m.scene = std::make_unique<SceneData>(std::move(desc));
+    }
+    // Every rank, the master included, starts from the guide in the bytes
+    // it sent: identical fields everywhere.
+    m.guide = setup.guide.empty() ? nullptr : guide_from_bytes(setup.guide, *m.scene);
+    if (m.guide && a.guide.mix) m.guide->set_guide_prob(static_cast<Float>(*a.guide.mix));
+    // Embree and oneTBB start their threads below: widen first.
+    const bool widened = widen_affinity_if_alone(t->ranks_on_this_machine());
+    if (widened && master)
+      std::fprintf(stderr, "tessera: farm: rank 0 is alone on its machine; using all its cores (mpirun had bound it to fewer)\n");
+    EmbreeScene embree(*m.scene);
+    const int32_t threads = render_threads(m.opt, t->ranks_on_this_machine());
+    if (!master) {
+      const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide != nullptr);
+      run_farm_worker(*t, m.scene->view(), embree, make_tile_settings(m.opt, spec, m.guide != nullptr), m.guide.get(),
+                      sync, threads);
+      return 0;
+    }
+    FarmMaster farm(*t, embree, m.scene->view(), std::max(1, threads), sync);
+    render_and_write(a, m, embree, &farm, [&](RenderStats& s) {
+      s.guide_sync = a.guide_sync;
+      s.guide_sync_seconds = farm.sync_seconds();
+      s.guide_sync_bytes = farm.sync_bytes();
+      s.guide_syncs = farm.syncs();
+    });
+    farm.stop();
+    return 0;
+  } catch (const std::exception& e) {
+    // A rank that fails mid-render cannot be waited for: end the whole job.
+    std::fprintf(stderr, "tessera: error: rank %d: %s\n", t->rank(), e.what());
+    std::fflush(stderr);
+    MpiSession::abort(1);
+  }
+}
+
+int run_render(const RenderArgs& a) { return launched_by_mpirun() ? run_render_farm(a) : run_render_local(a); }
 
 }  // namespace
 
 CommandRunner add_render_command(CLI::App& app) {
   auto a = std::make_shared<RenderArgs>();
-  CLI::App* c = app.add_subcommand("render", "Render a pbrt-v4 scene (default: the built-in Cornell box) to OpenEXR + PNG");
+  CLI::App* c = app.add_subcommand("render", "Render a pbrt-v4 scene (default: the built-in Cornell box) to OpenEXR + PNG; under mpirun, as a farm");
   c->add_option("scene", a->scene, "Scene file in pbrt-v4 syntax (omit for the built-in Cornell box)");
   c->add_option("-o,--output", a->output, "Output EXR (default: the scene's Film filename in the current directory)");
   c->add_option("--spp", a->spp, "Samples per pixel (overrides the scene's Sampler)")->check(CLI::Range(0, 1 << 30));
@@ -136,7 +326,7 @@ CommandRunner add_render_command(CLI::App& app) {
   c->add_option("--res", a->res, "Resolution WxH (overrides the scene's Film)");
   c->add_option("--max-depth", a->max_depth, "Maximum path depth, counted as pbrt-v4 does (overrides the Integrator)")->check(CLI::Range(0, 1 << 20));
   c->add_option("--seed", a->seed, "Random seed (same seed -> bit-identical image)")->check(CLI::NonNegativeNumber);
-  c->add_option("--threads", a->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
+  c->add_option("--threads", a->threads, "Worker threads per process (0 = all cores, shared out among the ranks on a machine)")->check(CLI::Range(0, 4096));
   c->add_option("--tile", a->tile, "Tile size in pixels")->check(CLI::Range(1, 4096));
   c->add_option("--stats", a->stats, "Write render statistics as JSON");
   c->add_option("--preview", a->preview, "sRGB PNG preview (default: beside the EXR)");
@@ -144,6 +334,11 @@ CommandRunner add_render_command(CLI::App& app) {
   c->add_flag("-q,--quiet", a->quiet, "No progress output");
   c->add_flag("--full-specialisation", a->full_specialisation,
               "Run the integrator compiled for every effect instead of the scene's effects set (for benchmarks)");
+  c->add_option("--checkpoint", a->checkpoint, "Write the render's state to this file (atomically) every --checkpoint-every seconds and at the end");
+  c->add_option("--checkpoint-every", a->checkpoint_every, "Seconds between checkpoints (0 = after every pass)")->check(CLI::NonNegativeNumber);
+  c->add_option("--resume", a->resume, "Continue a render from a checkpoint (same scene and options; any number of ranks)");
+  c->add_option("--guide-sync", a->guide_sync, "Farm: all-reduce the guide's learning after every pass (pass) or let each rank learn alone (off)")
+      ->check(CLI::IsMember({"pass", "off"}));
   add_guide_options(c, a->guide);
   return [a] { return run_render(*a); };
 }

@@ -1,6 +1,5 @@
 #include "master/renderer.h"
 
-#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -12,6 +11,7 @@
 #include <vector>
 
 #include "master/progress.h"
+#include "worker/cpu_affinity.h"
 
 namespace tessera {
 
@@ -20,44 +20,91 @@ uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& o
   return guiding ? spec | kSpecGuiding : spec;
 }
 
-RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& opt, GuideField* guide) {
+TileSettings make_tile_settings(const RenderOptions& opt, uint32_t specialisation, bool guiding) {
+  TileSettings ts;
+  ts.seed = opt.seed;
+  ts.path.max_depth = opt.max_depth;
+  ts.path.nee = opt.nee;
+  ts.specialisation = specialisation;
+  ts.learn = opt.guide_learn;
+  ts.path.guided_roulette = guiding && opt.guide_roulette;
+  return ts;
+}
+
+int32_t render_threads(const RenderOptions& opt, int32_t ranks_on_this_machine) {
+  if (opt.threads > 0) return opt.threads;
+  const int32_t machine = static_cast<int32_t>(std::max(1u, std::thread::hardware_concurrency()));
+  // A rank bound to some cores (mpirun's default) uses those.
+  return std::max(1, std::min(usable_cores(), machine / std::max(1, ranks_on_this_machine)));
+}
+
+uint32_t pass_spp_for(uint32_t pass, uint32_t max_pass_spp) {
+  return std::min<uint32_t>(max_pass_spp, pass == 0 ? 1u : (1u << std::min(pass - 1, 20u)));
+}
+
+LocalPassExecutor::LocalPassExecutor(const EmbreeScene& embree, const SceneView& view, int32_t threads)
+    : tracer_(embree.tracer()), view_(view), threads_(std::max(1, threads)) {}
+
+void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film,
+                                    TileCounters* counters, const std::function<void(uint64_t)>& on_tile_done) {
+  std::mutex counters_mutex;
+  tbb::task_arena arena(threads_);
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), jobs.size(), [&](size_t i) {
+      TileCounters tc = render_tile(view_, tracer_, settings, jobs[i], film_tile(film, jobs[i]));
+      {
+        std::lock_guard<std::mutex> lock(counters_mutex);
+        counters->add(tc);  // integer sums: order-independent
+      }
+      if (on_tile_done) on_tile_done(tc.samples);
+    });
+  });
+}
+
+RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& opt, GuideField* guide,
+                    PassExecutor* executor, const RenderResult* resume, const PassEndHook& on_pass_end) {
   const SceneView& view = scene.view();
   const int32_t w = view.camera.width, h = view.camera.height;
   RenderResult result;
-  result.film = Film(w, h);
+  if (resume) {
+    result = *resume;
+    result.stats.resumed_at_spp = resume->stats.spp;
+  } else {
+    result.film = Film(w, h);
+  }
   RenderStats& stats = result.stats;
   stats.effects = scene.effects();
   stats.specialisation = effective_specialisation(scene, opt, guide != nullptr);
+
+  std::unique_ptr<LocalPassExecutor> local;
+  if (!executor) {
+    local = std::make_unique<LocalPassExecutor>(embree, view, render_threads(opt));
+    executor = local.get();
+  }
+  stats.threads = executor->total_threads();
+  stats.ranks = executor->ranks();
 
   std::vector<TileJob> tiles;
   const int32_t ts = std::max(1, opt.tile_size);
   for (int32_t y = 0; y < h; y += ts)
     for (int32_t x = 0; x < w; x += ts) tiles.push_back(TileJob{x, y, std::min(x + ts, w), std::min(y + ts, h), 0, 0});
 
-  const int32_t threads = opt.threads > 0 ? opt.threads : static_cast<int32_t>(std::max(1u, std::thread::hardware_concurrency()));
-  stats.threads = threads;
-  tbb::task_arena arena(threads);
-
-  TileSettings ts_settings;
-  ts_settings.seed = opt.seed;
-  ts_settings.path.max_depth = opt.max_depth;
-  ts_settings.path.nee = opt.nee;
-  ts_settings.specialisation = stats.specialisation;
-  ts_settings.learn = stats.guide_learn = opt.guide_learn;
-  ts_settings.path.guided_roulette = opt.guide_roulette;
+  TileSettings settings = make_tile_settings(opt, stats.specialisation, guide != nullptr);
+  stats.guide_learn = opt.guide_learn;
   stats.guide_roulette = guide != nullptr && opt.guide_roulette;
-  const EmbreeTracer tracer = embree.tracer();
 
   const uint64_t pixels = static_cast<uint64_t>(w) * h;
   Progress progress(opt.progress, opt.spp > 0 ? pixels * opt.spp : 0, opt.time_budget_s);
-  std::atomic<uint64_t> samples_done{0};
-  std::mutex counters_mutex;
+  const double seconds_before = stats.seconds;  // a resumed render's time so far counts against --time
+  std::atomic<uint64_t> samples_done{stats.counters.samples};
   const auto start = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  auto elapsed = [&] {
+    return seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
 
-  uint32_t spp_done = 0;
-  double last_pass_s = 0.0;
-  for (uint32_t pass = 0;; ++pass) {
+  uint32_t spp_done = stats.spp;
+  double last_pass_s = stats.pass_stats.empty() ? 0.0 : stats.pass_stats.back().seconds;
+  for (uint32_t pass = stats.passes;; ++pass) {
     if (opt.spp > 0 && spp_done >= opt.spp) {
       stats.stop_reason = "spp";
       break;
@@ -66,29 +113,22 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
       stats.stop_reason = "time";
       break;
     }
-    // Pass sizes 1, 1, 2, 4, ... up to max_pass_spp: early passes are quick
-    // (a time budget gets fine granularity), later ones amortise overhead.
-    uint32_t pass_spp = std::min<uint32_t>(opt.max_pass_spp, pass == 0 ? 1u : (1u << std::min(pass - 1, 20u)));
+    uint32_t pass_spp = pass_spp_for(pass, opt.max_pass_spp);
     if (opt.spp > 0) pass_spp = std::min(pass_spp, opt.spp - spp_done);
     const double pass_start = elapsed();
     const TileCounters before = stats.counters;
-    if (guide) ts_settings.path.guide = guide->view();
-    arena.execute([&] {
-      tbb::parallel_for(size_t(0), tiles.size(), [&](size_t i) {
-        TileJob job = tiles[i];
-        job.sample_begin = spp_done;
-        job.sample_end = spp_done + pass_spp;
-        TileCounters tc = render_tile(view, tracer, ts_settings, job, result.film);
-        {
-          std::lock_guard<std::mutex> lock(counters_mutex);
-          stats.counters.add(tc);  // integer sums: order-independent
-        }
-        uint64_t done = samples_done.fetch_add(tc.samples) + tc.samples;
-        progress.advance(done, spp_done);
-      });
+    if (guide) settings.path.guide = guide->view();
+    std::vector<TileJob> jobs = tiles;
+    for (TileJob& job : jobs) {
+      job.sample_begin = spp_done;
+      job.sample_end = spp_done + pass_spp;
+    }
+    executor->render_pass(settings, jobs, result.film, &stats.counters, [&](uint64_t samples) {
+      progress.advance(samples_done.fetch_add(samples) + samples, spp_done);
     });
     if (guide) {
       const double fold_start = elapsed();
+      executor->reduce_guide(*guide);
       guide->fold();
       stats.guide_fold_seconds += elapsed() - fold_start;
     }
@@ -104,6 +144,9 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
     ps.guided_samples = stats.counters.path.guided_samples - before.path.guided_samples;
     ps.guidable_vertices = stats.counters.path.guidable_vertices - before.path.guidable_vertices;
     stats.pass_stats.push_back(ps);
+    stats.spp = spp_done;
+    stats.seconds = elapsed();
+    if (on_pass_end) on_pass_end(result, guide);
   }
   stats.spp = spp_done;
   stats.seconds = elapsed();

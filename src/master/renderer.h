@@ -1,8 +1,11 @@
-// The local render loop: passes of samples per pixel over all tiles (oneTBB).
-// Between passes is where later work (guide updates, farm syncs) plugs in.
+// The render loop: passes of samples per pixel over all tiles. A pass's
+// tiles are rendered by a PassExecutor: this process's threads (oneTBB), or
+// the farm (master/farm_master.h), which hands tiles to ranks. Between
+// passes the guide's learning is combined and folded in.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -47,12 +50,18 @@ struct RenderStats {
   TileCounters counters;
   uint32_t effects = 0;
   uint32_t specialisation = 0;
-  int32_t threads = 0;
+  int32_t threads = 0;              // all ranks together
+  int32_t ranks = 1;                // processes that rendered (farm)
+  uint32_t resumed_at_spp = 0;      // > 0: continued from a checkpoint at this many spp
   std::string stop_reason;
   std::vector<PassStats> pass_stats;
   std::string guide_mode = "none";  // none | qtable | qlearning
   GuideFieldStats guide;            // as the field stood at the end (when guided)
   double guide_fold_seconds = 0.0;
+  double guide_sync_seconds = 0.0;  // farm: time in guide all-reductions (rank 0's view)
+  uint64_t guide_sync_bytes = 0;    // farm: bytes all-reduced per sync
+  uint32_t guide_syncs = 0;
+  std::string guide_sync = "pass";  // pass | off (each rank learns alone)
   GuideLearnSchedule guide_learn;  // the learning schedule the render ran with
   bool guide_roulette = false;     // whether guide-driven roulette was on
 };
@@ -65,10 +74,60 @@ struct RenderResult {
 // The integrator specialisation a render with these options runs.
 uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options, bool guiding);
 
+// What every tile of a render is rendered with (the same on every rank).
+TileSettings make_tile_settings(const RenderOptions& options, uint32_t specialisation, bool guiding);
+
+// Threads a process renders with: options.threads, or (0) its share of the
+// machine's cores when several ranks of a farm run on one machine.
+int32_t render_threads(const RenderOptions& options, int32_t ranks_on_this_machine = 1);
+
+// Pass size schedule: 1, 1, 2, 4, ... up to max_pass_spp samples per pixel.
+// Early passes are quick (a time budget gets fine granularity, the guide
+// learns early), later ones amortise the per-pass overhead. Depends on the
+// pass index only, so a resumed render continues the same schedule.
+uint32_t pass_spp_for(uint32_t pass, uint32_t max_pass_spp);
+
+// Renders one pass of tiles and combines the guide's learning.
+class PassExecutor {
+ public:
+  virtual ~PassExecutor() = default;
+  // Renders every job (pixels and sample range) into film, adds the tiles'
+  // counters to *counters and calls on_tile_done(samples) after each tile
+  // (from any thread).
+  virtual void render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film,
+                           TileCounters* counters, const std::function<void(uint64_t)>& on_tile_done) = 0;
+  // Before a fold: makes the pass's guide accumulators the sum over
+  // everything that rendered it (a farm all-reduces them; locally they are).
+  virtual void reduce_guide(GuideField& guide) {}
+  // How many processes render (1 locally).
+  virtual int32_t ranks() const { return 1; }
+  virtual int32_t total_threads() const = 0;
+};
+
+// This process's threads (oneTBB), tiles handed out dynamically.
+class LocalPassExecutor : public PassExecutor {
+ public:
+  LocalPassExecutor(const EmbreeScene& embree, const SceneView& view, int32_t threads);
+  void render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film, TileCounters* counters,
+                   const std::function<void(uint64_t)>& on_tile_done) override;
+  int32_t total_threads() const override { return threads_; }
+
+ private:
+  EmbreeTracer tracer_;
+  const SceneView& view_;
+  int32_t threads_;
+};
+
+// Called after every pass (guide folded): where checkpoints are written.
+using PassEndHook = std::function<void(const RenderResult& so_far, const GuideField* guide)>;
+
 // Renders passes until options.spp or the time budget is reached. With a
 // guide, every pass samples from the field as it stood when the pass began
-// and the pass's learning is folded in before the next one.
+// and the pass's learning is folded in before the next one. `resume`
+// continues a render from a checkpoint (its film, passes and counters; the
+// guide is the caller's); `executor` defaults to this process's threads.
 RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& options,
-                    GuideField* guide = nullptr);
+                    GuideField* guide = nullptr, PassExecutor* executor = nullptr,
+                    const RenderResult* resume = nullptr, const PassEndHook& on_pass_end = {});
 
 }  // namespace tessera

@@ -51,6 +51,8 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
   j.add("height", uint64_t(height));
   j.add("seed", seed);
   j.add("threads", uint64_t(s.threads));
+  j.add("ranks", uint64_t(s.ranks));
+  if (s.resumed_at_spp > 0) j.add("resumed_at_spp", uint64_t(s.resumed_at_spp));
   j.add("spp", uint64_t(s.spp));
   j.add("passes", uint64_t(s.passes));
   j.add("seconds", s.seconds);
@@ -78,6 +80,13 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
     j.add("guide_targets_rejected_nonfinite", s.guide.rejected_nonfinite);
     j.add("guide_targets_rejected_large", s.guide.rejected_large);
     j.add("guide_fold_seconds", s.guide_fold_seconds);
+    if (s.ranks > 1) {
+      j.add_string("guide_sync", s.guide_sync);
+      j.add("guide_syncs", uint64_t(s.guide_syncs));
+      j.add("guide_sync_seconds", s.guide_sync_seconds);
+      j.add("guide_sync_bytes", s.guide_sync_bytes);
+      j.add("guide_sync_fraction", s.seconds > 0 ? s.guide_sync_seconds / s.seconds : 0.0);
+    }
     j.add("guide_learn_spp", uint64_t{s.guide_learn.all_spp});
     j.add("guide_learn_every", uint64_t{s.guide_learn.every});
     j.add_string("guide_roulette", s.guide_roulette ? "guided" : "throughput");

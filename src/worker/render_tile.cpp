@@ -8,13 +8,13 @@ namespace {
 
 template <uint32_t Spec>
 TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, const TileSettings& settings,
-                              const TileJob& job, Film& film) {
+                              const TileJob& job, TilePixels pixels) {
   TileCounters tc;
   PathSettings path = settings.path;
   for (int32_t y = job.y0; y < job.y1; ++y) {
     for (int32_t x = job.x0; x < job.x1; ++x) {
-      const uint64_t pixel_index = static_cast<uint64_t>(y) * static_cast<uint64_t>(film.width) + x;
-      PixelAccum& acc = film.at(x, y);
+      const uint64_t pixel_index = static_cast<uint64_t>(y) * static_cast<uint64_t>(s.camera.width) + x;
+      PixelAccum& acc = pixels.at(job, x, y);
       for (uint32_t si = job.sample_begin; si < job.sample_end; ++si) {
         Rng rng = Rng::for_sample(settings.seed, pixel_index, si);
         Vec2 offset = sample_filter_offset(s.filter, rng.uniform2());
@@ -42,7 +42,7 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
   return tc;
 }
 
-using TileFn = TileCounters (*)(const SceneView&, const EmbreeTracer&, const TileSettings&, const TileJob&, Film&);
+using TileFn = TileCounters (*)(const SceneView&, const EmbreeTracer&, const TileSettings&, const TileJob&, TilePixels);
 
 template <size_t... I>
 constexpr std::array<TileFn, sizeof...(I)> make_table(std::index_sequence<I...>) {
@@ -55,8 +55,8 @@ constexpr auto kTileFns = make_table(std::make_index_sequence<kSpecAll + 1>{});
 }  // namespace
 
 TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, const TileSettings& settings,
-                         const TileJob& job, Film& film) {
-  return kTileFns[settings.specialisation & kSpecAll](scene, tracer, settings, job, film);
+                         const TileJob& job, TilePixels pixels) {
+  return kTileFns[settings.specialisation & kSpecAll](scene, tracer, settings, job, pixels);
 }
 
 }  // namespace tessera

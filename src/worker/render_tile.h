@@ -59,7 +59,25 @@ struct TileCounters {
   }
 };
 
+// Where a tile's pixel accumulators live: pixel (x, y) of the job is at
+// origin[(y - y0) * stride + (x - x0)]. A local render points into the
+// image's film; a farm worker into the tile's own buffer.
+struct TilePixels {
+  PixelAccum* origin = nullptr;
+  int32_t stride = 0;
+  PixelAccum& at(const TileJob& job, int32_t x, int32_t y) const {
+    return origin[static_cast<size_t>(y - job.y0) * stride + (x - job.x0)];
+  }
+};
+
+// A tile of the image's film.
+inline TilePixels film_tile(Film& film, const TileJob& job) { return {&film.at(job.x0, job.y0), film.width}; }
+
+// Adds samples [sample_begin, sample_end) of every pixel of the job to its
+// accumulators, in sample order. Random streams depend on (seed, pixel index
+// in the whole image, sample index) only, so a tile renders the same
+// wherever it runs.
 TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, const TileSettings& settings,
-                         const TileJob& job, Film& film);
+                         const TileJob& job, TilePixels pixels);
 
 }  // namespace tessera

@@ -1,0 +1,93 @@
+// The messages of the render farm (rank 0 = master, others = workers).
+//
+//   setup     master -> all (broadcast): the parsed scene and the guide
+//             cache every rank starts from, or the error that stops them.
+//   Hello     worker -> master: how many threads it renders with.
+//   PassStart master -> worker: a pass begins (sample range is in the jobs).
+//   Request   worker -> master: the tiles it finished (pixel accumulators
+//             and counters) and a request for `capacity` more. A worker
+//             keeps kRequestsInFlight requests open so it never waits idle
+//             for its next tiles.
+//   Jobs      master -> worker: tiles to render, each with its pixel
+//             accumulators so far (so samples add in the same order as in
+//             a local render: the image is bit-identical); empty = none
+//             left in this pass.
+//   Stop      master -> worker: the render is over.
+//   Error     worker -> master: a worker failed (the master reports it and
+//             ends the job).
+// After a pass, every rank all-reduces the guide's accumulators (--guide-sync
+// pass) and folds them: identical sums, identical fields on every rank.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "comm/wire.h"
+#include "master/film.h"
+#include "worker/render_tile.h"
+
+namespace tessera {
+
+enum FarmTag : int32_t { kTagHello = 1, kTagPassStart, kTagRequest, kTagJobs, kTagStop, kTagError };
+
+constexpr uint32_t kRequestsInFlight = 2;
+
+struct FarmSetup {
+  std::string error;  // non-empty: the master could not start; workers exit
+  Bytes scene;        // encode_scene
+  Bytes guide;        // GuideField::save bytes, empty without guiding
+  template <class Archive>
+  void serialize(Archive& ar) {
+    ar(error, scene, guide);
+  }
+};
+
+struct FarmHello {
+  int32_t threads = 0;
+  template <class Archive>
+  void serialize(Archive& ar) {
+    ar(threads);
+  }
+};
+
+struct TileWork {
+  TileJob job;
+  std::vector<PixelAccum> pixels;  // row-major, (x1 - x0) * (y1 - y0)
+  template <class Archive>
+  void serialize(Archive& ar) {
+    ar(raw_value(job), raw(pixels));
+  }
+};
+
+struct TileRequest {
+  uint32_t capacity = 0;
+  std::vector<TileWork> results;
+  TileCounters counters;  // of the results
+  template <class Archive>
+  void serialize(Archive& ar) {
+    ar(capacity, results, raw_value(counters));
+  }
+};
+
+struct TileJobs {
+  std::vector<TileWork> jobs;
+  template <class Archive>
+  void serialize(Archive& ar) {
+    ar(jobs);
+  }
+};
+
+struct FarmError {
+  std::string message;
+  template <class Archive>
+  void serialize(Archive& ar) {
+    ar(message);
+  }
+};
+
+struct FarmEmpty {
+  template <class Archive>
+  void serialize(Archive&) {}
+};
+
+}  // namespace tessera

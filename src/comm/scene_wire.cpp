@@ -1,0 +1,25 @@
+#include "comm/scene_wire.h"
+
+#include "comm/wire.h"
+
+namespace tessera {
+
+template <class Archive>
+void serialize(Archive& ar, MeshDesc& m) {
+  ar(raw(m.p), raw(m.n), raw(m.uv), raw(m.indices), m.material, m.flip_normals, m.area_light, m.where);
+}
+template <class Archive>
+void serialize(Archive& ar, ImageDesc& i) {
+  ar(i.width, i.height, raw(i.texels), i.path);
+}
+template <class Archive>
+void serialize(Archive& ar, SceneDesc& d) {
+  ar(raw_value(d.camera.world_from_camera), d.camera.fov_degrees, d.camera.where);
+  ar(d.film.xres, d.film.yres, d.film.filename, raw_value(d.filter), d.spp, d.max_depth, d.seed);
+  ar(d.meshes, raw(d.materials), raw(d.textures), d.images, raw(d.area_lights), raw(d.lights), d.warnings, d.source);
+}
+
+Bytes encode_scene(const SceneDesc& desc) { return encode(desc); }
+SceneDesc decode_scene(const Bytes& bytes) { return decode<SceneDesc>(bytes); }
+
+}  // namespace tessera

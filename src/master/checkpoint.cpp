@@ -1,0 +1,109 @@
+#include "master/checkpoint.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "comm/wire.h"
+
+namespace tessera {
+namespace {
+
+constexpr char kMagic[] = "tessera-checkpoint";
+constexpr uint32_t kVersion = 1;
+
+// FNV-1a over the payload: any damaged byte is detected, not rendered.
+uint64_t fnv1a(const std::string& s) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+struct CheckpointBody {
+  Checkpoint* c;
+  template <class Archive>
+  void serialize(Archive& ar) {
+    RenderResult& r = c->so_far;
+    RenderStats& s = r.stats;
+    ar(r.film.width, r.film.height, raw(r.film.pixels));
+    ar(s.spp, s.passes, s.seconds, raw_value(s.counters), raw(s.pass_stats), s.guide_fold_seconds, s.guide_sync_seconds,
+       s.guide_syncs);
+    ar(c->guide);
+  }
+};
+
+}  // namespace
+
+uint64_t render_options_fingerprint(const RenderOptions& o, int32_t width, int32_t height, const std::string& guide_mode) {
+  std::ostringstream s;
+  s << width << 'x' << height << ' ' << o.seed << ' ' << o.max_depth << ' ' << o.nee << ' ' << o.max_pass_spp << ' '
+    << o.guide_learn.all_spp << ' ' << o.guide_learn.every << ' ' << o.guide_roulette << ' ' << guide_mode << ' '
+    << o.force_full_specialisation;
+  return fnv1a(s.str());
+}
+
+void write_checkpoint(const std::string& path, const RenderResult& so_far, const GuideField* guide,
+                      uint64_t scene_fingerprint, uint64_t options_fingerprint) {
+  Checkpoint c{so_far, {}};
+  if (guide) {
+    std::ostringstream g(std::ios::binary);
+    guide->save(g, scene_fingerprint);
+    const std::string gs = g.str();
+    c.guide.assign(gs.begin(), gs.end());
+  }
+  const Bytes body = encode(CheckpointBody{&c});
+  const std::string payload(body.begin(), body.end());
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) throw std::runtime_error("--checkpoint: cannot write " + tmp);
+    cereal::BinaryOutputArchive ar(f);
+    f.write(kMagic, sizeof kMagic);
+    ar(kVersion, scene_fingerprint, options_fingerprint, static_cast<uint64_t>(payload.size()), fnv1a(payload));
+    f.write(payload.data(), static_cast<std::streamsize>(payload.size()));
+    f.close();
+    if (!f) throw std::runtime_error("--checkpoint: cannot write " + tmp);
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+Checkpoint read_checkpoint(const std::string& path, uint64_t scene_fingerprint, uint64_t options_fingerprint) {
+  auto fail = [&](const std::string& why) { return std::runtime_error("--resume " + path + ": " + why); };
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw fail("cannot open");
+  char magic[sizeof kMagic] = {};
+  if (!f.read(magic, sizeof magic) || std::string(magic, sizeof magic) != std::string(kMagic, sizeof kMagic))
+    throw fail("not a Tessera checkpoint");
+  uint32_t version = 0;
+  uint64_t scene = 0, options = 0, size = 0, hash = 0;
+  try {
+    cereal::BinaryInputArchive ar(f);
+    ar(version, scene, options, size, hash);
+  } catch (const cereal::Exception&) {
+    throw fail("truncated checkpoint header");
+  }
+  if (version != kVersion)
+    throw fail("checkpoint version " + std::to_string(version) + ", this build reads version " + std::to_string(kVersion));
+  if (scene != scene_fingerprint) throw fail("checkpoint of another scene");
+  if (options != options_fingerprint)
+    throw fail("checkpoint made with other render options (resolution, seed, depth or guiding differ)");
+  if (size > (uint64_t(1) << 40)) throw fail("corrupt checkpoint (absurd size)");
+  std::string payload(static_cast<size_t>(size), '\0');
+  if (!f.read(payload.data(), static_cast<std::streamsize>(size))) throw fail("truncated checkpoint");
+  if (fnv1a(payload) != hash) throw fail("corrupt checkpoint (checksum mismatch)");
+  Checkpoint c;
+  try {
+    std::istringstream is(payload, std::ios::binary);
+    cereal::BinaryInputArchive ar(is);
+    CheckpointBody body{&c};
+    ar(body);
+  } catch (const std::exception& e) {
+    throw fail(std::string("corrupt checkpoint (") + e.what() + ")");
+  }
+  const Film& film = c.so_far.film;
+  if (film.width <= 0 || film.height <= 0 || film.pixels.size() != static_cast<size_t>(film.width) * film.height)
+    throw fail("corrupt checkpoint (film size)");
+  return c;
+}
+
+}  // namespace tessera

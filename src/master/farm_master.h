@@ -1,0 +1,44 @@
+// Rank 0 of the farm as a PassExecutor: hands a pass's tiles out to workers
+// on request (dynamic: fast ranks take more), renders tiles itself with its
+// own threads meanwhile, and puts returned tiles into the film. Between
+// passes it takes part in the guide's all-reduction like every rank.
+#pragma once
+
+#include <memory>
+
+#include "comm/transport.h"
+#include "master/renderer.h"
+
+namespace tessera {
+
+class FarmMaster : public PassExecutor {
+ public:
+  // Waits for every worker's Hello. local_threads (>= 1): the master's own
+  // rendering threads; they also answer the workers, between tiles.
+  FarmMaster(Transport& transport, const EmbreeScene& embree, const SceneView& view, int32_t local_threads,
+             bool sync_guide);
+  void render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film, TileCounters* counters,
+                   const std::function<void(uint64_t)>& on_tile_done) override;
+  void reduce_guide(GuideField& guide) override;
+  int32_t ranks() const override { return transport_.size(); }
+  int32_t total_threads() const override { return total_threads_; }
+  // Tells the workers the render is over.
+  void stop();
+
+  double sync_seconds() const { return sync_seconds_; }
+  uint64_t sync_bytes() const { return sync_bytes_; }
+  uint32_t syncs() const { return syncs_; }
+
+ private:
+  Transport& transport_;
+  EmbreeTracer tracer_;
+  const SceneView& view_;
+  int32_t local_threads_;
+  int32_t total_threads_;
+  bool sync_guide_;
+  double sync_seconds_ = 0.0;
+  uint64_t sync_bytes_ = 0;
+  uint32_t syncs_ = 0;
+};
+
+}  // namespace tessera
