@@ -263,17 +263,21 @@ int run_render_farm(const RenderArgs& a) {
       m = prepare_master(a, &setup.scene);
       if (m.guide) setup.guide = guide_bytes(*m.guide, *m.scene);
     } catch (const std::exception& e) {
+      // Printed before the workers hear of it: mpirun may end the job as
+      // soon as they exit.
+      std::fprintf(stderr, "tessera: error: %s\n", e.what());
+      std::fflush(stderr);
       setup = FarmSetup{e.what(), {}, {}};
       Bytes b = encode(setup);
       t->broadcast(b, 0);  // the workers stop too
-      throw;
+      return dynamic_cast<const SceneError*>(&e) ? 2 : 1;
     }
   }
   Bytes b = master ? encode(setup) : Bytes{};
   t->broadcast(b, 0);
   try {
     setup = decode<FarmSetup>(b);
-    if (!setup.error.empty()) return 1;  // the master reports it
+    if (!setup.error.empty()) return 0;  // the master reports it and exits non-zero
     if (!master) {
       SceneDesc desc = decode_scene(setup.scene);
       m.opt = make_options(a, desc);

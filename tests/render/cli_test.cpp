@@ -14,6 +14,7 @@
 #include <fstream>
 #include <string>
 
+#include "../cli_run.h"
 #include "render_helpers.h"
 
 namespace tessera {
@@ -21,20 +22,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int exit_code;
-  std::string output;  // stdout + stderr
-};
-
-RunResult run(const std::string& args) {
-  std::string cmd = std::string(TESSERA_BINARY) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128, out};
-}
+using testing::run;
+using testing::RunResult;
 
 class CliTest : public ::testing::Test {
  protected:

@@ -1,0 +1,150 @@
+// The farm end to end under mpirun: the same EXR as a local run for 1, 2
+// and 3 ranks; a render killed mid-way and resumed (on another number of
+// ranks) equals an uninterrupted one; bad checkpoints and scenes give one
+// clear error, a non-zero exit, and leave existing outputs alone.
+#include <OpenEXR/ImfArray.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+
+#include "../cli_run.h"
+#include "../render/render_helpers.h"
+
+namespace tessera {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::run;
+using testing::run_mpi;
+using testing::run_shell;
+using testing::RunResult;
+
+// Every channel of an EXR (RGB and the variance layer), as floats.
+std::vector<float> exr_channels(const std::string& path) {
+  Imf::InputFile file(path.c_str());
+  const Imath::Box2i dw = file.header().dataWindow();
+  const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
+  std::vector<std::string> names;
+  for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) names.push_back(it.name());
+  std::vector<float> data(static_cast<size_t>(w) * h * names.size());
+  Imf::FrameBuffer fb;
+  for (size_t c = 0; c < names.size(); ++c) {
+    float* base = data.data() + c * w * h - dw.min.x - dw.min.y * w;
+    fb.insert(names[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(base), sizeof(float), sizeof(float) * w));
+  }
+  file.setFrameBuffer(fb);
+  file.readPixels(dw.min.y, dw.max.y);
+  return data;
+}
+
+uint64_t json_number(const std::string& path, const std::string& key) {
+  std::ifstream f(path);
+  std::string text((std::istreambuf_iterator<char>(f)), {});
+  std::smatch m;
+  if (!std::regex_search(text, m, std::regex("\"" + key + "\": *([0-9]+)"))) return ~uint64_t(0);
+  return std::stoull(m[1]);
+}
+
+class FarmCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("tessera_farm_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+const std::string kDoor = testing::source_dir() + "/scenes/door-ajar.pbrt";
+
+TEST_F(FarmCliTest, MpirunWritesTheSameExrAsTheLocalRun) {
+  const std::string args = kDoor + " -q --no-preview --res 64x48 --spp 10 --seed 3";
+  RunResult local = run("render " + args + " -o " + path("local.exr") + " --stats " + path("local.json"));
+  ASSERT_EQ(local.exit_code, 0) << local.output;
+  const std::vector<float> expected = exr_channels(path("local.exr"));
+  for (int ranks : {1, 2, 3}) {
+    const std::string exr = path("farm" + std::to_string(ranks) + ".exr"), js = path("farm.json");
+    RunResult farm = run_mpi(ranks, "render " + args + " -o " + exr + " --stats " + js);
+    ASSERT_EQ(farm.exit_code, 0) << farm.output;
+    EXPECT_TRUE(exr_channels(exr) == expected) << ranks << " ranks: the image differs from the local run";
+    for (const char* key : {"paths", "rays", "shadow_rays", "guide_updates"})
+      EXPECT_EQ(json_number(js, key), json_number(path("local.json"), key)) << key << ", " << ranks << " ranks";
+    EXPECT_EQ(json_number(js, "ranks"), uint64_t(ranks));
+    if (ranks > 1) EXPECT_GT(json_number(js, "guide_syncs"), 0u);
+  }
+}
+
+TEST_F(FarmCliTest, KilledRenderResumesBitIdenticallyOnOtherRankCounts) {
+  const std::string args = kDoor + " -q --no-preview --res 128x96 --spp 160 --seed 4";
+  RunResult whole = run("render " + args + " -o " + path("whole.exr"));
+  ASSERT_EQ(whole.exit_code, 0) << whole.output;
+  // Checkpoint after every pass; SIGKILL shortly after the first one.
+  const std::string ck = path("render.ckpt");
+  RunResult killed = run_shell("(" + std::string(TESSERA_BINARY) + " render " + args + " -o " + path("killed.exr") +
+                               " --checkpoint " + ck + " --checkpoint-every 0 & P=$!; while [ ! -f " + ck +
+                               " ]; do sleep 0.01; done; sleep 0.3; kill -9 $P; wait $P; echo killed=$?)");
+  ASSERT_NE(killed.output.find("killed=137"), std::string::npos) << "the render finished before it was killed: " << killed.output;
+  EXPECT_FALSE(fs::exists(path("killed.exr")));
+  RunResult resumed = run_mpi(2, "render " + args + " -o " + path("resumed.exr") + " --resume " + ck);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(resumed.output, m, std::regex("resuming at ([0-9]+) spp"))) << resumed.output;
+  EXPECT_LT(std::stoi(m[1]), 160);
+  EXPECT_TRUE(exr_channels(path("resumed.exr")) == exr_channels(path("whole.exr")));
+}
+
+TEST_F(FarmCliTest, BadCheckpointsAreRefusedAndLeaveOutputsAlone) {
+  const std::string args = kDoor + " -q --no-preview --res 32x24 --spp 4 --seed 4";
+  const std::string ck = path("good.ckpt");
+  ASSERT_EQ(run("render " + args + " -o " + path("a.exr") + " --checkpoint " + ck).exit_code, 0);
+  std::string bytes;
+  {
+    std::ifstream f(ck, std::ios::binary);
+    bytes.assign((std::istreambuf_iterator<char>(f)), {});
+  }
+  std::ofstream(path("truncated.ckpt"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  std::string flipped = bytes;
+  flipped[flipped.size() * 3 / 4] ^= 0x5a;
+  std::ofstream(path("flipped.ckpt"), std::ios::binary) << flipped;
+  std::ofstream(path("out.exr")) << "a good image";
+
+  struct Case {
+    std::string args, expect;
+    int ranks;
+  } cases[] = {
+      {args + " --resume " + path("truncated.ckpt"), "truncated", 1},
+      {args + " --resume " + path("flipped.ckpt"), "checksum", 2},
+      {args + " --resume " + path("missing.ckpt"), "cannot open", 2},
+      {kDoor + " -q --no-preview --res 32x24 --spp 4 --seed 5 --resume " + ck, "other render options", 1},
+      {testing::source_dir() + "/scenes/cornell-box.pbrt -q --res 32x24 --spp 4 --seed 4 --resume " + ck,
+       "another scene", 2},
+  };
+  for (const Case& c : cases) {
+    RunResult r = c.ranks == 1 ? run("render " + c.args + " -o " + path("out.exr"))
+                               : run_mpi(c.ranks, "render " + c.args + " -o " + path("out.exr"));
+    EXPECT_NE(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("error: --resume"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(c.expect), std::string::npos) << r.output;
+    std::ifstream f(path("out.exr"));
+    EXPECT_EQ(std::string((std::istreambuf_iterator<char>(f)), {}), "a good image");
+  }
+}
+
+TEST_F(FarmCliTest, MissingSceneStopsEveryRank) {
+  RunResult r = run_mpi(3, "render " + path("nope.pbrt") + " -q -o " + path("x.exr"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("nope.pbrt:1: cannot open scene file"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("x.exr")));
+}
+
+}  // namespace
+}  // namespace tessera

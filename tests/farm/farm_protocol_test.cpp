@@ -1,0 +1,159 @@
+// The farm protocol in one process (InProcessTransport, ranks as threads):
+// any number of ranks renders the same image, counters and guide field as
+// the local renderer, bit for bit.
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "../render/render_helpers.h"
+#include "comm/farm_protocol.h"
+#include "comm/inproc_transport.h"
+#include "comm/scene_wire.h"
+#include "master/farm_master.h"
+#include "worker/farm_worker.h"
+
+namespace tessera {
+namespace {
+
+using testing::films_identical;
+
+struct FarmScene {
+  SceneData scene;
+  EmbreeScene embree;
+  RenderOptions opt;
+  explicit FarmScene(SceneDesc d) : scene(std::move(d)), embree(scene) {
+    opt.progress = false;
+    opt.spp = 12;
+    opt.max_depth = scene.desc().max_depth;
+    opt.seed = 5;
+    opt.threads = 1;
+  }
+  std::unique_ptr<GuideField> make_guide() const {
+    return std::make_unique<GuideField>(GuideConfig{}, scene.bounds().lo, scene.bounds().hi, scene.view().num_lights,
+                                        scene.max_emitted_radiance());
+  }
+};
+
+SceneDesc door_ajar() {
+  SceneDesc d = load_pbrt_file(testing::source_dir() + "/scenes/door-ajar.pbrt");
+  d.film.xres = 48;
+  d.film.yres = 36;
+  return d;
+}
+
+struct FarmRun {
+  RenderResult result;
+  std::vector<std::unique_ptr<GuideField>> guides;  // every rank's field at the end
+};
+
+// Rank 0 runs the master (1 rendering thread), ranks 1.. run workers.
+FarmRun render_farm(const FarmScene& fs, int32_t ranks, bool guided, bool sync) {
+  InProcessHub hub(ranks);
+  std::vector<std::unique_ptr<Transport>> ends;
+  FarmRun run;
+  for (int32_t r = 0; r < ranks; ++r) {
+    ends.push_back(hub.endpoint(r));
+    run.guides.push_back(guided ? fs.make_guide() : nullptr);
+  }
+  const uint32_t spec = effective_specialisation(fs.scene, fs.opt, guided);
+  std::vector<std::thread> workers;
+  for (int32_t r = 1; r < ranks; ++r) {
+    workers.emplace_back([&, r] {
+      run_farm_worker(*ends[r], fs.scene.view(), fs.embree, make_tile_settings(fs.opt, spec, guided),
+                      run.guides[r].get(), sync, 1);
+    });
+  }
+  FarmMaster master(*ends[0], fs.embree, fs.scene.view(), 1, sync);
+  run.result = render(fs.scene, fs.embree, fs.opt, run.guides[0].get(), &master);
+  master.stop();
+  for (auto& w : workers) w.join();
+  return run;
+}
+
+void expect_same_counters(const TileCounters& a, const TileCounters& b) {
+  EXPECT_EQ(a.samples, b.samples);
+  EXPECT_EQ(a.zero_radiance, b.zero_radiance);
+  EXPECT_EQ(a.path.rays, b.path.rays);
+  EXPECT_EQ(a.path.shadow_rays, b.path.shadow_rays);
+  EXPECT_EQ(a.path.guide_updates, b.path.guide_updates);
+  EXPECT_EQ(a.path.guided_samples, b.path.guided_samples);
+}
+
+TEST(FarmProtocol, UnguidedImageIsBitIdenticalForAnyRankCount) {
+  FarmScene fs(door_ajar());
+  RenderResult local = render(fs.scene, fs.embree, fs.opt);
+  for (int32_t ranks : {1, 2, 3}) {
+    FarmRun farm = render_farm(fs, ranks, false, true);
+    EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
+    expect_same_counters(farm.result.stats.counters, local.stats.counters);
+    EXPECT_EQ(farm.result.stats.ranks, ranks);
+  }
+}
+
+TEST(FarmProtocol, SharedGuideGivesTheLocalImageAndFieldOnEveryRank) {
+  FarmScene fs(door_ajar());
+  auto local_guide = fs.make_guide();
+  RenderResult local = render(fs.scene, fs.embree, fs.opt, local_guide.get());
+  ASSERT_GT(local.stats.counters.path.guided_samples, 0u);
+  for (int32_t ranks : {2, 3}) {
+    FarmRun farm = render_farm(fs, ranks, true, true);
+    EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
+    expect_same_counters(farm.result.stats.counters, local.stats.counters);
+    for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(*farm.guides[r] == *local_guide) << "rank " << r;
+  }
+}
+
+TEST(FarmProtocol, GuideSyncOffLetsEachRankLearnAlone) {
+  FarmScene fs(door_ajar());
+  FarmRun shared = render_farm(fs, 3, true, true);
+  FarmRun alone = render_farm(fs, 3, true, false);
+  // Every target reaches every field when shared; alone, a rank's field has
+  // only its own tiles' targets.
+  uint64_t alone_updates = 0;
+  for (const auto& g : alone.guides) {
+    EXPECT_LT(g->stats().updates, shared.guides[0]->stats().updates);
+    alone_updates += g->stats().updates;
+  }
+  EXPECT_GT(alone_updates, 0u);
+  for (const PixelAccum& p : alone.result.film.pixels)
+    for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(p.sum[c]));
+  EXPECT_EQ(alone.result.stats.counters.samples, shared.result.stats.counters.samples);
+}
+
+TEST(FarmProtocol, SceneSurvivesTheWire) {
+  SceneDesc d = door_ajar();
+  d.warnings.push_back("x:1: a warning");
+  SceneDesc back = decode_scene(encode_scene(d));
+  SceneData a(std::move(d)), b(std::move(back));
+  EXPECT_EQ(a.fingerprint(), b.fingerprint());
+  EXPECT_EQ(a.desc().film.xres, b.desc().film.xres);
+  EXPECT_EQ(a.desc().warnings, b.desc().warnings);
+  Bytes garbage{1, 2, 3};
+  EXPECT_THROW(decode_scene(garbage), std::runtime_error);
+}
+
+TEST(FarmProtocol, WorkerFailureReachesTheMaster) {
+  FarmScene fs(door_ajar());
+  InProcessHub hub(2);
+  auto master_end = hub.endpoint(0), worker_end = hub.endpoint(1);
+  std::thread worker([&] {
+    // A worker that says hello and then fails on its first pass.
+    worker_end->send(0, kTagHello, encode(FarmHello{1}));
+    worker_end->receive(0);
+    worker_end->send(0, kTagError, encode(FarmError{"out of device memory"}));
+    while (worker_end->receive(0).tag != kTagStop) {
+    }
+  });
+  FarmMaster master(*master_end, fs.embree, fs.scene.view(), 1, true);
+  try {
+    render(fs.scene, fs.embree, fs.opt, nullptr, &master);
+    ADD_FAILURE() << "the render should fail";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("rank 1: out of device memory"), std::string::npos) << e.what();
+  }
+  master.stop();
+  worker.join();
+}
+
+}  // namespace
+}  // namespace tessera
