@@ -16,6 +16,7 @@ PACKAGES=(
   libassimp-dev                   # PLY meshes (ASCII and binary)
   libstb-dev                      # PNG/JPEG read, PNG write
   python3                         # benchmark and test helper scripts
+  python3-matplotlib              # benchmark plots (scripts/bench_*.py)
 )
 
 missing=()
