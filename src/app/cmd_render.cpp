@@ -223,17 +223,20 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, const EmbreeS
   const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide != nullptr);
   log_setup(m, spec, executor ? executor->ranks() : 1);
   double last_checkpoint = m.resume ? m.resume->so_far.stats.seconds : 0.0;
+  uint32_t checkpointed_spp = ~0u;  // spp of the last checkpoint this run wrote (none yet)
   PassEndHook hook;
   if (!a.checkpoint.empty()) {
     hook = [&](const RenderResult& so_far, const GuideField* guide) {
       if (so_far.stats.seconds - last_checkpoint < a.checkpoint_every) return;
       write_checkpoint(a.checkpoint, so_far, guide, m.scene->fingerprint(), m.options_fingerprint);
       last_checkpoint = so_far.stats.seconds;
+      checkpointed_spp = so_far.stats.spp;
     };
   }
   RenderResult r = render(*m.scene, embree, m.opt, m.guide.get(), executor, m.resume ? &m.resume->so_far : nullptr, hook);
   // The finished render is a checkpoint too: --resume with a larger --spp continues it.
-  if (!a.checkpoint.empty()) write_checkpoint(a.checkpoint, r, m.guide.get(), m.scene->fingerprint(), m.options_fingerprint);
+  if (!a.checkpoint.empty() && checkpointed_spp != r.stats.spp)
+    write_checkpoint(a.checkpoint, r, m.guide.get(), m.scene->fingerprint(), m.options_fingerprint);
   if (add_stats) add_stats(r.stats);
   if (m.guide) save_guide(a.guide, *m.guide, *m.scene);
   write_outputs(a, m, r, spec);
