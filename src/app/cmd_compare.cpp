@@ -1,8 +1,11 @@
 // tessera compare IMAGE.exr REFERENCE.exr [--json]
 #include <cstdio>
+#include <filesystem>
 
 #include "app/commands.h"
+#include "master/error_estimate.h"
 #include "master/image_metrics.h"
+#include "master/image_output.h"
 #include "scene/image_io.h"
 
 namespace tessera {
@@ -15,6 +18,19 @@ ImageRgb to_image(const ImageDesc& d) {
   return img;
 }
 
+// relMSE an EXR's own variance layer predicts for it (< 0: no variance layer).
+double own_estimate(const std::string& path, const ImageRgb& mean) {
+  if (std::filesystem::path(path).extension() != ".exr") return -1.0;
+  std::optional<ImageRgb> var = read_exr_variance(path);
+  if (!var) return -1.0;
+  try {
+    ErrorEstimate e = estimate_rel_mse(mean, *var);
+    return e.valid ? e.rel_mse : -1.0;
+  } catch (const std::invalid_argument& ex) {
+    throw std::runtime_error(path + ": " + ex.what());
+  }
+}
+
 int run_compare(const std::string& image, const std::string& reference, bool json) {
   ImageRgb a = to_image(load_image(image)), f = to_image(load_image(reference));
   ImageErrors e;
@@ -23,11 +39,15 @@ int run_compare(const std::string& image, const std::string& reference, bool jso
   } catch (const std::invalid_argument& ex) {
     throw std::runtime_error(image + " vs " + reference + ": " + ex.what());
   }
+  // From the variance layers: the error the image expects of itself, and the
+  // reference's own noise, which the measured relMSE includes (about additively).
+  const double image_est = own_estimate(image, a), reference_est = own_estimate(reference, f);
   if (json) {
-    std::printf("{\"relmse\": %.9g, \"mape\": %.9g, \"rmse\": %.9g, \"nonfinite_pixels\": %llu, "
+    std::printf("{\"relmse\": %.9g, \"mape\": %.9g, \"rmse\": %.9g, \"estimated_relmse\": %.9g, "
+                "\"reference_estimated_relmse\": %.9g, \"nonfinite_pixels\": %llu, "
                 "\"reference_nonfinite_pixels\": %llu, \"pixels\": %llu, \"mean_rgb\": [%.6g, %.6g, %.6g], "
                 "\"reference_mean_rgb\": [%.6g, %.6g, %.6g]}\n",
-                e.rel_mse, e.mape, e.rmse, static_cast<unsigned long long>(e.nonfinite_pixels),
+                e.rel_mse, e.mape, e.rmse, image_est, reference_est, static_cast<unsigned long long>(e.nonfinite_pixels),
                 static_cast<unsigned long long>(e.reference_nonfinite_pixels), static_cast<unsigned long long>(e.pixels),
                 e.mean_image[0], e.mean_image[1], e.mean_image[2], e.mean_reference[0], e.mean_reference[1],
                 e.mean_reference[2]);
@@ -35,6 +55,8 @@ int run_compare(const std::string& image, const std::string& reference, bool jso
     std::printf("relMSE:           %.6g\n", e.rel_mse);
     std::printf("MAPE:             %.6g\n", e.mape);
     std::printf("RMSE:             %.6g\n", e.rmse);
+    if (image_est >= 0) std::printf("relMSE estimated: %.6g (from the image's variance layer)\n", image_est);
+    if (reference_est >= 0) std::printf("reference noise:  %.6g (relMSE its variance layer predicts; part of the relMSE above)\n", reference_est);
     std::printf("mean RGB:         %.5g %.5g %.5g (reference %.5g %.5g %.5g)\n", e.mean_image[0], e.mean_image[1],
                 e.mean_image[2], e.mean_reference[0], e.mean_reference[1], e.mean_reference[2]);
     std::printf("NaN/Inf pixels:   %llu (reference: %llu) of %llu\n", static_cast<unsigned long long>(e.nonfinite_pixels),

@@ -16,6 +16,7 @@
 #include "master/farm_master.h"
 #include "master/image_output.h"
 #include "master/renderer.h"
+#include "master/snapshots.h"
 #include "master/stats_json.h"
 #include "scene/scene_effects.h"
 #include "worker/cpu_affinity.h"
@@ -29,6 +30,8 @@ struct RenderArgs {
   int64_t spp = -1, max_depth = -1, threads = 0, tile = 16;
   int64_t seed = -1;
   double time = 0.0;
+  double target_error = 0.0;
+  std::string snapshot_every;
   bool quiet = false, no_preview = false, full_specialisation = false;
   std::string checkpoint, resume;
   double checkpoint_every = 60.0;
@@ -62,8 +65,10 @@ SceneDesc load_desc(const RenderArgs& a) {
 // farm derives the same options from the scene the master sends.
 RenderOptions make_options(const RenderArgs& a, const SceneDesc& desc) {
   RenderOptions opt;
-  opt.spp = (a.spp < 0 && a.time > 0) ? 0u : static_cast<uint32_t>(desc.spp);
+  // A time budget or a target error replaces the scene's sample count unless --spp is given too.
+  opt.spp = (a.spp < 0 && (a.time > 0 || a.target_error > 0)) ? 0u : static_cast<uint32_t>(desc.spp);
   opt.time_budget_s = a.time;
+  opt.target_error = a.target_error;
   opt.max_depth = desc.max_depth;
   opt.seed = desc.seed;
   opt.threads = static_cast<int32_t>(a.threads);
@@ -71,7 +76,8 @@ RenderOptions make_options(const RenderArgs& a, const SceneDesc& desc) {
   opt.progress = !a.quiet;
   opt.force_full_specialisation = a.full_specialisation;
   apply_guide_render_options(a.guide, &opt);
-  if (opt.spp == 0 && opt.time_budget_s <= 0) throw std::runtime_error("--spp 0 needs a --time budget");
+  if (opt.spp == 0 && opt.time_budget_s <= 0 && opt.target_error <= 0)
+    throw std::runtime_error("--spp 0 needs a --time budget or a --target-error");
   return opt;
 }
 
@@ -112,6 +118,7 @@ struct MasterSetup {
   std::string guide_why;
   std::optional<Checkpoint> resume;
   uint64_t options_fingerprint = 0;
+  SnapshotPolicy snapshots;
 };
 
 MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
@@ -119,6 +126,7 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   SceneDesc desc = load_desc(a);
   m.opt = make_options(a, desc);
   m.out = output_paths(a, desc);
+  if (!a.snapshot_every.empty()) m.snapshots = parse_snapshot_policy(a.snapshot_every);
   if (scene_bytes) *scene_bytes = encode_scene(desc);
   m.scene = std::make_unique<SceneData>(std::move(desc));
   m.guide = make_guide(a.guide, *m.scene, &m.guide_why);
@@ -156,6 +164,13 @@ void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks) {
   } else {
     std::fprintf(stderr, "tessera: guiding: none (%s)\n", m.guide_why.c_str());
   }
+  if (m.opt.target_error > 0) {
+    std::string limits;
+    if (m.opt.spp > 0) limits += " or " + std::to_string(m.opt.spp) + " spp";
+    if (m.opt.time_budget_s > 0) limits += " or " + std::to_string(m.opt.time_budget_s).substr(0, 8) + " s";
+    std::fprintf(stderr, "tessera: stops at estimated relMSE <= %g%s, whichever comes first%s\n", m.opt.target_error,
+                 limits.c_str(), limits.empty() ? " (no --time or --spp limit: runs until then)" : "");
+  }
   if (ranks > 1) std::fprintf(stderr, "tessera: farm: %d ranks (rank 0 schedules and renders)\n", ranks);
   if (m.resume)
     std::fprintf(stderr, "tessera: resuming at %u spp (%u passes) from checkpoint\n", m.resume->so_far.stats.spp,
@@ -170,19 +185,39 @@ void write_atomically(const std::string& path, Write write) {
   std::filesystem::rename(tmp, path);
 }
 
-void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult& r, uint32_t spec) {
+// What every image of this render records, final or snapshot.
+ExrMetadata base_metadata(const MasterSetup& m, uint32_t spec) {
+  ExrMetadata meta;
+  meta.strings["seed"] = std::to_string(m.opt.seed);
+  meta.strings["effects"] = describe_effects(m.scene->effects());
+  meta.strings["specialisation"] = describe_specialisation(spec);
+  meta.strings["software"] = "tessera " TESSERA_VERSION;
+  meta.strings["scene"] = m.scene->desc().source;
+  return meta;
+}
+
+// "time (target relMSE 1e-05 not reached: estimated 0.00031)"
+std::string describe_stop(const RenderStats& s) {
+  char b[160];
+  if (s.stop_reason == "target-error")
+    std::snprintf(b, sizeof b, "target-error (estimated relMSE %.3g <= %.3g)", s.estimated_rel_mse, s.target_error);
+  else if (s.target_error > 0 && s.estimated_rel_mse >= 0)
+    std::snprintf(b, sizeof b, "%s (target relMSE %.3g not reached: estimated %.3g)", s.stop_reason.c_str(), s.target_error,
+                  s.estimated_rel_mse);
+  else if (s.target_error > 0)
+    std::snprintf(b, sizeof b, "%s (target relMSE %.3g not reached: too few samples to estimate it)", s.stop_reason.c_str(),
+                  s.target_error);
+  else
+    std::snprintf(b, sizeof b, "%s", s.stop_reason.c_str());
+  return b;
+}
+
+void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult& r, uint32_t spec,
+                   const std::vector<SnapshotRecord>& snapshots) {
   const SceneData& scene = *m.scene;
   ImageRgb mean = film_mean(r.film), var = film_variance_of_mean(r.film);
-  ExrMetadata meta;
-  meta.numbers["spp"] = r.stats.spp;
-  meta.numbers["seconds"] = r.stats.seconds;
-  meta.numbers["ranks"] = r.stats.ranks;
-  meta.strings["seed"] = std::to_string(m.opt.seed);
-  meta.strings["effects"] = describe_effects(scene.effects());
-  meta.strings["specialisation"] = describe_specialisation(spec);
-  meta.strings["guide"] = r.stats.guide_mode;
-  meta.strings["software"] = "tessera " TESSERA_VERSION;
-  meta.strings["scene"] = scene.desc().source;
+  ExrMetadata meta = base_metadata(m, spec);
+  add_render_metadata(&meta, r.stats);
   write_atomically(m.out.exr, [&](const std::string& p) { write_exr(p, mean, &var, meta); });
   std::printf("wrote %s\n", m.out.exr.c_str());
   if (!m.out.preview.empty()) {
@@ -192,7 +227,8 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
   const TileCounters& c = r.stats.counters;
   std::fprintf(stderr, "tessera: %u spp in %.2fs (%.2f Msamples/s, %.2f Mrays/s), stopped by %s",
                r.stats.spp, r.stats.seconds, c.samples / std::max(r.stats.seconds, 1e-9) * 1e-6,
-               (c.path.rays + c.path.shadow_rays) / std::max(r.stats.seconds, 1e-9) * 1e-6, r.stats.stop_reason.c_str());
+               (c.path.rays + c.path.shadow_rays) / std::max(r.stats.seconds, 1e-9) * 1e-6, describe_stop(r.stats).c_str());
+  if (r.stats.estimated_rel_mse >= 0) std::fprintf(stderr, "; estimated relMSE %.3g", r.stats.estimated_rel_mse);
   if (c.rejected_nonfinite || c.rejected_negative)
     std::fprintf(stderr, "; rejected %llu NaN/Inf and %llu negative samples",
                  static_cast<unsigned long long>(c.rejected_nonfinite), static_cast<unsigned long long>(c.rejected_negative));
@@ -210,7 +246,7 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
   }
   if (!a.stats.empty()) {
     write_atomically(a.stats, [&](const std::string& p) {
-      write_text_file(p, stats_to_json(r.stats, scene.desc().source, mean.width, mean.height, m.opt.seed));
+      write_text_file(p, stats_to_json(r.stats, scene.desc().source, mean.width, mean.height, m.opt.seed, snapshots));
     });
     std::printf("wrote %s\n", a.stats.c_str());
   }
@@ -224,10 +260,13 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, const EmbreeS
   log_setup(m, spec, executor ? executor->ranks() : 1);
   double last_checkpoint = m.resume ? m.resume->so_far.stats.seconds : 0.0;
   uint32_t checkpointed_spp = ~0u;  // spp of the last checkpoint this run wrote (none yet)
+  std::optional<SnapshotWriter> snapshots;
+  if (m.snapshots.enabled()) snapshots.emplace(m.snapshots, m.out.exr, base_metadata(m, spec));
   PassEndHook hook;
-  if (!a.checkpoint.empty()) {
+  if (!a.checkpoint.empty() || snapshots) {
     hook = [&](const RenderResult& so_far, const GuideField* guide) {
-      if (so_far.stats.seconds - last_checkpoint < a.checkpoint_every) return;
+      if (snapshots) snapshots->on_pass_end(so_far);
+      if (a.checkpoint.empty() || so_far.stats.seconds - last_checkpoint < a.checkpoint_every) return;
       write_checkpoint(a.checkpoint, so_far, guide, m.scene->fingerprint(), m.options_fingerprint);
       last_checkpoint = so_far.stats.seconds;
       checkpointed_spp = so_far.stats.spp;
@@ -239,7 +278,7 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, const EmbreeS
     write_checkpoint(a.checkpoint, r, m.guide.get(), m.scene->fingerprint(), m.options_fingerprint);
   if (add_stats) add_stats(r.stats);
   if (m.guide) save_guide(a.guide, *m.guide, *m.scene);
-  write_outputs(a, m, r, spec);
+  write_outputs(a, m, r, spec, snapshots ? snapshots->records() : std::vector<SnapshotRecord>{});
   return r;
 }
 
@@ -329,7 +368,12 @@ CommandRunner add_render_command(CLI::App& app) {
   c->add_option("scene", a->scene, "Scene file in pbrt-v4 syntax (omit for the built-in Cornell box)");
   c->add_option("-o,--output", a->output, "Output EXR (default: the scene's Film filename in the current directory)");
   c->add_option("--spp", a->spp, "Samples per pixel (overrides the scene's Sampler)")->check(CLI::Range(0, 1 << 30));
-  c->add_option("--time", a->time, "Time budget in seconds: render whole passes until it is spent")->check(CLI::PositiveNumber);
+  c->add_option("--time", a->time, "Time budget in seconds: render whole passes until it is spent")->check(positive_number());
+  c->add_option("--target-error", a->target_error,
+                 "Stop after the first pass whose estimated relMSE is at or below this (with --time or --spp: whichever comes first)")
+      ->check(positive_number());
+  c->add_option("--snapshot-every", a->snapshot_every,
+                "Write the image so far every SECONDS, or at doubling sample counts ('doubling'), into <output>-snapshots/");
   c->add_option("--res", a->res, "Resolution WxH (overrides the scene's Film)");
   c->add_option("--max-depth", a->max_depth, "Maximum path depth, counted as pbrt-v4 does (overrides the Integrator)")->check(CLI::Range(0, 1 << 20));
   c->add_option("--seed", a->seed, "Random seed (same seed -> bit-identical image)")->check(CLI::NonNegativeNumber);

@@ -4,10 +4,29 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <string>
 
 namespace tessera {
 
 using CommandRunner = std::function<int()>;
+
+// A finite number > 0; the error reads "must be a positive number, got 'X'"
+// (CLI11's PositiveNumber prints its whole double range).
+inline CLI::Validator positive_number() {
+  return CLI::Validator(
+      [](std::string& in) -> std::string {
+        size_t used = 0;
+        double v = 0;
+        try {
+          v = std::stod(in, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == in.size() && v > 0 && v < 1e300) return {};
+        return "must be a positive number, got '" + in + "'";
+      },
+      "POSITIVE");
+}
 
 CommandRunner add_render_command(CLI::App& app);
 CommandRunner add_info_command(CLI::App& app);

@@ -10,7 +10,7 @@ namespace tessera {
 namespace {
 
 constexpr char kMagic[] = "tessera-checkpoint";
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;  // 2: per-pass error estimates
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.
 uint64_t fnv1a(const std::string& s) {
@@ -28,6 +28,7 @@ struct CheckpointBody {
     ar(r.film.width, r.film.height, raw(r.film.pixels));
     ar(s.spp, s.passes, s.seconds, raw_value(s.counters), raw(s.pass_stats), s.guide_fold_seconds, s.guide_sync_seconds,
        s.guide_syncs);
+    ar(s.estimated_rel_mse, s.pass_end_seconds);
     ar(c->guide);
   }
 };

@@ -29,7 +29,7 @@ ImageErrors compare_images(const ImageRgb& img, const ImageRgb& ref) {
       e.mean_image[c] += a[c];
       e.mean_reference[c] += f[c];
       double d = static_cast<double>(a[c]) - f[c];
-      rel += d * d / (static_cast<double>(f[c]) * f[c] + 1e-2);
+      rel += d * d / (static_cast<double>(f[c]) * f[c] + kRelMseEpsilon);
       sq += d * d;
     }
     // MAPE (seed thesis): |A - F| / A with A the reference, on luminance.

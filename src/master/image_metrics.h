@@ -7,8 +7,11 @@
 
 namespace tessera {
 
+// relMSE's regulariser: keeps near-black reference pixels from dominating.
+constexpr double kRelMseEpsilon = 1e-2;
+
 struct ImageErrors {
-  double rel_mse = 0;   // mean over pixels and channels of (A-F)^2 / (F^2 + 1e-2)
+  double rel_mse = 0;   // mean over pixels and channels of (A-F)^2 / (F^2 + kRelMseEpsilon)
   double mape = 0;      // mean over pixels of |A-F|/A on luminance, skipping A = 0
   double rmse = 0;
   uint64_t nonfinite_pixels = 0;  // pixels of the image with a NaN/Inf channel (excluded from the metrics)

@@ -4,6 +4,7 @@
 #include <OpenEXR/ImfDoubleAttribute.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <stb/stb_image_write.h>
@@ -14,6 +15,16 @@
 #include <vector>
 
 namespace tessera {
+
+void add_render_metadata(ExrMetadata* meta, const RenderStats& s) {
+  meta->numbers["spp"] = s.spp;
+  meta->numbers["seconds"] = s.seconds;
+  meta->numbers["ranks"] = s.ranks;
+  if (s.estimated_rel_mse >= 0) meta->numbers["estimated_relmse"] = s.estimated_rel_mse;
+  if (s.target_error > 0) meta->numbers["target_error"] = s.target_error;
+  if (!s.stop_reason.empty()) meta->strings["stop_reason"] = s.stop_reason;
+  meta->strings["guide"] = s.guide_mode;
+}
 
 void write_exr(const std::string& path, const ImageRgb& mean, const ImageRgb* variance, const ExrMetadata& meta) {
   try {
@@ -36,6 +47,29 @@ void write_exr(const std::string& path, const ImageRgb& mean, const ImageRgb* va
     file.writePixels(mean.height);
   } catch (const std::exception& e) {
     throw std::runtime_error("cannot write " + path + ": " + e.what());
+  }
+}
+
+std::optional<ImageRgb> read_exr_variance(const std::string& path) {
+  const char* var_names[3] = {"variance.R", "variance.G", "variance.B"};
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imf::Header& h = file.header();
+    for (const char* n : var_names)
+      if (!h.channels().findChannel(n)) return std::nullopt;
+    const Imath::Box2i dw = h.dataWindow();
+    ImageRgb img{dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1, {}};
+    img.rgb.assign(static_cast<size_t>(img.width) * img.height * 3, 0.f);
+    const size_t xs = 3 * sizeof(float), ys = xs * img.width;
+    // Slices are addressed by absolute pixel coordinates: offset the base by the window's origin.
+    char* base = reinterpret_cast<char*>(img.rgb.data()) - dw.min.x * xs - dw.min.y * ys;
+    Imf::FrameBuffer fb;
+    for (int c = 0; c < 3; ++c) fb.insert(var_names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    return img;
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot read " + path + ": " + e.what());
   }
 }
 

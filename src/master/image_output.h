@@ -3,9 +3,11 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 
 #include "master/film.h"
+#include "master/renderer.h"
 
 namespace tessera {
 
@@ -14,9 +16,17 @@ struct ExrMetadata {
   std::map<std::string, double> numbers;
 };
 
+// What a render's image records about how it was made: samples, time,
+// stop reason, estimated relMSE (and the target asked for), guide mode.
+void add_render_metadata(ExrMetadata* meta, const RenderStats& stats);
+
 // Channels R, G, B (the mean) and, when variance is given, variance.R/G/B
 // (variance of the pixel mean). Throws std::runtime_error naming the path.
 void write_exr(const std::string& path, const ImageRgb& mean, const ImageRgb* variance, const ExrMetadata& meta);
+
+// The variance layer of an EXR written by write_exr; nullopt when the file
+// has none. Throws std::runtime_error naming the path if it cannot be read.
+std::optional<ImageRgb> read_exr_variance(const std::string& path);
 
 // Linear radiance -> sRGB 8-bit, values clamped to [0, 1] (a preview only).
 void write_png_preview(const std::string& path, const ImageRgb& mean);

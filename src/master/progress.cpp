@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 
 namespace tessera {
 
@@ -28,26 +29,37 @@ void Progress::finish(uint64_t done, uint32_t spp) {
   print(done, spp, true);
 }
 
+void Progress::set_error(double estimated_rel_mse, double target_error) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  error_ = estimated_rel_mse;
+  target_ = target_error;
+}
+
 void Progress::print(uint64_t done, uint32_t spp, bool final) {
   double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   double rate = elapsed > 0 ? done / elapsed : 0.0;  // samples per second
   double frac = 0.0;
   if (total_ > 0) frac = std::min(1.0, static_cast<double>(done) / total_);
   if (budget_ > 0) frac = std::max(frac, std::min(1.0, elapsed / budget_));
+  // relMSE ~ 1/time: the share of the time to the target already spent is target/error.
+  if (target_ > 0 && error_ > 0) frac = std::max(frac, std::min(1.0, target_ / error_));
   double eta = frac > 0 ? elapsed * (1.0 - frac) / frac : 0.0;
-  char line[256];
+  char err[64] = "";
+  if (error_ >= 0) std::snprintf(err, sizeof err, "  relMSE~%.3g", error_);
+  if (error_ >= 0 && target_ > 0) std::snprintf(err + std::strlen(err), sizeof err - std::strlen(err), " (target %.3g)", target_);
+  char line[320];
   if (tty_) {
     constexpr int kWidth = 30;
     int filled = static_cast<int>(frac * kWidth);
     std::string bar(filled, '#');
     bar.resize(kWidth, '.');
-    std::snprintf(line, sizeof line, "\r[%s] %5.1f%%  %u spp  %.2f Msamples/s  %.1fs elapsed  ETA %.1fs ",
-                  bar.c_str(), 100 * frac, spp, rate * 1e-6, elapsed, final ? 0.0 : eta);
+    std::snprintf(line, sizeof line, "\r[%s] %5.1f%%  %u spp  %.2f Msamples/s  %.1fs elapsed  ETA %.1fs%s ",
+                  bar.c_str(), 100 * frac, spp, rate * 1e-6, elapsed, final ? 0.0 : eta, err);
     std::fputs(line, stderr);
     if (final) std::fputc('\n', stderr);
   } else {
-    std::snprintf(line, sizeof line, "progress: %5.1f%%  %u spp  %.2f Msamples/s  %.1fs elapsed  ETA %.1fs\n",
-                  100 * frac, spp, rate * 1e-6, elapsed, final ? 0.0 : eta);
+    std::snprintf(line, sizeof line, "progress: %5.1f%%  %u spp  %.2f Msamples/s  %.1fs elapsed  ETA %.1fs%s\n",
+                  100 * frac, spp, rate * 1e-6, elapsed, final ? 0.0 : eta, err);
     std::fputs(line, stderr);
   }
   std::fflush(stderr);

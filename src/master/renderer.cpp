@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "master/error_estimate.h"
 #include "master/progress.h"
 #include "worker/cpu_affinity.h"
 
@@ -102,11 +103,19 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
     return seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
 
+  stats.target_error = opt.target_error;
+  if (guide) stats.guide_mode = guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable";
+  if (!stats.pass_stats.empty()) progress.set_error(stats.estimated_rel_mse, opt.target_error);
+
   uint32_t spp_done = stats.spp;
   double last_pass_s = stats.pass_stats.empty() ? 0.0 : stats.pass_stats.back().seconds;
   for (uint32_t pass = stats.passes;; ++pass) {
     if (opt.spp > 0 && spp_done >= opt.spp) {
       stats.stop_reason = "spp";
+      break;
+    }
+    if (opt.target_error > 0 && stats.estimated_rel_mse >= 0 && stats.estimated_rel_mse <= opt.target_error) {
+      stats.stop_reason = "target-error";
       break;
     }
     if (opt.time_budget_s > 0 && pass > 0 && elapsed() + last_pass_s > opt.time_budget_s) {
@@ -143,17 +152,22 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
     ps.vertices = stats.counters.path.vertices - before.path.vertices;
     ps.guided_samples = stats.counters.path.guided_samples - before.path.guided_samples;
     ps.guidable_vertices = stats.counters.path.guidable_vertices - before.path.guidable_vertices;
+    const ErrorEstimate err = estimate_rel_mse(result.film);
+    ps.estimated_rel_mse = err.valid ? err.rel_mse : -1.0;
+    stats.estimated_rel_mse = ps.estimated_rel_mse;
+    progress.set_error(stats.estimated_rel_mse, opt.target_error);
     stats.pass_stats.push_back(ps);
     stats.spp = spp_done;
     stats.seconds = elapsed();
-    if (on_pass_end) on_pass_end(result, guide);
+    if (on_pass_end) {
+      const double hook_start = elapsed();
+      on_pass_end(result, guide);
+      stats.pass_end_seconds += elapsed() - hook_start;
+    }
   }
   stats.spp = spp_done;
   stats.seconds = elapsed();
-  if (guide) {
-    stats.guide = guide->stats();
-    stats.guide_mode = guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable";
-  }
+  if (guide) stats.guide = guide->stats();
   progress.finish(samples_done.load(), spp_done);
   return result;
 }

@@ -20,6 +20,7 @@ namespace tessera {
 struct RenderOptions {
   uint32_t spp = 16;            // 0 = unlimited (then time_budget_s must be set)
   double time_budget_s = 0.0;   // 0 = none; whole passes are rendered until it is spent
+  double target_error = 0.0;    // 0 = none; stop after the first pass whose estimated relMSE is <= this
   int32_t max_depth = 5;
   bool nee = true;
   uint64_t seed = 0;
@@ -41,6 +42,7 @@ struct PassStats {
   uint64_t vertices = 0;      // surface interactions
   uint64_t guided_samples = 0;
   uint64_t guidable_vertices = 0;
+  double estimated_rel_mse = -1.0;  // of the image after this pass; < 0 = not yet estimable
 };
 
 struct RenderStats {
@@ -53,7 +55,10 @@ struct RenderStats {
   int32_t threads = 0;              // all ranks together
   int32_t ranks = 1;                // processes that rendered (farm)
   uint32_t resumed_at_spp = 0;      // > 0: continued from a checkpoint at this many spp
-  std::string stop_reason;
+  std::string stop_reason;         // spp | time | target-error
+  double target_error = 0.0;       // the --target-error asked for (0 = none)
+  double estimated_rel_mse = -1.0; // of the final image, from its per-pixel variances (< 0 = too few samples)
+  double pass_end_seconds = 0.0;   // of `seconds`, spent in the pass-end hook (checkpoints, snapshots)
   std::vector<PassStats> pass_stats;
   std::string guide_mode = "none";  // none | qtable | qlearning
   GuideFieldStats guide;            // as the field stood at the end (when guided)
@@ -121,7 +126,8 @@ class LocalPassExecutor : public PassExecutor {
 // Called after every pass (guide folded): where checkpoints are written.
 using PassEndHook = std::function<void(const RenderResult& so_far, const GuideField* guide)>;
 
-// Renders passes until options.spp or the time budget is reached. With a
+// Renders passes until options.spp, the time budget or the target error is
+// reached, whichever comes first. With a
 // guide, every pass samples from the field as it stood when the pass began
 // and the pass's learning is folded in before the next one. `resume`
 // continues a render from a checkpoint (its film, passes and counters; the

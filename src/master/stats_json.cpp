@@ -39,7 +39,8 @@ struct JsonObject {
 
 }  // namespace
 
-std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_t width, int32_t height, uint64_t seed) {
+std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_t width, int32_t height, uint64_t seed,
+                          const std::vector<SnapshotRecord>& snapshots) {
   const TileCounters& c = s.counters;
   const double paths = static_cast<double>(c.samples);
   const double rays = static_cast<double>(c.path.rays + c.path.shadow_rays);
@@ -57,6 +58,10 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
   j.add("passes", uint64_t(s.passes));
   j.add("seconds", s.seconds);
   j.add_string("stop_reason", s.stop_reason);
+  if (s.target_error > 0) j.add("target_error", s.target_error);
+  // -1 when too few samples per pixel to estimate it.
+  j.add("estimated_relmse", s.estimated_rel_mse);
+  j.add("pass_end_seconds", s.pass_end_seconds);
   j.add("paths", c.samples);
   j.add("rays", c.path.rays + c.path.shadow_rays);
   j.add("camera_and_bounce_rays", c.path.rays);
@@ -104,9 +109,20 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
               ", \"seconds\": " + number(p.seconds) + ", \"zero_contribution_fraction\": " +
               number(p.zero_radiance / n) + ", \"mean_path_length\": " + number(p.vertices / n) +
               ", \"guided_sample_fraction\": " +
-              number(p.guidable_vertices ? double(p.guided_samples) / double(p.guidable_vertices) : 0.0) + "}";
+              number(p.guidable_vertices ? double(p.guided_samples) / double(p.guidable_vertices) : 0.0) +
+              ", \"estimated_relmse\": " + number(p.estimated_rel_mse) + "}";
   }
   j.add("per_pass", passes + "\n  ]");
+  if (!snapshots.empty()) {
+    std::string list = "[";
+    for (size_t i = 0; i < snapshots.size(); ++i) {
+      const SnapshotRecord& r = snapshots[i];
+      list += (i ? ",\n    " : "\n    ") + std::string("{\"file\": ") + quote(r.file) + ", \"spp\": " +
+              std::to_string(r.spp) + ", \"seconds\": " + number(r.seconds) + ", \"render_seconds\": " +
+              number(r.render_seconds) + ", \"estimated_relmse\": " + number(r.estimated_rel_mse) + "}";
+    }
+    j.add("snapshots", list + "\n  ]");
+  }
   return j.str();
 }
 

@@ -3,12 +3,15 @@
 
 #include <string>
 
+#include <vector>
+
 #include "master/renderer.h"
+#include "master/snapshots.h"
 
 namespace tessera {
 
 std::string stats_to_json(const RenderStats& stats, const std::string& scene, int32_t width, int32_t height,
-                          uint64_t seed);
+                          uint64_t seed, const std::vector<SnapshotRecord>& snapshots = {});
 void write_text_file(const std::string& path, const std::string& text);
 
 }  // namespace tessera

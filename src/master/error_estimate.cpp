@@ -1,0 +1,63 @@
+#include "master/error_estimate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "master/image_metrics.h"
+
+namespace tessera {
+
+namespace {
+
+// One channel of one pixel: Var[mean] / (F^2 + eps), F^2 = mean^2 - Var[mean].
+double rel_mse_term(double mean, double var_of_mean) {
+  const double f2 = std::max(0.0, mean * mean - var_of_mean);
+  return var_of_mean / (f2 + kRelMseEpsilon);
+}
+
+}  // namespace
+
+ErrorEstimate estimate_rel_mse(const Film& film) {
+  ErrorEstimate e;
+  if (film.pixels.empty()) return e;
+  double sum = 0.0;
+  for (const PixelAccum& p : film.pixels) {
+    if (p.n < kMinSppForErrorEstimate) return e;
+    const double n = static_cast<double>(p.n);
+    for (int c = 0; c < 3; ++c) {
+      const double mean = p.sum[c] / n;
+      // Sample variance from the double sums; rounding can make it slightly negative.
+      const double var = std::max(0.0, (p.sum_sq[c] - p.sum[c] * mean) / (n - 1.0));
+      sum += rel_mse_term(mean, var / n);
+    }
+  }
+  e.valid = std::isfinite(sum);
+  e.rel_mse = sum / (3.0 * static_cast<double>(film.pixels.size()));
+  return e;
+}
+
+ErrorEstimate estimate_rel_mse(const ImageRgb& mean, const ImageRgb& var) {
+  if (mean.width != var.width || mean.height != var.height)
+    throw std::invalid_argument("variance layer is " + std::to_string(var.width) + "x" + std::to_string(var.height) +
+                                ", image " + std::to_string(mean.width) + "x" + std::to_string(mean.height));
+  ErrorEstimate e;
+  double sum = 0.0;
+  uint64_t counted = 0;
+  const size_t n = static_cast<size_t>(mean.width) * mean.height;
+  for (size_t i = 0; i < n; ++i) {
+    const float* m = &mean.rgb[3 * i];
+    const float* v = &var.rgb[3 * i];
+    bool finite = true;
+    for (int c = 0; c < 3; ++c) finite = finite && std::isfinite(m[c]) && std::isfinite(v[c]) && v[c] >= 0;
+    if (!finite) continue;
+    for (int c = 0; c < 3; ++c) sum += rel_mse_term(m[c], v[c]);
+    ++counted;
+  }
+  e.valid = counted > 0;
+  e.rel_mse = counted > 0 ? sum / (3.0 * static_cast<double>(counted)) : 0.0;
+  return e;
+}
+
+}  // namespace tessera

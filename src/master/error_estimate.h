@@ -1,0 +1,36 @@
+// The image's error estimated from the film alone, while rendering: no
+// reference needed. Each pixel's sample variance gives the variance of its
+// mean; summed as compare_images sums squared errors, that is the expected
+// relMSE of the current image against the converged one.
+#pragma once
+
+#include <cstdint>
+
+#include "master/film.h"
+
+namespace tessera {
+
+// Samples per pixel below which the estimate is not given: a sample
+// variance from fewer samples is too noisy to stop a render on.
+constexpr uint64_t kMinSppForErrorEstimate = 4;
+
+struct ErrorEstimate {
+  bool valid = false;    // false below kMinSppForErrorEstimate samples in some pixel
+  double rel_mse = 0.0;  // estimated relMSE of film_mean(film) (the metric of compare_images)
+};
+
+// relMSE = mean over pixels and channels of Var[mean] / (F^2 + eps), with
+// Var[mean] the unbiased sample variance / n, and F^2 estimated without
+// bias as mean^2 - Var[mean] (at least 0): a pixel lit by one rare bright
+// sample must count as noisy, not as bright. Unbiased per pixel when the
+// samples of a pixel are independent with a common mean, which holds for
+// guided renders too (every pass's estimator is unbiased).
+ErrorEstimate estimate_rel_mse(const Film& film);
+
+// The same from an image and the variance of its mean (the variance layer
+// of a Tessera EXR): e.g. how noisy a reference itself still is. Pixels
+// with a NaN/Inf channel are skipped. Throws std::invalid_argument when
+// the sizes differ.
+ErrorEstimate estimate_rel_mse(const ImageRgb& mean, const ImageRgb& variance_of_mean);
+
+}  // namespace tessera
