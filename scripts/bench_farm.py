@@ -9,9 +9,8 @@ On one machine, with one rendering thread per rank (so ranks = cores used):
            guide's all-reductions
 N defaults to the machine's core count. Writes out/bench-farm/results.csv and
 out/bench-farm/scaling.png (matplotlib), and prints a table.
-The reference for the sync comparison is scripts/bench_guiding.py's cached
-one when present (out/bench-guiding/<scene>-reference.exr), else it is
-rendered here (unguided, --ref-spp) and cached.
+The reference for the sync comparison comes from scripts/reference.py's
+cache (rendered there, unguided, --ref-spp, on first use).
 """
 import argparse
 import csv
@@ -22,7 +21,10 @@ import subprocess
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import reference as ref_cache  # noqa: E402
+
+ROOT = ref_cache.ROOT
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
 
 
@@ -91,13 +93,7 @@ def main():
                   f"guide sync {100 * s.get('guide_sync_fraction', 0.0):.2f} % of the time", flush=True)
 
     # Shared versus per-rank guiding at equal time.
-    ref = os.path.join(ROOT, "out", "bench-guiding", f"{a.scene}-reference.exr")
-    if not os.path.exists(ref):
-        ref = os.path.join(a.out, f"{a.scene}-reference.exr")
-        if not os.path.exists(ref):
-            print(f"reference: {a.ref_spp} spp unguided ...", flush=True)
-            run([a.tessera, "render", a.scene_path, "-q", "--no-preview", "--guide", "none", "--spp", str(a.ref_spp),
-                 "--seed", "987654321", "-o", ref])
+    ref, _ = ref_cache.reference(a.scene_path, spp=a.ref_spp, tessera=a.tessera, log=lambda m: print(m, flush=True))
     n = max(2, n_max)
     for sync in ("pass", "off", "none"):
         errs, fracs = [], []

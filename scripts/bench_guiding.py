@@ -12,8 +12,8 @@ Reported per scene and method (median over --repeats seeds): relMSE against
 the reference, zero-contribution fraction, mean path length, time per sample.
 
 The reference of each scene is an unguided render of --ref-spp samples per
-pixel, cached under out/bench-guiding/ (its seed and time are recorded), so
-re-runs only pay for it once. Results: out/bench-guiding/results.json and a
+pixel, made and cached by scripts/reference.py (its command and time are
+recorded beside it), so re-runs only pay for it once. Results: out/bench-guiding/results.json and a
 table on stdout with the issue-3 targets checked.
 """
 import argparse
@@ -22,9 +22,11 @@ import os
 import statistics
 import subprocess
 import sys
-import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import reference as ref_cache  # noqa: E402
+
+ROOT = ref_cache.ROOT
 SCENES = ["cornell-box", "door-ajar", "shelter", "pillars", "glossy"]
 # relMSE(qtable) / relMSE(none) targets from issue 3.
 TARGETS = {"door-ajar": 0.25, "shelter": 0.5, "pillars": 0.5, "cornell-box": 1.1}
@@ -61,16 +63,8 @@ def main():
                "ref_spp": a.ref_spp, "scenes": {}}
     for scene in a.scenes:
         path = os.path.join(ROOT, "scenes", scene + ".pbrt")
-        ref = os.path.join(a.out, f"{scene}-reference.exr")
-        ref_meta = ref + ".json"
-        if not (os.path.exists(ref) and os.path.exists(ref_meta) and json.load(open(ref_meta)).get("spp") == a.ref_spp):
-            print(f"[{scene}] reference: {a.ref_spp} spp unguided ...", flush=True)
-            t0 = time.perf_counter()
-            run([a.tessera, "render", path, "-q", "--no-preview", "--guide", "none", "--spp", str(a.ref_spp),
-                 "--seed", "987654321", "-o", ref, *threads])
-            json.dump({"spp": a.ref_spp, "seconds": time.perf_counter() - t0, "guide": "none", "seed": 987654321},
-                      open(ref_meta, "w"))
-        meta = json.load(open(ref_meta))
+        ref, meta = ref_cache.reference(path, spp=a.ref_spp, tessera=a.tessera, threads=a.threads,
+                                        log=lambda m: print(f"[{scene}] {m}", flush=True))
         entry = {"reference": {"spp": meta["spp"], "seconds": meta["seconds"]}, "methods": {}}
         for method in a.methods:
             rows = []
