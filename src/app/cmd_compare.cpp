@@ -21,6 +21,9 @@ ImageRgb to_image(const ImageDesc& d) {
 // relMSE an EXR's own variance layer predicts for it (< 0: no variance layer).
 double own_estimate(const std::string& path, const ImageRgb& mean) {
   if (std::filesystem::path(path).extension() != ".exr") return -1.0;
+  // Below kMinSppForErrorEstimate the variance layer holds zeros or noise, not an estimate.
+  const std::optional<double> spp = read_exr_number(path, "spp");
+  if (spp && *spp < static_cast<double>(kMinSppForErrorEstimate)) return -1.0;
   std::optional<ImageRgb> var = read_exr_variance(path);
   if (!var) return -1.0;
   try {

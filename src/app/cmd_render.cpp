@@ -261,7 +261,7 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, const EmbreeS
   double last_checkpoint = m.resume ? m.resume->so_far.stats.seconds : 0.0;
   uint32_t checkpointed_spp = ~0u;  // spp of the last checkpoint this run wrote (none yet)
   std::optional<SnapshotWriter> snapshots;
-  if (m.snapshots.enabled()) snapshots.emplace(m.snapshots, m.out.exr, base_metadata(m, spec));
+  if (m.snapshots.enabled()) snapshots.emplace(m.snapshots, m.out.exr, base_metadata(m, spec), m.resume.has_value());
   PassEndHook hook;
   if (!a.checkpoint.empty() || snapshots) {
     hook = [&](const RenderResult& so_far, const GuideField* guide) {

@@ -73,6 +73,16 @@ std::optional<ImageRgb> read_exr_variance(const std::string& path) {
   }
 }
 
+std::optional<double> read_exr_number(const std::string& path, const std::string& name) {
+  try {
+    Imf::InputFile file(path.c_str());
+    if (const auto* a = file.header().findTypedAttribute<Imf::DoubleAttribute>(name)) return a->value();
+    return std::nullopt;
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot read " + path + ": " + e.what());
+  }
+}
+
 void write_png_preview(const std::string& path, const ImageRgb& mean) {
   std::vector<unsigned char> px(mean.rgb.size());
   for (size_t i = 0; i < mean.rgb.size(); ++i) {

@@ -28,6 +28,9 @@ void write_exr(const std::string& path, const ImageRgb& mean, const ImageRgb* va
 // has none. Throws std::runtime_error naming the path if it cannot be read.
 std::optional<ImageRgb> read_exr_variance(const std::string& path);
 
+// A numeric header attribute of an EXR (e.g. "spp"); nullopt when absent.
+std::optional<double> read_exr_number(const std::string& path, const std::string& name);
+
 // Linear radiance -> sRGB 8-bit, values clamped to [0, 1] (a preview only).
 void write_png_preview(const std::string& path, const ImageRgb& mean);
 

@@ -27,11 +27,20 @@ SnapshotPolicy parse_snapshot_policy(const std::string& text) {
   return p;
 }
 
-SnapshotWriter::SnapshotWriter(SnapshotPolicy policy, const std::string& output_exr, ExrMetadata base)
+SnapshotWriter::SnapshotWriter(SnapshotPolicy policy, const std::string& output_exr, ExrMetadata base, bool resumed)
     : policy_(policy), base_(std::move(base)) {
   const std::filesystem::path out(output_exr);
   stem_ = out.stem().string();
   dir_ = (out.parent_path() / (stem_ + "-snapshots")).string();
+  if (resumed) return;
+  // Only files this writer makes: <stem>-NNNNNNspp.exr and snapshots.csv.
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
+    const std::string name = entry.path().filename().string();
+    const bool ours = name == "snapshots.csv" ||
+                      (name.rfind(stem_ + "-", 0) == 0 && name.size() > 7 && name.substr(name.size() - 7) == "spp.exr");
+    if (ours) std::filesystem::remove(entry.path(), ec);
+  }
 }
 
 void SnapshotWriter::on_pass_end(const RenderResult& so_far) {

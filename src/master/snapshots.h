@@ -33,10 +33,12 @@ struct SnapshotRecord {
 
 // Writes <dir>/<stem>-snapshots/<stem>-<spp>spp.exr (mean + variance, with
 // the render's metadata) and appends a line per snapshot to snapshots.csv
-// there, so an interrupted render keeps its record too.
+// there, so an interrupted render keeps its record too. A fresh render
+// first removes the snapshots of an earlier one of the same output; a
+// resumed render (`resumed`) continues its record.
 class SnapshotWriter {
  public:
-  SnapshotWriter(SnapshotPolicy policy, const std::string& output_exr, ExrMetadata base);
+  SnapshotWriter(SnapshotPolicy policy, const std::string& output_exr, ExrMetadata base, bool resumed = false);
   // Called after every pass; writes a snapshot when one is due.
   void on_pass_end(const RenderResult& so_far);
   const std::vector<SnapshotRecord>& records() const { return records_; }

@@ -79,7 +79,9 @@ TEST_F(FarmCliTest, MpirunWritesTheSameExrAsTheLocalRun) {
     for (const char* key : {"paths", "rays", "shadow_rays", "guide_updates"})
       EXPECT_EQ(json_number(js, key), json_number(path("local.json"), key)) << key << ", " << ranks << " ranks";
     EXPECT_EQ(json_number(js, "ranks"), uint64_t(ranks));
-    if (ranks > 1) EXPECT_GT(json_number(js, "guide_syncs"), 0u);
+    if (ranks > 1) {
+      EXPECT_GT(json_number(js, "guide_syncs"), 0u);
+    }
   }
 }
 
