@@ -166,8 +166,12 @@ void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks) {
   }
   if (m.opt.target_error > 0) {
     std::string limits;
+    char b[48];
     if (m.opt.spp > 0) limits += " or " + std::to_string(m.opt.spp) + " spp";
-    if (m.opt.time_budget_s > 0) limits += " or " + std::to_string(m.opt.time_budget_s).substr(0, 8) + " s";
+    if (m.opt.time_budget_s > 0) {
+      std::snprintf(b, sizeof b, " or %g s", m.opt.time_budget_s);
+      limits += b;
+    }
     std::fprintf(stderr, "tessera: stops at estimated relMSE <= %g%s, whichever comes first%s\n", m.opt.target_error,
                  limits.c_str(), limits.empty() ? " (no --time or --spp limit: runs until then)" : "");
   }
