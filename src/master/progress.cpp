@@ -44,9 +44,12 @@ void Progress::print(uint64_t done, uint32_t spp, bool final) {
   // relMSE ~ 1/time: the share of the time to the target already spent is target/error.
   if (target_ > 0 && error_ > 0) frac = std::max(frac, std::min(1.0, target_ / error_));
   double eta = frac > 0 ? elapsed * (1.0 - frac) / frac : 0.0;
-  char err[64] = "";
+  char err[96] = "";
   if (error_ >= 0) std::snprintf(err, sizeof err, "  relMSE~%.3g", error_);
-  if (error_ >= 0 && target_ > 0) std::snprintf(err + std::strlen(err), sizeof err - std::strlen(err), " (target %.3g)", target_);
+  // How long the requested accuracy will take, even when --time or --spp ends the render first.
+  if (error_ > 0 && target_ > 0)
+    std::snprintf(err + std::strlen(err), sizeof err - std::strlen(err), " (target %.3g in ~%.0fs)", target_,
+                  std::max(0.0, elapsed * (error_ / target_ - 1.0)));
   char line[320];
   if (tty_) {
     constexpr int kWidth = 30;
