@@ -11,13 +11,6 @@
 namespace tessera {
 namespace {
 
-ImageRgb to_image(const ImageDesc& d) {
-  ImageRgb img{d.width, d.height, std::vector<float>(d.texels.size() * 3)};
-  for (size_t i = 0; i < d.texels.size(); ++i)
-    for (int c = 0; c < 3; ++c) img.rgb[3 * i + c] = d.texels[i][c];
-  return img;
-}
-
 // relMSE an EXR's own variance layer predicts for it (< 0: no variance layer).
 double own_estimate(const std::string& path, const ImageRgb& mean) {
   if (std::filesystem::path(path).extension() != ".exr") return -1.0;
@@ -35,7 +28,7 @@ double own_estimate(const std::string& path, const ImageRgb& mean) {
 }
 
 int run_compare(const std::string& image, const std::string& reference, bool json) {
-  ImageRgb a = to_image(load_image(image)), f = to_image(load_image(reference));
+  ImageRgb a = to_image_rgb(load_image(image)), f = to_image_rgb(load_image(reference));
   ImageErrors e;
   try {
     e = compare_images(a, f);

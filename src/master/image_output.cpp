@@ -14,6 +14,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "scene/image_io.h"
+
 namespace tessera {
 
 void add_render_metadata(ExrMetadata* meta, const RenderStats& s) {
@@ -50,27 +52,17 @@ void write_exr(const std::string& path, const ImageRgb& mean, const ImageRgb* va
   }
 }
 
+ImageRgb to_image_rgb(const ImageDesc& d) {
+  ImageRgb img{d.width, d.height, std::vector<float>(d.texels.size() * 3)};
+  for (size_t i = 0; i < d.texels.size(); ++i)
+    for (int c = 0; c < 3; ++c) img.rgb[3 * i + c] = d.texels[i][c];
+  return img;
+}
+
 std::optional<ImageRgb> read_exr_variance(const std::string& path) {
-  const char* var_names[3] = {"variance.R", "variance.G", "variance.B"};
-  try {
-    Imf::InputFile file(path.c_str());
-    const Imf::Header& h = file.header();
-    for (const char* n : var_names)
-      if (!h.channels().findChannel(n)) return std::nullopt;
-    const Imath::Box2i dw = h.dataWindow();
-    ImageRgb img{dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1, {}};
-    img.rgb.assign(static_cast<size_t>(img.width) * img.height * 3, 0.f);
-    const size_t xs = 3 * sizeof(float), ys = xs * img.width;
-    // Slices are addressed by absolute pixel coordinates: offset the base by the window's origin.
-    char* base = reinterpret_cast<char*>(img.rgb.data()) - dw.min.x * xs - dw.min.y * ys;
-    Imf::FrameBuffer fb;
-    for (int c = 0; c < 3; ++c) fb.insert(var_names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
-    file.setFrameBuffer(fb);
-    file.readPixels(dw.min.y, dw.max.y);
-    return img;
-  } catch (const std::exception& e) {
-    throw std::runtime_error("cannot read " + path + ": " + e.what());
-  }
+  std::optional<ImageDesc> var = load_exr_layer(path, {"variance.R", "variance.G", "variance.B"});
+  if (!var) return std::nullopt;
+  return to_image_rgb(*var);
 }
 
 std::optional<double> read_exr_number(const std::string& path, const std::string& name) {

@@ -8,6 +8,7 @@
 
 #include "master/film.h"
 #include "master/renderer.h"
+#include "scene/scene_desc.h"
 
 namespace tessera {
 
@@ -24,8 +25,11 @@ void add_render_metadata(ExrMetadata* meta, const RenderStats& stats);
 // (variance of the pixel mean). Throws std::runtime_error naming the path.
 void write_exr(const std::string& path, const ImageRgb& mean, const ImageRgb* variance, const ExrMetadata& meta);
 
+// An image as loaded (scene/image_io.h) as the RGB floats metrics work on.
+ImageRgb to_image_rgb(const ImageDesc& image);
+
 // The variance layer of an EXR written by write_exr; nullopt when the file
-// has none. Throws std::runtime_error naming the path if it cannot be read.
+// has none. Throws SceneError naming the path if it cannot be read.
 std::optional<ImageRgb> read_exr_variance(const std::string& path);
 
 // A numeric header attribute of an EXR (e.g. "spp"); nullopt when absent.

@@ -39,38 +39,44 @@ Float decode(Float v, const ColorEncoding& e) {
   return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
 }
 
-// R, G, B read as 32-bit floats whatever the file stores: RgbaInputFile
-// converts to half, which turns values above 65504 (a sun in an environment
-// map, a firefly in a render) into Inf and rounds the rest to 11 bits.
-ImageDesc load_exr_rgb_float(const std::string& path, Imf::InputFile& file) {
-  const Imath::Box2i dw = file.header().dataWindow();
-  const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
-  std::vector<float> rgb(static_cast<size_t>(w) * h * 3, 0.f);
-  const size_t xs = 3 * sizeof(float), ys = xs * w;
-  // Slices are addressed by absolute pixel coordinates: offset the base by the window's origin.
-  char* base = reinterpret_cast<char*>(rgb.data()) - dw.min.x * static_cast<ptrdiff_t>(xs) - dw.min.y * static_cast<ptrdiff_t>(ys);
-  Imf::FrameBuffer fb;
-  const char* names[3] = {"R", "G", "B"};
-  for (int c = 0; c < 3; ++c) fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
-  file.setFrameBuffer(fb);
-  file.readPixels(dw.min.y, dw.max.y);
-  ImageDesc img;
-  img.width = w;
-  img.height = h;
-  img.path = path;
-  img.texels.resize(static_cast<size_t>(w) * h);
-  for (size_t i = 0; i < img.texels.size(); ++i) img.texels[i] = Rgb(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
-  return img;
+}  // namespace
+
+std::optional<ImageDesc> load_exr_layer(const std::string& path, const std::array<const char*, 3>& channels) {
+  try {
+    Imf::InputFile file(path.c_str());
+    for (const char* name : channels)
+      if (!file.header().channels().findChannel(name)) return std::nullopt;
+    const Imath::Box2i dw = file.header().dataWindow();
+    const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
+    ImageDesc img;
+    img.width = w;
+    img.height = h;
+    img.path = path;
+    img.texels.resize(static_cast<size_t>(w) * h);
+    static_assert(sizeof(Rgb) == 3 * sizeof(float), "texels are read in place as 3 floats");
+    const size_t xs = sizeof(Rgb), ys = xs * w;
+    // Slices are addressed by absolute pixel coordinates: offset the base by the window's origin.
+    char* base = reinterpret_cast<char*>(img.texels.data()) - dw.min.x * static_cast<ptrdiff_t>(xs) -
+                 dw.min.y * static_cast<ptrdiff_t>(ys);
+    Imf::FrameBuffer fb;
+    for (int c = 0; c < 3; ++c) fb.insert(channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    return img;
+  } catch (const std::exception& e) {
+    fail(path, e.what());
+  }
 }
 
+namespace {
+
 ImageDesc load_exr(const std::string& path) {
+  // R, G, B as 32-bit floats: OpenEXR's RGBA interface converts to half,
+  // which turns values above 65504 (a sun in an environment map, a firefly
+  // in a render) into Inf and rounds the rest to 11 bits.
+  if (std::optional<ImageDesc> rgb = load_exr_layer(path, {"R", "G", "B"})) return std::move(*rgb);
   try {
-    {
-      Imf::InputFile file(path.c_str());
-      const Imf::ChannelList& ch = file.header().channels();
-      if (ch.findChannel("R") && ch.findChannel("G") && ch.findChannel("B")) return load_exr_rgb_float(path, file);
-    }
-    // Luminance/chroma or partial files: OpenEXR's RGBA interface reconstructs RGB (at half precision).
+    // Luminance/chroma files: the RGBA interface reconstructs RGB (at half precision).
     Imf::RgbaInputFile file(path.c_str());
     Imath::Box2i dw = file.dataWindow();
     const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;

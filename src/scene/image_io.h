@@ -1,6 +1,7 @@
 // Reading texture and environment images into linear RGB.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 
@@ -22,6 +23,11 @@ std::optional<ColorEncoding> parse_color_encoding(const std::string& text);
 // PNG/JPEG/TGA/BMP/HDR (stb_image) or EXR (OpenEXR). Row 0 is the top of the
 // file. Throws SceneError("cannot read image '<path>': <reason>").
 ImageDesc load_image(const std::string& path);  // 8-bit data treated as sRGB
+
+// Three channels of an EXR as 32-bit floats (e.g. {"R","G","B"} or a
+// layer such as {"variance.R","variance.G","variance.B"}); nullopt when
+// the file lacks one of them. Throws SceneError like load_image.
+std::optional<ImageDesc> load_exr_layer(const std::string& path, const std::array<const char*, 3>& channels);
 ImageDesc load_image(const std::string& path, const ColorEncoding& encoding);
 
 }  // namespace tessera

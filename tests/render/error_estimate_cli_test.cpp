@@ -19,7 +19,9 @@
 #include <vector>
 
 #include "../cli_run.h"
+#include "../exr_read.h"
 #include "master/image_output.h"
+#include "furnace_scene.h"
 #include "render_helpers.h"
 
 namespace tessera {
@@ -28,22 +30,7 @@ namespace {
 namespace fs = std::filesystem;
 using testing::run;
 using testing::RunResult;
-
-// The closed-sphere furnace (furnace_test.cpp), 16x16. Its Sampler asks for
-// 4 spp: --target-error must replace that, as --time does.
-const char* kFurnace = R"(
-LookAt 0 0 0  0 0 1  0 1 0
-Camera "perspective" "float fov" [ 60 ]
-Film "rgb" "integer xresolution" [ 16 ] "integer yresolution" [ 16 ]
-Sampler "independent" "integer pixelsamples" [ 4 ]
-Integrator "path" "integer maxdepth" [ 5 ]
-WorldBegin
-AttributeBegin
-  Material "diffuse" "rgb reflectance" [ 0.5 0.5 0.5 ]
-  AreaLightSource "diffuse" "rgb L" [ 1 1 1 ] "bool twosided" true
-  Shape "sphere" "float radius" [ 10 ]
-AttributeEnd
-)";
+using testing::exr_channels;
 
 std::string read_text(const fs::path& p) {
   std::ifstream f(p);
@@ -64,24 +51,6 @@ std::vector<double> json_numbers(const std::string& json, const std::string& key
   for (auto it = std::sregex_iterator(json.begin(), json.end(), re); it != std::sregex_iterator(); ++it)
     out.push_back(std::stod((*it)[1]));
   return out;
-}
-
-// Every channel of an EXR (RGB and the variance layer), as stored (float).
-std::vector<float> exr_channels(const std::string& path) {
-  Imf::InputFile file(path.c_str());
-  const Imath::Box2i dw = file.header().dataWindow();
-  const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
-  std::vector<std::string> names;
-  for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) names.push_back(it.name());
-  std::vector<float> data(static_cast<size_t>(w) * h * names.size());
-  Imf::FrameBuffer fb;
-  for (size_t c = 0; c < names.size(); ++c) {
-    float* base = data.data() + c * w * h - dw.min.x - dw.min.y * w;
-    fb.insert(names[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(base), sizeof(float), sizeof(float) * w));
-  }
-  file.setFrameBuffer(fb);
-  file.readPixels(dw.min.y, dw.max.y);
-  return data;
 }
 
 double exr_number(const std::string& path, const char* name) {
@@ -116,7 +85,8 @@ class ErrorEstimateCli : public ::testing::Test {
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     furnace_ = (dir_ / "furnace.pbrt").string();
-    std::ofstream(furnace_) << kFurnace;
+    // 16x16; its Sampler asks for 4 spp: --target-error must replace that, as --time does.
+    std::ofstream(furnace_) << testing::furnace_scene(0.5, 5, 16, 4);
   }
   void TearDown() override { fs::remove_all(dir_); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }

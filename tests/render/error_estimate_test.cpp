@@ -19,10 +19,14 @@
 
 #include "master/error_estimate.h"
 #include "master/image_metrics.h"
+#include "furnace_scene.h"
 #include "render_helpers.h"
 
 namespace tessera {
 namespace {
+
+using testing::expected_furnace;
+using testing::furnace_scene;
 
 // Adds one sample (the same value in all channels unless given per channel).
 void add(PixelAccum& p, double r, double g, double b) {
@@ -161,32 +165,6 @@ TEST(ErrorEstimate, ImageOverloadSkipsNonFinitePixelsAndChecksSizes) {
 
 // ---- Against the truth, on the analytic furnace ------------------------------
 
-// Closed emitting sphere of albedo rho seen from inside: every pixel is
-// sum_{k=0..D} rho^k (see furnace_test.cpp), with real per-path variance
-// (NEE + MIS and Russian roulette).
-std::string furnace_scene(double rho, int max_depth, int res) {
-  char buf[1024];
-  std::snprintf(buf, sizeof buf, R"(
-LookAt 0 0 0  0 0 1  0 1 0
-Camera "perspective" "float fov" [ 60 ]
-Film "rgb" "integer xresolution" [ %d ] "integer yresolution" [ %d ]
-Integrator "path" "integer maxdepth" [ %d ]
-WorldBegin
-AttributeBegin
-  Material "diffuse" "rgb reflectance" [ %g %g %g ]
-  AreaLightSource "diffuse" "rgb L" [ 1 1 1 ] "bool twosided" true
-  Shape "sphere" "float radius" [ 10 ]
-AttributeEnd
-)", res, res, max_depth, rho, rho, rho);
-  return buf;
-}
-
-double expected_furnace(double rho, int depth) {
-  double s = 0, r = 1;
-  for (int k = 0; k <= depth; ++k, r *= rho) s += r;
-  return s;
-}
-
 struct AtSpp {
   double measured_sum = 0, estimated_sum = 0;  // summed over seeds
 };
@@ -215,7 +193,7 @@ TEST(ErrorEstimate, MatchesMeasuredRelMseOnFurnace) {
   const ImageRgb truth{kRes, kRes, std::vector<float>(kRes * kRes * 3, static_cast<float>(truth_value))};
   std::map<uint32_t, AtSpp> at;
   for (uint64_t seed : {1u, 2u}) {
-    SceneDesc desc = load_pbrt_string(furnace_scene(kRho, kDepth, kRes), "<furnace>", ".");
+    SceneDesc desc = load_pbrt_string(furnace_scene(kRho, kDepth, kRes, 0), "<furnace>", ".");
     RenderOptions opt;
     opt.progress = false;
     opt.spp = 256;
@@ -253,7 +231,7 @@ TEST(ErrorEstimate, MatchesMeasuredRelMseOnFurnace) {
 // that with room. A variance not divided by n would give ~1, one divided by
 // n^2 ~1/16.
 TEST(ErrorEstimate, PerPassEstimatesFallAsOneOverSpp) {
-  SceneDesc desc = load_pbrt_string(furnace_scene(0.5, 5, 32), "<furnace>", ".");
+  SceneDesc desc = load_pbrt_string(furnace_scene(0.5, 5, 32, 0), "<furnace>", ".");
   RenderOptions opt;
   opt.progress = false;
   opt.spp = 256;

@@ -6,34 +6,14 @@
 
 #include <cmath>
 
+#include "furnace_scene.h"
 #include "render_helpers.h"
 
 namespace tessera {
 namespace {
 
-std::string furnace_scene(double rho, int max_depth, const char* extra_material = "") {
-  char buf[1024];
-  std::snprintf(buf, sizeof buf, R"(
-LookAt 0 0 0  0 0 1  0 1 0
-Camera "perspective" "float fov" [ 60 ]
-Film "rgb" "integer xresolution" [ 16 ] "integer yresolution" [ 16 ]
-Sampler "independent" "integer pixelsamples" [ 256 ]
-Integrator "path" "integer maxdepth" [ %d ]
-WorldBegin
-AttributeBegin
-  Material "diffuse" "rgb reflectance" [ %g %g %g ] %s
-  AreaLightSource "diffuse" "rgb L" [ 1 1 1 ] "bool twosided" true
-  Shape "sphere" "float radius" [ 10 ]
-AttributeEnd
-)", max_depth, rho, rho, rho, extra_material);
-  return buf;
-}
-
-double expected_furnace(double rho, int depth) {
-  double s = 0, r = 1;
-  for (int k = 0; k <= depth; ++k, r *= rho) s += r;
-  return s;
-}
+using testing::expected_furnace;
+using testing::furnace_scene;
 
 // Tolerance: 256 spp x 256 pixels = 65k paths; the per-path standard
 // deviation is below 1 for these scenes, so 1% is > 5 standard errors.

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "master/error_estimate.h"
+#include "furnace_scene.h"
 #include "render_helpers.h"
 
 namespace tessera {
@@ -18,7 +19,7 @@ namespace {
 // ~0.12/spp with NEE, so 0.01 is reached after a handful of passes.
 class TargetError : public ::testing::Test {
  protected:
-  TargetError() : scene_(load_pbrt_string(kFurnace, "<furnace>", ".")), embree_(scene_) {}
+  TargetError() : scene_(load_pbrt_string(testing::furnace_scene(0.5, 5, 16, 0), "<furnace>", ".")), embree_(scene_) {}
 
   // Unlimited spp, a generous time budget (never reached: the test renders
   // well under a second), the given target.
@@ -35,19 +36,6 @@ class TargetError : public ::testing::Test {
   RenderResult render_with(const RenderOptions& opt, const RenderResult* resume = nullptr) {
     return render(scene_, embree_, opt, nullptr, nullptr, resume);
   }
-
-  static constexpr const char* kFurnace = R"(
-LookAt 0 0 0  0 0 1  0 1 0
-Camera "perspective" "float fov" [ 60 ]
-Film "rgb" "integer xresolution" [ 16 ] "integer yresolution" [ 16 ]
-Integrator "path" "integer maxdepth" [ 5 ]
-WorldBegin
-AttributeBegin
-  Material "diffuse" "rgb reflectance" [ 0.5 0.5 0.5 ]
-  AreaLightSource "diffuse" "rgb L" [ 1 1 1 ] "bool twosided" true
-  Shape "sphere" "float radius" [ 10 ]
-AttributeEnd
-)";
   SceneData scene_;
   EmbreeScene embree_;
 };
