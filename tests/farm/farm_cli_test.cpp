@@ -14,6 +14,7 @@
 #include <regex>
 #include <string>
 
+#include "../test_dir.h"
 #include "../cli_run.h"
 #include "../exr_read.h"
 #include "../render/render_helpers.h"
@@ -39,9 +40,7 @@ uint64_t json_number(const std::string& path, const std::string& key) {
 class FarmCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("tessera_farm_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    dir_ = testing::fresh_test_dir("tessera_farm");
   }
   void TearDown() override { fs::remove_all(dir_); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <string>
 
+#include "../test_dir.h"
 #include "../cli_run.h"
 #include "render_helpers.h"
 
@@ -28,9 +29,7 @@ using testing::RunResult;
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("tessera_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    dir_ = testing::fresh_test_dir("tessera_cli");
   }
   void TearDown() override { fs::remove_all(dir_); }
   std::string write(const std::string& name, const std::string& text) {

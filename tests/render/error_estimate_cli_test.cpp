@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "../test_dir.h"
 #include "../cli_run.h"
 #include "../exr_read.h"
 #include "master/image_output.h"
@@ -80,10 +81,7 @@ void expect_option_error(const RunResult& r, const std::string& option) {
 class ErrorEstimateCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("tessera_errcli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = testing::fresh_test_dir("tessera_errcli");
     furnace_ = (dir_ / "furnace.pbrt").string();
     // 16x16; its Sampler asks for 4 spp: --target-error must replace that, as --time does.
     std::ofstream(furnace_) << testing::furnace_scene(0.5, 5, 16, 4);

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "../test_dir.h"
 #include "master/snapshots.h"
 
 namespace tessera {
@@ -48,10 +49,7 @@ TEST(SnapshotPolicy, RejectsNamingTheOption) {
 class SnapshotWriterTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("tessera_snap_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = testing::fresh_test_dir("tessera_snap");
     so_far_.film = Film(4, 2);
     for (PixelAccum& p : so_far_.film.pixels) {
       p.n = 1;
