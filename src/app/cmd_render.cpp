@@ -157,10 +157,12 @@ void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks) {
   std::fprintf(stderr, "tessera: effects: %s; integrator specialisation: %s\n", describe_effects(scene.effects()).c_str(),
                describe_specialisation(spec).c_str());
   if (m.guide) {
-    std::fprintf(stderr, "tessera: guiding: %s (%s), %u direction bins, %s light selection, budget %.0f MB\n",
+    std::fprintf(stderr,
+                 "tessera: guiding: %s (%s), %u direction bins, %s light selection, %s next-event estimation, budget "
+                 "%.0f MB\n",
                  m.guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable", m.guide_why.c_str(),
                  m.guide->config().grid * m.guide->config().grid, m.guide->learned_lights() ? "learned" : "power-based",
-                 m.guide->config().budget_bytes / 1048576.0);
+                 m.guide->config().nee_gain > 0.f ? "learned" : "every-vertex", m.guide->config().budget_bytes / 1048576.0);
   } else {
     std::fprintf(stderr, "tessera: guiding: none (%s)\n", m.guide_why.c_str());
   }

@@ -32,6 +32,10 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
                   "Russian roulette of guided renders: guided (by the guide's prediction of what a path will "
                   "bring) or throughput (pbrt-v4's rule)")
       ->check(CLI::IsMember({"guided", "throughput"}));
+  cmd->add_option("--guide-nee", a.nee,
+                  "Next-event estimation of guided renders: learned (cells whose shadow rays bring little trace "
+                  "them less often) or always (every vertex)")
+      ->check(CLI::IsMember({"learned", "always"}));
   cmd->add_option("--guide-in", a.in, "Start from a guide cache saved by --guide-out (same scene only)");
   cmd->add_option("--guide-out", a.out, "Save the learned guide cache after rendering");
 }
@@ -66,6 +70,7 @@ std::unique_ptr<GuideField> make_guide(const GuideArgs& a, const SceneData& scen
     try {
       auto g = std::make_unique<GuideField>(GuideField::load(f, scene.fingerprint()));
       if (a.mix) g->set_guide_prob(static_cast<Float>(*a.mix));
+      g->set_nee_gain(a.nee == "always" ? 0.f : GuideConfig{}.nee_gain);
       *why = "loaded from " + a.in;
       return g;
     } catch (const std::exception& e) {
@@ -77,6 +82,7 @@ std::unique_ptr<GuideField> make_guide(const GuideArgs& a, const SceneData& scen
   if (a.mix) cfg.guide_prob = static_cast<Float>(*a.mix);
   cfg.split_updates = static_cast<uint64_t>(a.split);
   cfg.grid = static_cast<uint32_t>(a.grid);
+  if (a.nee == "always") cfg.nee_gain = 0.f;
   cfg.target = mode == "qlearning" ? GuideTarget::QLearning : GuideTarget::ExpectedSarsa;
   const Bounds& b = scene.bounds();
   return std::make_unique<GuideField>(cfg, b.lo, b.hi, scene.view().num_lights, scene.max_emitted_radiance());

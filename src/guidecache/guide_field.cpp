@@ -54,8 +54,8 @@ size_t GuideField::add_cell() {
 uint64_t GuideField::bytes_per_cell() const {
   const uint64_t entry = sizeof(Float) + sizeof(uint32_t) + 2 * sizeof(uint64_t);  // value, visits, acc sum + count
   const uint64_t tables = bins_ * sizeof(GuideAlias) + (lights_ + 1) * sizeof(Float);  // alias table, light cdf
-  // normal sum + its accumulator, update count, irradiance, qmax, light share, learn-normal flag
-  const uint64_t extras = 3 * sizeof(int64_t) + 3 * sizeof(uint64_t) + sizeof(uint64_t) + 3 * sizeof(Float) + 1;
+  // normal sum + its accumulator, update count, irradiance, qmax, light share, nee probability, learn-normal flag
+  const uint64_t extras = 3 * sizeof(int64_t) + 3 * sizeof(uint64_t) + sizeof(uint64_t) + 4 * sizeof(Float) + 1;
   const uint64_t node = (8 * sizeof(GuideNode) + 8) / 7 + 1;  // amortised share of the octree
   return stride() * entry + tables + extras + node;
 }
@@ -92,6 +92,8 @@ GuideView GuideField::view() {
   g.qmax = qmax_.data();
   g.learn_normal = learn_normal_.data();
   g.cell_light_prob = cell_light_prob_.data();
+  g.nee_prob = nee_prob_.data();
+  g.nee_entry = bins_ + lights_;
   g.acc = acc_.data();
   g.acc_normal = acc_.data() + acc_normal_offset();
   g.rejected = acc_.data() + acc_rejected_offset();
@@ -180,6 +182,7 @@ void GuideField::build_distributions() {
   qmax_.assign(cells, 0.f);
   learn_normal_.assign(cells, 0);
   cell_light_prob_.assign(cells, 0.f);
+  nee_prob_.assign(cells, 1.f);
   std::vector<double> w(std::max(bins_, lights_));
   const double floor = std::clamp<double>(config_.floor, 0.0, 1.0);
   // Probability of entry j of m: its weight's share, mixed with the uniform floor.
@@ -249,13 +252,39 @@ void GuideField::build_distributions() {
       // Until a cell has seen light, its table is uniform: selection by power does better.
       cell_light_prob_[c] = lt > 0.0 ? config_.light_guide_prob : 0.f;
     }
+    nee_prob_[c] = nee_probability(c);
   }
+}
+
+// Next-event estimation pays a shadow ray at every vertex; where those rays
+// bring a small share of the light a cell reflects (direct D against the
+// learned indirect I, means over the same vertices), the cell traces them
+// with probability nee_gain * D / (D + I), never below nee_min_prob: a share
+// of a quarter or more (gain 4) keeps every shadow ray. Until a cell has
+// seen kNeeMinVisits vertices (or reflects nothing), it keeps them all.
+// Rarely-visible light is already in D as its mean, so a cell whose vertices
+// sometimes see a bright light keeps a high probability.
+Float GuideField::nee_probability(size_t cell) const {
+  constexpr uint32_t kNeeMinVisits = 64;
+  if (!(config_.nee_gain > 0.f)) return 1.f;
+  const size_t e = cell * stride() + bins_ + lights_;
+  if (visits_[e] < kNeeMinVisits || visits_[e + 1] < kNeeMinVisits) return 1.f;
+  const double d = value_[e], i = value_[e + 1];
+  if (!(d + i > 0.0)) return 1.f;
+  const double p = config_.nee_gain * d / (d + i);
+  return static_cast<Float>(std::clamp(p, static_cast<double>(std::clamp(config_.nee_min_prob, 0.01f, 1.f)), 1.0));
+}
+
+void GuideField::set_nee_gain(Float gain) {
+  config_.nee_gain = gain;
+  for (size_t c = 0; c < nee_prob_.size(); ++c) nee_prob_[c] = nee_probability(c);
 }
 
 GuideFieldStats GuideField::stats() const {
   GuideFieldStats s = totals_;
   s.cells = num_cells();
   s.bytes = num_cells() * bytes_per_cell();
+  s.learned_nee = config_.nee_gain > 0.f;
   return s;
 }
 

@@ -42,6 +42,11 @@ struct GuideConfig {
   Float floor = 0.02f;
   GuideTarget target = GuideTarget::ExpectedSarsa;
   uint32_t max_learned_lights = 256;    // more lights than this: light selection stays power-based
+  // Learned next-event probability (see GuideView::nee_prob): a cell whose
+  // shadow rays bring less than 1/nee_gain of the light it reflects traces
+  // them less often, down to nee_min_prob. nee_gain 0: always trace them.
+  Float nee_gain = 4.f;
+  Float nee_min_prob = 0.1f;
 
   bool operator==(const GuideConfig&) const = default;
 };
@@ -54,6 +59,7 @@ struct GuideFieldStats {
   uint64_t rejected_large = 0;       // targets beyond the fixed-point range
   uint64_t splits = 0;
   bool budget_reached = false;       // a split was refused for memory
+  bool learned_nee = false;          // next-event probability learned per cell (config nee_gain > 0)
 };
 
 class GuideField {
@@ -81,6 +87,7 @@ class GuideField {
   const GuideConfig& config() const { return config_; }
   // Sampling settings that do not change what was learned.
   void set_guide_prob(Float p) { config_.guide_prob = p; }
+  void set_nee_gain(Float gain);  // 0: every vertex traces its next-event shadow ray
   GuideFieldStats stats() const;
   uint32_t num_cells() const { return static_cast<uint32_t>(cell_updates_.size()); }
   uint32_t learned_lights() const { return lights_; }
@@ -100,12 +107,15 @@ class GuideField {
   void serialize(Archive& ar);
 
  private:
-  uint32_t stride() const { return bins_ + lights_; }
+  // Entries per cell: direction bins, learned lights, then the two
+  // next-event statistics (kGuideNeeEntries).
+  uint32_t stride() const { return bins_ + lights_ + kGuideNeeEntries; }
   uint64_t bytes_per_cell() const;
   uint64_t split_threshold() const;
   size_t add_cell();
   void split(size_t node);
   void build_distributions();
+  Float nee_probability(size_t cell) const;
   void build_bin_dirs();
   // Offsets of the parts of acc_.
   size_t acc_normal_offset() const { return 2 * num_cells() * size_t(stride()); }
@@ -131,7 +141,7 @@ class GuideField {
   std::vector<Float> light_cdf_, irradiance_, qmax_;
   std::vector<GuideAlias> dir_alias_;
   std::vector<uint8_t> learn_normal_;
-  std::vector<Float> cell_light_prob_;
+  std::vector<Float> cell_light_prob_, nee_prob_;
   std::vector<uint64_t> acc_;
 };
 

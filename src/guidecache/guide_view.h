@@ -42,6 +42,12 @@ struct GuideAlias {
   Float alias_pmf = 0.f;  // probability of bin `alias`
 };
 
+// Per cell, after the bins and lights: the mean of next-event estimation's
+// (unweighted) estimate of the light reflected at the cell's vertices, and of
+// the learned estimate of the rest (the bins' integral), both per unit
+// throughput, recorded at the same vertices. Their ratio sets nee_prob.
+constexpr uint32_t kGuideNeeEntries = 2;
+
 // Surface points are split by the dominant axis of their normal (+-x, +-y,
 // +-z), so surfaces facing different ways never share a cell.
 constexpr uint32_t kGuideNormalClasses = 6;
@@ -59,7 +65,8 @@ struct GuideView {
   uint32_t grid = 12;      // bins per side of the equal-area square
   uint32_t bins = 144;     // grid * grid
   uint32_t lights = 0;     // learned light-selection entries per cell (0 = off)
-  uint32_t stride = 144;   // entries per cell: bins, then lights
+  uint32_t stride = 146;   // entries per cell: bins, then lights, then kGuideNeeEntries
+  uint32_t nee_entry = 144;  // first next-event statistic: bins + lights
   const Vec3* bin_dirs = nullptr;  // centre direction of each bin
 
   // Frozen per cell: values (incident radiance per bin, contribution per light),
@@ -71,6 +78,12 @@ struct GuideView {
   const Float* qmax = nullptr;         // cells: largest Q over the bins above the cell's surface
   const uint8_t* learn_normal = nullptr;  // cells: 1 while the cell's mean normal is still being estimated
   const Float* cell_light_prob = nullptr;  // cells: mixture weight of learned light selection (0: power only)
+  // cells: probability that a vertex traces its next-event shadow ray. Below 1
+  // where shadow rays have brought little of the light the cell reflects (a
+  // room lit through a door gap: its light is almost always occluded). A
+  // vertex that skips it counts as having selected no light, so the estimate
+  // and the MIS weights stay unbiased (light pdfs carry this factor).
+  const Float* nee_prob = nullptr;
 
   // Accumulators for the running pass (relaxed atomics).
   uint64_t* acc = nullptr;         // cells * stride pairs (sum in fixed point = target * fixed_scale, count)

@@ -10,20 +10,35 @@
 
 namespace tessera {
 
-// Probability of selecting light li for next-event estimation at a point in
-// `cell` (cell < 0 or no learned lights: the power-based distribution alone).
-TESSERA_HOST_DEVICE inline Float light_select_pmf(const SceneView& s, const GuideView* g, int32_t cell, uint32_t li) {
-  Float p_power = s.light_select.discrete_pmf(li);
-  if (!g || g->lights == 0 || cell < 0) return p_power;
-  const Float lp = g->cell_light_prob[cell];
-  return (1.f - lp) * p_power + lp * g->light_distribution(cell).discrete_pmf(li);
+// Probability that a vertex in `cell` traces next-event estimation at all
+// (GuideView::nee_prob; 1 without a guide).
+TESSERA_HOST_DEVICE inline Float nee_probability(const GuideView* g, int32_t cell) {
+  return g && cell >= 0 ? g->nee_prob[cell] : 1.f;
 }
 
-// Selects a light with one uniform number; *pmf is the mixture probability.
+// Probability that next-event estimation at a point in `cell` samples light
+// li: that it is traced at all, times the selection probability (cell < 0 or
+// no learned lights: the power-based distribution alone). The density of the
+// light-sampling strategy in every MIS weight carries it.
+TESSERA_HOST_DEVICE inline Float light_select_pmf(const SceneView& s, const GuideView* g, int32_t cell, uint32_t li) {
+  Float p_power = s.light_select.discrete_pmf(li);
+  if (!g || cell < 0) return p_power;
+  const Float p_nee = g->nee_prob[cell];
+  if (g->lights == 0) return p_nee * p_power;
+  const Float lp = g->cell_light_prob[cell];
+  return p_nee * ((1.f - lp) * p_power + lp * g->light_distribution(cell).discrete_pmf(li));
+}
+
+// Selects a light with one uniform number, given that next-event estimation
+// is traced; *pmf is light_select_pmf (the traced probability included).
 TESSERA_HOST_DEVICE inline uint32_t select_light(const SceneView& s, const GuideView* g, int32_t cell, Float u,
                                                  Float* pmf) {
   const Float lp = g && g->lights > 0 && cell >= 0 ? g->cell_light_prob[cell] : 0.f;
-  if (lp <= 0.f) return s.light_select.sample_discrete(u, pmf);
+  if (lp <= 0.f) {
+    const uint32_t li = s.light_select.sample_discrete(u, pmf);
+    *pmf *= nee_probability(g, cell);
+    return li;
+  }
   uint32_t li;
   if (u < lp) {
     li = g->light_distribution(cell).sample_discrete(glm::min(u / lp, 0x1.fffffep-1f), nullptr);

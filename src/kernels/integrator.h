@@ -34,6 +34,7 @@ struct PathCounters {
   uint64_t guided_samples = 0;     // directions drawn from the guide
   uint64_t guide_updates = 0;      // direction targets accepted by the guide
   uint64_t guided_roulette = 0;    // roulette decisions the guide's prediction took part in
+  uint64_t nee_skipped = 0;        // vertices that skipped next-event estimation (GuideView::nee_prob)
 };
 
 struct PathSettings {
@@ -229,11 +230,24 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
 
     // Next-event estimation at non-specular vertices (pbrt-v4's SampleLd).
     Float direct_estimate = 0.f;  // its unweighted estimate of light reflected here (guide targets)
-    if (settings.nee && lobes_have_non_specular(lobes) && s.num_lights > 0) {
+    const bool nee_vertex = settings.nee && lobes_have_non_specular(lobes) && s.num_lights > 0;
+    if (nee_vertex) {
       Float u_select = rng.uniform();
       Vec2 u_light = rng.uniform2();
+      // Where the guide has learned that shadow rays bring little, the vertex
+      // traces one with probability p_nee (the same number decides, rescaled).
+      bool traced = true;
+      if constexpr (kGuide) {
+        const Float p_nee = nee_probability(guide, cell);
+        if (p_nee < 1.f) {
+          traced = u_select < p_nee;
+          u_select = glm::min(u_select / p_nee, 0x1.fffffep-1f);
+        }
+      }
       Float pmf = 0.f;
-      uint32_t li = select_light(s, guide, cell, u_select, &pmf);
+      uint32_t li = 0;
+      if (traced) li = select_light(s, guide, cell, u_select, &pmf);
+      else ++c.nee_skipped;
       LightSample ls;
       Float learned = 0.f;  // unoccluded contribution of the selected light, for the guide
       if (pmf > 0.f && sample_light(s, li, h.p, u_light, &ls)) {
@@ -265,10 +279,17 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     // gives guide-driven roulette the path's expected radiance.
     const bool completes_target = learn && pend_cell >= 0 && !pend_at_delta;
     const bool sets_expectation = guide_roulette && !(path_expected > 0.f) && !delta_lobe && g.learned(cell);
-    if (completes_target || sets_expectation) {
+    const bool records_nee = learn && nee_vertex;
+    if (completes_target || sets_expectation || records_nee) {
       const bool lambertian = (Spec & kSpecNonDiffuse) == 0 || bsdf.type == BsdfType::Diffuse;
-      const Float reflected = direct_estimate + guide_bins_integral(g, cell, bsdf, lambertian, wo_l,
-                                                                    [&](const Vec3& v) { return frame.to_local(v); }, rng);
+      const Float indirect = guide_bins_integral(g, cell, bsdf, lambertian, wo_l,
+                                                 [&](const Vec3& v) { return frame.to_local(v); }, rng);
+      const Float reflected = direct_estimate + indirect;
+      if (records_nee) {
+        // The two shares of the light reflected here, for nee_prob.
+        guide_record(g, cell, g.nee_entry, direct_estimate);
+        guide_record(g, cell, g.nee_entry + 1, indirect);
+      }
       if (completes_target) {
         if (guide_record(g, pend_cell, pend_bin, pend_le + reflected)) ++c.guide_updates;
         pend_cell = -1;

@@ -10,7 +10,7 @@ namespace tessera {
 namespace {
 
 constexpr char kMagic[] = "tessera-checkpoint";
-constexpr uint32_t kVersion = 2;  // 2: per-pass error estimates
+constexpr uint32_t kVersion = 3;  // 2: per-pass error estimates; 3: next-event skip counter, guide cache v2
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.
 uint64_t fnv1a(const std::string& s) {

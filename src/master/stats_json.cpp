@@ -97,6 +97,9 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
     j.add_string("guide_roulette", s.guide_roulette ? "guided" : "throughput");
     j.add("guided_roulette_fraction",
           c.path.vertices > 0 ? double(c.path.guided_roulette) / double(c.path.vertices) : 0.0);
+    j.add_string("guide_nee", s.guide.learned_nee ? "learned" : "always");
+    j.add("nee_skipped_fraction",
+          c.path.vertices > 0 ? double(c.path.nee_skipped) / double(c.path.vertices) : 0.0);
     j.add("guided_sample_fraction",
           c.path.guidable_vertices > 0 ? double(c.path.guided_samples) / double(c.path.guidable_vertices) : 0.0);
   }

@@ -52,6 +52,7 @@ struct TileCounters {
     path.guided_samples += o.path.guided_samples;
     path.guide_updates += o.path.guide_updates;
     path.guided_roulette += o.path.guided_roulette;
+    path.nee_skipped += o.path.nee_skipped;
     samples += o.samples;
     zero_radiance += o.zero_radiance;
     rejected_nonfinite += o.rejected_nonfinite;

@@ -282,6 +282,42 @@ TEST(GuideField, LearnedLightShareOnlyWhereLightWasLearned) {
   EXPECT_EQ(g.cell_light_prob[1], 0.f);
 }
 
+// Next-event estimation's probability per cell: the share of the reflected
+// light its shadow rays brought (direct D against the learned indirect I),
+// times the gain, between nee_min_prob and 1; 1 until both have 64 visits.
+TEST(GuideField, NextEventProbabilityFollowsTheDirectShare) {
+  GuideConfig cfg;
+  cfg.nee_gain = 4.f;
+  cfg.nee_min_prob = 0.1f;
+  GuideField f = make_field(cfg);
+  GuideView g = f.view();
+  auto record = [&](int32_t cell, int n, Float direct, Float indirect) {
+    for (int i = 0; i < n; ++i) {
+      guide_record(g, cell, g.nee_entry, direct);
+      guide_record(g, cell, g.nee_entry + 1, indirect);
+    }
+  };
+  record(0, 100, 0.f, 1.f);   // shadow rays never arrive: the floor
+  record(1, 100, 1.f, 39.f);  // 2.5 % direct: 4 x 0.025
+  record(2, 100, 1.f, 1.f);   // half direct: always
+  record(3, 63, 0.f, 1.f);    // too few vertices to judge
+  record(4, 100, 0.f, 0.f);   // nothing reflected: nothing to judge
+  f.fold();
+  g = f.view();
+  EXPECT_FLOAT_EQ(g.nee_prob[0], 0.1f);
+  EXPECT_NEAR(g.nee_prob[1], 0.1f, 1e-6f);
+  EXPECT_EQ(g.nee_prob[2], 1.f);
+  EXPECT_EQ(g.nee_prob[3], 1.f);
+  EXPECT_EQ(g.nee_prob[4], 1.f);
+  record(1, 100, 3.f, 37.f);  // means now 2 and 38: 4 x 0.05
+  f.fold();
+  EXPECT_NEAR(f.view().nee_prob[1], 0.2f, 1e-6f);
+  // Gain 0 (--guide-nee always): every vertex traces its shadow ray.
+  f.set_nee_gain(0.f);
+  for (uint32_t c = 0; c < f.num_cells(); ++c) EXPECT_EQ(f.view().nee_prob[c], 1.f);
+  EXPECT_FALSE(f.stats().learned_nee);
+}
+
 TEST(GuideSerialisation, RoundTripIsExact) {
   GuideConfig cfg;
   cfg.split_updates = 50;

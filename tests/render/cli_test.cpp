@@ -233,6 +233,27 @@ TEST_F(CliTest, GuideRouletteOption) {
   EXPECT_NE(bad.output.find("--guide-roulette"), std::string::npos) << bad.output;
 }
 
+// --guide-nee learned (default) skips shadow rays where the guide learned
+// they bring little (door-ajar's room behind a door gap); always never does.
+TEST_F(CliTest, GuideNextEventOption) {
+  const std::string scene = testing::source_dir() + "/scenes/door-ajar.pbrt";
+  auto stats_of = [&](const std::string& args, const std::string& name) {
+    return render_stats(scene + " --res 32x24 --spp 64 --seed 3 --guide qtable " + args, name);
+  };
+  auto fraction = [](const std::string& json) {
+    const size_t k = json.find("\"nee_skipped_fraction\": ");
+    return k == std::string::npos ? -1.0 : std::stod(json.substr(k + 24));
+  };
+  const std::string learned = stats_of("", "learned.json"), always = stats_of("--guide-nee always", "always.json");
+  EXPECT_NE(learned.find("\"guide_nee\": \"learned\""), std::string::npos) << learned;
+  EXPECT_NE(always.find("\"guide_nee\": \"always\""), std::string::npos) << always;
+  EXPECT_GT(fraction(learned), 0.1) << learned;
+  EXPECT_EQ(fraction(always), 0.0) << always;
+  RunResult bad = run("render --guide-nee never");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--guide-nee"), std::string::npos) << bad.output;
+}
+
 TEST_F(CliTest, InfoPrintsEffects) {
   RunResult r = run("info");
   EXPECT_EQ(r.exit_code, 0);

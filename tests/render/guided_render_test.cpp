@@ -68,6 +68,12 @@ TEST(GuidedUnbiased, DoorAjarAndShelterAgreeWithUnguided) {
     expect_agree(channel_stats(g.film), mu, name);
     EXPECT_TRUE(all_finite(g.film));
     EXPECT_GT(g.stats.guide.splits, 0u) << "the field never refined";
+    // Door-ajar's room is lit through a gap: most of its shadow rays are
+    // occluded, and the learned next-event probability skips many of them
+    // (the agreement above covers the MIS weights that carry it).
+    if (std::string(name) == "door-ajar") {
+      EXPECT_GT(g.stats.counters.path.nee_skipped, g.stats.counters.path.vertices / 10);
+    }
   }
 }
 
