@@ -79,7 +79,10 @@ std::unique_ptr<GuideField> make_guide(const GuideArgs& a, const SceneData& scen
   }
   GuideConfig cfg;
   cfg.budget_bytes = static_cast<uint64_t>(std::llround(a.budget_mb * 1048576.0));
-  if (a.mix) cfg.guide_prob = static_cast<Float>(*a.mix);
+  if (a.mix) {
+    cfg.guide_prob = static_cast<Float>(*a.mix);
+    cfg.learn_mix = false;
+  }
   cfg.split_updates = static_cast<uint64_t>(a.split);
   cfg.grid = static_cast<uint32_t>(a.grid);
   if (a.nee == "always") cfg.nee_gain = 0.f;

@@ -9,6 +9,7 @@ namespace {
 
 constexpr uint32_t kMaxGrid = 64;
 constexpr Float kNormalSamples = 256.f;
+constexpr uint32_t kMixMinVisits = 128;  // vertices a cell needs before its mixture weight is chosen
 
 }  // namespace
 
@@ -54,8 +55,9 @@ size_t GuideField::add_cell() {
 uint64_t GuideField::bytes_per_cell() const {
   const uint64_t entry = sizeof(Float) + sizeof(uint32_t) + 2 * sizeof(uint64_t);  // value, visits, acc sum + count
   const uint64_t tables = bins_ * sizeof(GuideAlias) + (lights_ + 1) * sizeof(Float);  // alias table, light cdf
-  // normal sum + its accumulator, update count, irradiance, qmax, light share, nee probability, learn-normal flag
-  const uint64_t extras = 3 * sizeof(int64_t) + 3 * sizeof(uint64_t) + sizeof(uint64_t) + 4 * sizeof(Float) + 1;
+  // normal sum + its accumulator, update count, irradiance, qmax, light share, nee probability, mixture weight,
+  // learn-normal flag
+  const uint64_t extras = 3 * sizeof(int64_t) + 3 * sizeof(uint64_t) + sizeof(uint64_t) + 5 * sizeof(Float) + 1;
   const uint64_t node = (8 * sizeof(GuideNode) + 8) / 7 + 1;  // amortised share of the octree
   return stride() * entry + tables + extras + node;
 }
@@ -64,7 +66,7 @@ uint64_t GuideField::split_threshold() const {
   return config_.split_updates > 0 ? config_.split_updates : 24ull * bins_;
 }
 
-void GuideField::resize_accumulators() { acc_.assign(acc_rejected_offset() + 2, 0); }
+void GuideField::resize_accumulators() { acc_.assign(acc_rejected_offset() + 3, 0); }
 
 void GuideField::build_bin_dirs() {
   bin_dirs_.resize(bins_);
@@ -94,6 +96,9 @@ GuideView GuideField::view() {
   g.cell_light_prob = cell_light_prob_.data();
   g.nee_prob = nee_prob_.data();
   g.nee_entry = bins_ + lights_;
+  g.mix_entry = g.nee_entry + kGuideNeeEntries;
+  g.cell_mix = cell_mix_.data();
+  g.learn_mix = config_.learn_mix;
   g.acc = acc_.data();
   g.acc_normal = acc_.data() + acc_normal_offset();
   g.rejected = acc_.data() + acc_rejected_offset();
@@ -128,6 +133,7 @@ void GuideField::fold() {
   for (size_t i = 0; i < normal_sum_.size(); ++i) normal_sum_[i] += static_cast<int64_t>(normal[i]);
   totals_.rejected_nonfinite += rejected[0];
   totals_.rejected_large += rejected[1];
+  totals_.mix_out_of_range += rejected[2];
 
   // Refine busy leaves, in node order (deterministic), while the budget allows.
   const size_t leaves_before = nodes_.size();
@@ -183,6 +189,7 @@ void GuideField::build_distributions() {
   learn_normal_.assign(cells, 0);
   cell_light_prob_.assign(cells, 0.f);
   nee_prob_.assign(cells, 1.f);
+  cell_mix_.assign(cells, config_.guide_prob);
   std::vector<double> w(std::max(bins_, lights_));
   const double floor = std::clamp<double>(config_.floor, 0.0, 1.0);
   // Probability of entry j of m: its weight's share, mixed with the uniform floor.
@@ -253,6 +260,7 @@ void GuideField::build_distributions() {
       cell_light_prob_[c] = lt > 0.0 ? config_.light_guide_prob : 0.f;
     }
     nee_prob_[c] = nee_probability(c);
+    cell_mix_[c] = mix_weight(c);
   }
 }
 
@@ -275,6 +283,29 @@ Float GuideField::nee_probability(size_t cell) const {
   return static_cast<Float>(std::clamp(p, static_cast<double>(std::clamp(config_.nee_min_prob, 0.01f, 1.f)), 1.0));
 }
 
+// The candidate weight with the smallest mean second moment, once every
+// candidate has kMixMinVisits vertices; guide_prob until then or when the
+// weight is fixed. The statistics are estimates from the field's own
+// learning targets, so a field that is wrong where it is confident (a cell
+// averaging points that see a light and points that do not) shows it here
+// as the second moment of its higher weights.
+Float GuideField::mix_weight(size_t cell) const {
+  if (!config_.learn_mix) return config_.guide_prob;
+  const size_t e = cell * stride() + bins_ + lights_ + kGuideNeeEntries;
+  uint32_t best = 0;
+  for (uint32_t k = 0; k < kGuideMixEntries; ++k) {
+    if (visits_[e + k] < kMixMinVisits) return config_.guide_prob;
+    if (value_[e + k] < value_[e + best]) best = k;
+  }
+  return guide_mix_candidate(best);
+}
+
+void GuideField::set_guide_prob(Float p) {
+  config_.guide_prob = p;
+  config_.learn_mix = false;
+  for (size_t c = 0; c < cell_mix_.size(); ++c) cell_mix_[c] = mix_weight(c);
+}
+
 void GuideField::set_nee_gain(Float gain) {
   config_.nee_gain = gain;
   for (size_t c = 0; c < nee_prob_.size(); ++c) nee_prob_[c] = nee_probability(c);
@@ -285,6 +316,16 @@ GuideFieldStats GuideField::stats() const {
   s.cells = num_cells();
   s.bytes = num_cells() * bytes_per_cell();
   s.learned_nee = config_.nee_gain > 0.f;
+  double mix_sum = 0.0;
+  uint64_t guiding = 0;
+  for (size_t c = 0; c < cell_mix_.size(); ++c) {
+    if (!(irradiance_[c] > 0.f)) continue;
+    mix_sum += cell_mix_[c];
+    ++guiding;
+    const size_t e = c * stride() + bins_ + lights_ + kGuideNeeEntries;
+    if (config_.learn_mix && visits_[e] >= kMixMinVisits) ++s.mix_learned_cells;
+  }
+  s.mean_mix = guiding ? mix_sum / double(guiding) : 0.0;
   return s;
 }
 

@@ -47,6 +47,9 @@ struct GuideConfig {
   // them less often, down to nee_min_prob. nee_gain 0: always trace them.
   Float nee_gain = 4.f;
   Float nee_min_prob = 0.1f;
+  // Learn the mixture weight per cell (from guide_prob, among
+  // guide_mix_candidate()); off: guide_prob everywhere (--guide-mix given).
+  bool learn_mix = true;
 
   bool operator==(const GuideConfig&) const = default;
 };
@@ -60,6 +63,9 @@ struct GuideFieldStats {
   uint64_t splits = 0;
   bool budget_reached = false;       // a split was refused for memory
   bool learned_nee = false;          // next-event probability learned per cell (config nee_gain > 0)
+  uint64_t mix_out_of_range = 0;     // mixture statistics too large to record (a heuristic's input, not the image)
+  uint64_t mix_learned_cells = 0;    // cells whose mixture weight was learned
+  double mean_mix = 0.0;             // mean mixture weight over cells that guide
 };
 
 class GuideField {
@@ -86,7 +92,8 @@ class GuideField {
 
   const GuideConfig& config() const { return config_; }
   // Sampling settings that do not change what was learned.
-  void set_guide_prob(Float p) { config_.guide_prob = p; }
+  // A fixed mixture weight everywhere (learning the weight stops).
+  void set_guide_prob(Float p);
   void set_nee_gain(Float gain);  // 0: every vertex traces its next-event shadow ray
   GuideFieldStats stats() const;
   uint32_t num_cells() const { return static_cast<uint32_t>(cell_updates_.size()); }
@@ -109,13 +116,14 @@ class GuideField {
  private:
   // Entries per cell: direction bins, learned lights, then the two
   // next-event statistics (kGuideNeeEntries).
-  uint32_t stride() const { return bins_ + lights_ + kGuideNeeEntries; }
+  uint32_t stride() const { return bins_ + lights_ + kGuideNeeEntries + kGuideMixEntries; }
   uint64_t bytes_per_cell() const;
   uint64_t split_threshold() const;
   size_t add_cell();
   void split(size_t node);
   void build_distributions();
   Float nee_probability(size_t cell) const;
+  Float mix_weight(size_t cell) const;
   void build_bin_dirs();
   // Offsets of the parts of acc_.
   size_t acc_normal_offset() const { return 2 * num_cells() * size_t(stride()); }
@@ -141,7 +149,7 @@ class GuideField {
   std::vector<Float> light_cdf_, irradiance_, qmax_;
   std::vector<GuideAlias> dir_alias_;
   std::vector<uint8_t> learn_normal_;
-  std::vector<Float> cell_light_prob_, nee_prob_;
+  std::vector<Float> cell_light_prob_, nee_prob_, cell_mix_;
   std::vector<uint64_t> acc_;
 };
 

@@ -29,13 +29,13 @@ template <class Archive>
 void serialize(Archive& ar, GuideConfig& c) {
   uint32_t target = static_cast<uint32_t>(c.target);
   ar(c.grid, c.budget_bytes, c.split_updates, c.max_depth, c.guide_prob, c.light_guide_prob, c.floor, target,
-     c.max_learned_lights, c.nee_gain, c.nee_min_prob);
+     c.max_learned_lights, c.nee_gain, c.nee_min_prob, c.learn_mix);
   c.target = static_cast<GuideTarget>(target);
 }
 
 template <class Archive>
 void serialize(Archive& ar, GuideFieldStats& s) {
-  ar(s.updates, s.rejected_nonfinite, s.rejected_large, s.splits, s.budget_reached);
+  ar(s.updates, s.rejected_nonfinite, s.rejected_large, s.splits, s.budget_reached, s.mix_out_of_range);
 }
 
 template <class Archive>
@@ -46,7 +46,7 @@ void GuideField::serialize(Archive& ar) {
 
 namespace {
 constexpr char kMagic[] = "tessera-guide-cache";
-constexpr uint32_t kVersion = 2;  // 2: next-event statistics per cell
+constexpr uint32_t kVersion = 3;  // 2: next-event statistics per cell; 3: mixture statistics
 }  // namespace
 
 void GuideField::save(std::ostream& out, uint64_t scene_fingerprint) const {

@@ -48,6 +48,13 @@ struct GuideAlias {
 // throughput, recorded at the same vertices. Their ratio sets nee_prob.
 constexpr uint32_t kGuideNeeEntries = 2;
 
+// Then, per cell, the learned mixture weight's statistics: for each candidate
+// weight a_k, the mean over guided vertices of the estimator's second moment
+// had the vertex sampled with a_k (importance-weighted from the weight it
+// used), in units of the cell's own scale. The smallest one wins.
+constexpr uint32_t kGuideMixEntries = 5;
+TESSERA_HOST_DEVICE inline Float guide_mix_candidate(uint32_t k) { return 0.2f + 0.15f * static_cast<Float>(k); }
+
 // Surface points are split by the dominant axis of their normal (+-x, +-y,
 // +-z), so surfaces facing different ways never share a cell.
 constexpr uint32_t kGuideNormalClasses = 6;
@@ -67,6 +74,7 @@ struct GuideView {
   uint32_t lights = 0;     // learned light-selection entries per cell (0 = off)
   uint32_t stride = 146;   // entries per cell: bins, then lights, then kGuideNeeEntries
   uint32_t nee_entry = 144;  // first next-event statistic: bins + lights
+  uint32_t mix_entry = 146;  // first mixture statistic: nee_entry + kGuideNeeEntries
   const Vec3* bin_dirs = nullptr;  // centre direction of each bin
 
   // Frozen per cell: values (incident radiance per bin, contribution per light),
@@ -88,17 +96,20 @@ struct GuideView {
   // Accumulators for the running pass (relaxed atomics).
   uint64_t* acc = nullptr;         // cells * stride pairs (sum in fixed point = target * fixed_scale, count)
   uint64_t* acc_normal = nullptr;  // cells * 3, fixed point (kGuideNormalScale)
-  uint64_t* rejected = nullptr;    // [0] NaN/Inf/negative targets, [1] targets too large for the fixed point
+  uint64_t* rejected = nullptr;    // [0] NaN/Inf/negative targets, [1] targets too large for the fixed point,
+                                   // [2] mixture statistics out of the fixed point's range (not recorded)
   Float fixed_scale = 1.f;
   Float max_target = 1e30f;        // larger targets are rejected (and counted), never clamped
 
-  Float guide_prob = 0.5f;         // mixture weight of guided direction sampling
+  Float guide_prob = 0.5f;         // mixture weight of guided direction sampling (cells that have not learned one)
+  const Float* cell_mix = nullptr; // cells: mixture weight of guided sampling (learned, or guide_prob)
+  bool learn_mix = true;           // record the mixture statistics (off when the weight is fixed)
   GuideTarget target = GuideTarget::ExpectedSarsa;
 
   // Mixture weight of guided sampling in a cell. A cell that has learned no
   // light above its surface would sample the whole sphere uniformly, half of
   // it behind the surface: BSDF sampling does better until it has.
-  TESSERA_HOST_DEVICE Float cell_guide_prob(int32_t cell) const { return learned(cell) ? guide_prob : 0.f; }
+  TESSERA_HOST_DEVICE Float cell_guide_prob(int32_t cell) const { return learned(cell) ? cell_mix[cell] : 0.f; }
   // Whether a cell has learned any light above its surface (else it samples,
   // and predicts, nothing).
   TESSERA_HOST_DEVICE bool learned(int32_t cell) const { return irradiance[cell] > 0.f; }

@@ -68,6 +68,41 @@ TESSERA_HOST_DEVICE inline Float guide_probability(const GuideView& g, int32_t c
   return p * glm::clamp((alpha - 0.05f) / 0.25f, 0.f, 1.f);
 }
 
+// What a guided vertex remembers of its sampled direction until the learning
+// target of that direction arrives (one vertex later).
+struct GuideMixSample {
+  Float fcos = 0.f;       // luminance of f |cos| of the direction taken
+  Float guide_pdf = 0.f;  // density of the guide's strategy for it
+  Float bsdf_pdf = 0.f;   // density of the BSDF's strategy for it
+  Float mix_pdf = 0.f;    // the mixture density it was drawn with
+};
+
+// Records, for every candidate weight a_k, the second moment the vertex's
+// estimator would have had with a_k, estimated from this sample drawn with
+// the current weight: (f cos T / s)^2 / (p_k p_cur), with T the learning
+// target (the radiance estimate along the direction) and s the cell's scale
+// (its learned irradiance / pi). A sample too large for the fixed point is
+// counted in rejected[2], for all candidates alike.
+TESSERA_HOST_DEVICE inline void guide_record_mix(const GuideView& g, int32_t cell, const GuideMixSample& m,
+                                                 Float target) {
+  const Float scale = g.irradiance[cell] * kInvPi;
+  if (!(scale > 0.f) || !(m.mix_pdf > 0.f) || !(target >= 0.f)) return;
+  const Float v = m.fcos * target / scale;
+  Float s[kGuideMixEntries];
+  Float largest = 0.f;
+  for (uint32_t k = 0; k < kGuideMixEntries; ++k) {
+    const Float a = guide_mix_candidate(k);
+    const Float pk = a * m.guide_pdf + (1.f - a) * m.bsdf_pdf;
+    s[k] = pk > 0.f ? v * v / (pk * m.mix_pdf) : 3.4e38f;
+    largest = glm::max(largest, s[k]);
+  }
+  if (!(largest <= g.max_target)) {
+    atomic_add_u64(&g.rejected[2], 1);
+    return;
+  }
+  for (uint32_t k = 0; k < kGuideMixEntries; ++k) guide_record(g, cell, g.mix_entry + k, s[k]);
+}
+
 // Guide-driven Russian roulette, after Vorba & Krivanek 2016 ("Adjoint-driven
 // Russian roulette and splitting"): the probability with which the guide
 // would let a path continue along a direction in `bin` from a vertex in

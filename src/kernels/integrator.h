@@ -142,6 +142,16 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   uint32_t pend_bin = 0;
   Float pend_le = 0.f;
   bool pend_at_delta = false;
+  // The pending direction's densities, for the mixture-weight statistics
+  // (mix_pdf 0: the vertex did not take part).
+  GuideMixSample pend_mix;
+  // Sends the pending target (and its mixture statistics) to x's cell.
+  auto finish_target = [&](Float target) {
+    if (guide_record(g, pend_cell, pend_bin, target)) {
+      ++c.guide_updates;
+      if (pend_mix.mix_pdf > 0.f) guide_record_mix(g, pend_cell, pend_mix, target);
+    }
+  };
 
   for (;;) {
     TraceHit hit;
@@ -163,7 +173,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       }
       if constexpr (kGuide) {
         const bool counted = specular_bounce || !settings.nee;  // else NEE delivers the environment
-        if (pend_cell >= 0 && guide_record(g, pend_cell, pend_bin, counted ? luminance(Le_total) : 0.f)) ++c.guide_updates;
+        if (pend_cell >= 0) finish_target(counted ? luminance(Le_total) : 0.f);
       }
       break;
     }
@@ -291,7 +301,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         guide_record(g, cell, g.nee_entry + 1, indirect);
       }
       if (completes_target) {
-        if (guide_record(g, pend_cell, pend_bin, pend_le + reflected)) ++c.guide_updates;
+        finish_target(pend_le + reflected);
         pend_cell = -1;
       }
       if (sets_expectation) path_expected = luminance(beta) * reflected;
@@ -304,13 +314,13 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     Float scatter_pdf;
     Float bsdf_pdf;  // the BSDF's own pdf of the direction taken (for roulette)
     uint32_t wi_bin = 0;  // guide bin of wi (guiding only)
+    Float guide_density = 0.f;  // the guide's density for wi (guided vertices only)
     if (guided_vertex) {
       // One extra dimension picks the strategy; the mixture pdf weights either.
       ++c.guidable_vertices;
       const Float p = guide_p;
       if (rng.uniform() < p) {
         ++c.guided_samples;
-        Float guide_density;
         if (!guide_sample(g, cell, uc, u, &wi, &guide_density, &wi_bin)) break;
         bs.wi = frame.to_local(wi);
         bs.f = eval_f<Spec>(bsdf, wo_l, bs.wi);
@@ -324,7 +334,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         wi = frame.to_world(bs.wi);
         bsdf_pdf = bs.pdf;
         wi_bin = guide_bin_of(g, wi);
-        scatter_pdf = p * guide_bin_pdf(g, cell, wi_bin) + (1.f - p) * bs.pdf;
+        guide_density = guide_bin_pdf(g, cell, wi_bin);
+        scatter_pdf = p * guide_density + (1.f - p) * bs.pdf;
       }
     } else {
       if (!sample_f<Spec>(bsdf, wo_l, uc, u, &bs) || !(bs.pdf > 0.f)) break;
@@ -336,12 +347,19 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     const Rgb weight = bs.f * (abs_cos_theta(bs.wi) / scatter_pdf);
     if (learn) {
       // A delta vertex's integral is the direction it actually took.
-      if (pend_at_delta && pend_cell >= 0 &&
-          guide_record(g, pend_cell, pend_bin, pend_le + guide_value(g, cell, wi_bin) * luminance(weight)))
-        ++c.guide_updates;
+      if (pend_at_delta && pend_cell >= 0) finish_target(pend_le + guide_value(g, cell, wi_bin) * luminance(weight));
       pend_cell = cell;
       pend_bin = wi_bin;
       pend_at_delta = false;
+      // Only vertices that sample with the cell's own weight (not faded by a
+      // glossy lobe) inform it.
+      pend_mix = GuideMixSample{};
+      if (g.learn_mix && guided_vertex && guide_p == g.cell_guide_prob(cell)) {
+        pend_mix.fcos = luminance(bs.f) * abs_cos_theta(bs.wi);
+        pend_mix.bsdf_pdf = bsdf_pdf;
+        pend_mix.guide_pdf = guide_density;
+        pend_mix.mix_pdf = scatter_pdf;
+      }
     }
     beta *= weight;
     rr_beta *= bsdf_pdf > 0.f ? bs.f * (abs_cos_theta(bs.wi) / bsdf_pdf) : weight;

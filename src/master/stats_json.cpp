@@ -97,6 +97,9 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
     j.add_string("guide_roulette", s.guide_roulette ? "guided" : "throughput");
     j.add("guided_roulette_fraction",
           c.path.vertices > 0 ? double(c.path.guided_roulette) / double(c.path.vertices) : 0.0);
+    j.add("guide_mix_learned_cells", s.guide.mix_learned_cells);
+    j.add("guide_mean_mix", s.guide.mean_mix);
+    j.add("guide_mix_samples_out_of_range", s.guide.mix_out_of_range);
     j.add_string("guide_nee", s.guide.learned_nee ? "learned" : "always");
     j.add("nee_skipped_fraction",
           c.path.vertices > 0 ? double(c.path.nee_skipped) / double(c.path.vertices) : 0.0);
