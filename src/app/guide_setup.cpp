@@ -16,7 +16,9 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
       ->check(CLI::IsMember({"auto", "none", "qtable", "qlearning"}));
   cmd->add_option("--guide-budget", a.budget_mb, "Guide cache memory budget in MB (cells stop refining there)")
       ->check(CLI::Range(0.1, 1048576.0));
-  cmd->add_option("--guide-mix", a.mix, "Probability of sampling a direction from the guide instead of the BSDF")
+  cmd->add_option("--guide-mix", a.mix,
+                  "Probability of sampling a direction from the guide instead of the BSDF, the same in every cell "
+                  "(default: learned per cell)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--guide-split", a.split, "Updates a cell takes before it splits (0 = 24 per direction bin)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 40));

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "guidecache/guide_field.h"
+#include "kernels/guiding.h"
 #include "kernels/rng.h"
 
 namespace tessera {
@@ -316,6 +317,56 @@ TEST(GuideField, NextEventProbabilityFollowsTheDirectShare) {
   f.set_nee_gain(0.f);
   for (uint32_t c = 0; c < f.num_cells(); ++c) EXPECT_EQ(f.view().nee_prob[c], 1.f);
   EXPECT_FALSE(f.stats().learned_nee);
+}
+
+// The learned mixture weight: the candidate with the smallest mean second
+// moment, once every candidate has 128 vertices; a fixed --guide-mix wins.
+TEST(GuideField, MixtureWeightIsTheCandidateWithTheSmallestSecondMoment) {
+  GuideConfig cfg;
+  cfg.guide_prob = 0.5f;
+  GuideField f = make_field(cfg);
+  GuideView g = f.view();
+  const Float moments[kGuideMixEntries] = {5.f, 4.f, 3.f, 1.f, 2.f};
+  for (int i = 0; i < 128; ++i)
+    for (uint32_t k = 0; k < kGuideMixEntries; ++k) guide_record(g, 0, g.mix_entry + k, moments[k]);
+  for (int i = 0; i < 127; ++i)
+    for (uint32_t k = 0; k < kGuideMixEntries; ++k) guide_record(g, 1, g.mix_entry + k, moments[k]);
+  f.fold();
+  g = f.view();
+  EXPECT_FLOAT_EQ(g.cell_mix[0], guide_mix_candidate(3));
+  EXPECT_FLOAT_EQ(guide_mix_candidate(3), 0.65f);
+  EXPECT_EQ(g.cell_mix[1], 0.5f);  // too few vertices yet
+  EXPECT_EQ(f.stats().mix_learned_cells, 0u) << "no cell has learned light, so none guides";
+  f.set_guide_prob(0.3f);
+  for (uint32_t c = 0; c < f.num_cells(); ++c) EXPECT_EQ(f.view().cell_mix[c], 0.3f);
+  EXPECT_FALSE(f.view().learn_mix);
+}
+
+// One guided vertex's record: for each candidate a_k, (f cos T / s)^2 /
+// (p_k p_cur) with p_k = a_k guide + (1 - a_k) bsdf and s = irradiance / pi.
+TEST(GuideField, MixtureStatisticsAreImportanceWeightedSecondMoments) {
+  GuideField f = make_field();
+  teach_peaked(f, 0);
+  GuideView g = f.view();
+  const Float scale = g.irradiance[0] * kInvPi;
+  ASSERT_GT(scale, 0.f);
+  GuideMixSample m;
+  m.fcos = 0.3f;
+  m.guide_pdf = 2.f;
+  m.bsdf_pdf = 0.5f;
+  m.mix_pdf = 0.5f * 2.f + 0.5f * 0.5f;
+  guide_record_mix(g, 0, m, 3.f);
+  // A sample beyond the fixed-point range is counted, not recorded.
+  m.fcos = 1e20f;
+  guide_record_mix(g, 0, m, 3.f);
+  f.fold();
+  const Float* v = f.cell_values(0) + g.mix_entry;
+  const double x = 0.3 * 3.0 / scale;
+  for (uint32_t k = 0; k < kGuideMixEntries; ++k) {
+    const double a = guide_mix_candidate(k), pk = a * 2.0 + (1.0 - a) * 0.5;
+    EXPECT_NEAR(v[k], x * x / (pk * 1.25), 1e-5 * x * x) << "candidate " << k;
+  }
+  EXPECT_EQ(f.stats().mix_out_of_range, 1u);
 }
 
 TEST(GuideSerialisation, RoundTripIsExact) {

@@ -249,6 +249,13 @@ TEST_F(CliTest, GuideNextEventOption) {
   EXPECT_NE(always.find("\"guide_nee\": \"always\""), std::string::npos) << always;
   EXPECT_GT(fraction(learned), 0.1) << learned;
   EXPECT_EQ(fraction(always), 0.0) << always;
+  // The mixture weight is learned per cell unless --guide-mix fixes it.
+  EXPECT_EQ(learned.find("\"guide_mix_learned_cells\": 0,"), std::string::npos) << learned;
+  const std::string fixed = stats_of("--guide-mix 0.35", "fixed.json");
+  EXPECT_NE(fixed.find("\"guide_mix_learned_cells\": 0,"), std::string::npos) << fixed;
+  const size_t k = fixed.find("\"guide_mean_mix\": ");
+  ASSERT_NE(k, std::string::npos) << fixed;
+  EXPECT_NEAR(std::stod(fixed.substr(k + 18)), 0.35, 1e-6) << fixed;
   RunResult bad = run("render --guide-nee never");
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_NE(bad.output.find("--guide-nee"), std::string::npos) << bad.output;

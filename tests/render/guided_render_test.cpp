@@ -74,6 +74,8 @@ TEST(GuidedUnbiased, DoorAjarAndShelterAgreeWithUnguided) {
     if (std::string(name) == "door-ajar") {
       EXPECT_GT(g.stats.counters.path.nee_skipped, g.stats.counters.path.vertices / 10);
     }
+    // ... and cells learned their own mixture weights (the agreement covers them too).
+    EXPECT_GT(g.stats.guide.mix_learned_cells, 0u);
   }
 }
 
