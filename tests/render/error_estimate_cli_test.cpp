@@ -21,6 +21,7 @@
 #include "../test_dir.h"
 #include "../cli_run.h"
 #include "../exr_read.h"
+#include "../json_read.h"
 #include "master/image_output.h"
 #include "furnace_scene.h"
 #include "render_helpers.h"
@@ -32,27 +33,9 @@ namespace fs = std::filesystem;
 using testing::run;
 using testing::RunResult;
 using testing::exr_channels;
-
-std::string read_text(const fs::path& p) {
-  std::ifstream f(p);
-  return std::string((std::istreambuf_iterator<char>(f)), {});
-}
-
-// The first `"key": number` in a JSON text; NaN when absent.
-double json_number(const std::string& json, const std::string& key) {
-  std::smatch m;
-  if (!std::regex_search(json, m, std::regex("\"" + key + "\": *(-?[0-9.eE+-]+)"))) return std::nan("");
-  return std::stod(m[1]);
-}
-
-// Every `"key": number` in order (e.g. one per pass).
-std::vector<double> json_numbers(const std::string& json, const std::string& key) {
-  std::vector<double> out;
-  const std::regex re("\"" + key + "\": *(-?[0-9.eE+-]+)");
-  for (auto it = std::sregex_iterator(json.begin(), json.end(), re); it != std::sregex_iterator(); ++it)
-    out.push_back(std::stod((*it)[1]));
-  return out;
-}
+using testing::json_number;
+using testing::json_numbers;
+using testing::read_text;
 
 double exr_number(const std::string& path, const char* name) {
   Imf::InputFile file(path.c_str());
