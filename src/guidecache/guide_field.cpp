@@ -95,8 +95,8 @@ GuideView GuideField::view() {
   g.learn_normal = learn_normal_.data();
   g.cell_light_prob = cell_light_prob_.data();
   g.nee_prob = nee_prob_.data();
-  g.nee_entry = bins_ + lights_;
-  g.mix_entry = g.nee_entry + kGuideNeeEntries;
+  g.nee_entry = nee_entry();
+  g.mix_entry = mix_entry();
   g.cell_mix = cell_mix_.data();
   g.learn_mix = config_.learn_mix;
   g.acc = acc_.data();
@@ -275,7 +275,7 @@ void GuideField::build_distributions() {
 Float GuideField::nee_probability(size_t cell) const {
   constexpr uint32_t kNeeMinVisits = 64;
   if (!(config_.nee_gain > 0.f)) return 1.f;
-  const size_t e = cell * stride() + bins_ + lights_;
+  const size_t e = cell * stride() + nee_entry();
   if (visits_[e] < kNeeMinVisits || visits_[e + 1] < kNeeMinVisits) return 1.f;
   const double d = value_[e], i = value_[e + 1];
   if (!(d + i > 0.0)) return 1.f;
@@ -284,20 +284,25 @@ Float GuideField::nee_probability(size_t cell) const {
 }
 
 // The candidate weight with the smallest mean second moment, once every
-// candidate has kMixMinVisits vertices; guide_prob until then or when the
-// weight is fixed. The statistics are estimates from the field's own
-// learning targets, so a field that is wrong where it is confident (a cell
-// averaging points that see a light and points that do not) shows it here
-// as the second moment of its higher weights.
-Float GuideField::mix_weight(size_t cell) const {
-  if (!config_.learn_mix) return config_.guide_prob;
-  const size_t e = cell * stride() + bins_ + lights_ + kGuideNeeEntries;
+// candidate has kMixMinVisits vertices (-1 until then, or when the weight is
+// fixed). The statistics are estimates from the field's own learning
+// targets, so a field that is wrong where it is confident (a cell averaging
+// points that see a light and points that do not) shows it here as the
+// second moment of its higher weights.
+int32_t GuideField::learned_mix_candidate(size_t cell) const {
+  if (!config_.learn_mix) return -1;
+  const size_t e = cell * stride() + mix_entry();
   uint32_t best = 0;
   for (uint32_t k = 0; k < kGuideMixEntries; ++k) {
-    if (visits_[e + k] < kMixMinVisits) return config_.guide_prob;
+    if (visits_[e + k] < kMixMinVisits) return -1;
     if (value_[e + k] < value_[e + best]) best = k;
   }
-  return guide_mix_candidate(best);
+  return static_cast<int32_t>(best);
+}
+
+Float GuideField::mix_weight(size_t cell) const {
+  const int32_t k = learned_mix_candidate(cell);
+  return k >= 0 ? guide_mix_candidate(static_cast<uint32_t>(k)) : config_.guide_prob;
 }
 
 void GuideField::set_guide_prob(Float p) {
@@ -322,8 +327,7 @@ GuideFieldStats GuideField::stats() const {
     if (!(irradiance_[c] > 0.f)) continue;
     mix_sum += cell_mix_[c];
     ++guiding;
-    const size_t e = c * stride() + bins_ + lights_ + kGuideNeeEntries;
-    if (config_.learn_mix && visits_[e] >= kMixMinVisits) ++s.mix_learned_cells;
+    if (learned_mix_candidate(c) >= 0) ++s.mix_learned_cells;
   }
   s.mean_mix = guiding ? mix_sum / double(guiding) : 0.0;
   return s;

@@ -114,15 +114,18 @@ class GuideField {
   void serialize(Archive& ar);
 
  private:
-  // Entries per cell: direction bins, learned lights, then the two
-  // next-event statistics (kGuideNeeEntries).
-  uint32_t stride() const { return bins_ + lights_ + kGuideNeeEntries + kGuideMixEntries; }
+  // Entries per cell: direction bins, learned lights, the next-event
+  // statistics (kGuideNeeEntries), then the mixture statistics (kGuideMixEntries).
+  uint32_t stride() const { return mix_entry() + kGuideMixEntries; }
+  uint32_t nee_entry() const { return bins_ + lights_; }
+  uint32_t mix_entry() const { return nee_entry() + kGuideNeeEntries; }
   uint64_t bytes_per_cell() const;
   uint64_t split_threshold() const;
   size_t add_cell();
   void split(size_t node);
   void build_distributions();
   Float nee_probability(size_t cell) const;
+  int32_t learned_mix_candidate(size_t cell) const;
   Float mix_weight(size_t cell) const;
   void build_bin_dirs();
   // Offsets of the parts of acc_.

@@ -72,7 +72,7 @@ struct GuideView {
   uint32_t grid = 12;      // bins per side of the equal-area square
   uint32_t bins = 144;     // grid * grid
   uint32_t lights = 0;     // learned light-selection entries per cell (0 = off)
-  uint32_t stride = 146;   // entries per cell: bins, then lights, then kGuideNeeEntries
+  uint32_t stride = 151;   // entries per cell: bins, lights, kGuideNeeEntries, kGuideMixEntries
   uint32_t nee_entry = 144;  // first next-event statistic: bins + lights
   uint32_t mix_entry = 146;  // first mixture statistic: nee_entry + kGuideNeeEntries
   const Vec3* bin_dirs = nullptr;  // centre direction of each bin
