@@ -140,6 +140,12 @@ def plot(a, results, docs_dir):
     colors = {"none": "black", "qtable": "tab:blue", "qlearning": "tab:orange"}
     files = []
 
+    def save(fig, name):
+        fig.tight_layout()
+        files.append(os.path.join(docs_dir, name))
+        fig.savefig(files[-1], dpi=90)
+        plt.close(fig)
+
     fig, axes = plt.subplots(1, len(scenes), figsize=(4 * len(scenes), 3.6), squeeze=False)
     for ax, scene in zip(axes[0], scenes):
         e = results["scenes"][scene]
@@ -151,10 +157,7 @@ def plot(a, results, docs_dir):
         ax.grid(True, which="both", alpha=0.3)
     axes[0][0].set_ylabel("relMSE vs reference")
     axes[0][0].legend(fontsize=8)
-    fig.tight_layout()
-    files.append(os.path.join(docs_dir, "error-vs-time.png"))
-    fig.savefig(files[-1], dpi=90)
-    plt.close(fig)
+    save(fig, "error-vs-time.png")
 
     fig, axes = plt.subplots(2, len(scenes), figsize=(4 * len(scenes), 6), squeeze=False)
     for col, scene in enumerate(scenes):
@@ -173,10 +176,7 @@ def plot(a, results, docs_dir):
     axes[0][0].set_ylabel("zero-contribution fraction")
     axes[1][0].set_ylabel("mean path length")
     axes[0][0].legend(fontsize=8)
-    fig.tight_layout()
-    files.append(os.path.join(docs_dir, "training.png"))
-    fig.savefig(files[-1], dpi=90)
-    plt.close(fig)
+    save(fig, "training.png")
 
     fig, ax = plt.subplots(figsize=(5, 4.5))
     lo, hi = 1e9, 0
@@ -201,10 +201,7 @@ def plot(a, results, docs_dir):
     ax.set_ylabel("estimated relMSE (while rendering)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    files.append(os.path.join(docs_dir, "estimate-vs-measured.png"))
-    fig.savefig(files[-1], dpi=90)
-    plt.close(fig)
+    save(fig, "estimate-vs-measured.png")
     return files
 
 
