@@ -115,8 +115,18 @@ struct GuideView {
   TESSERA_HOST_DEVICE bool learned(int32_t cell) const { return irradiance[cell] > 0.f; }
 
   TESSERA_HOST_DEVICE Float bin_solid_angle() const { return 4.f * kPi / static_cast<Float>(bins); }
-  TESSERA_HOST_DEVICE Float dir_pmf_of(int32_t cell, uint32_t bin) const {
-    return dir_alias[static_cast<size_t>(cell) * bins + bin].pmf;
+  // The alias entry of a bin, and the solid-angle density of guided sampling
+  // for directions in that bin.
+  TESSERA_HOST_DEVICE const GuideAlias* bin_entry(int32_t cell, uint32_t bin) const {
+    return &dir_alias[static_cast<size_t>(cell) * bins + bin];
+  }
+  TESSERA_HOST_DEVICE Float entry_pdf(const GuideAlias& a) const {
+    return a.pmf * (static_cast<Float>(bins) * kInv4Pi);
+  }
+  // The alias entry sample_bin(cell, u) reads first.
+  TESSERA_HOST_DEVICE const GuideAlias* alias_entry(int32_t cell, Float u) const {
+    const uint32_t i = glm::min(static_cast<uint32_t>(u * static_cast<Float>(bins)), bins - 1);
+    return &dir_alias[static_cast<size_t>(cell) * bins + i];
   }
   // Draws a bin with one uniform number (alias method); *pmf is its probability.
   TESSERA_HOST_DEVICE uint32_t sample_bin(int32_t cell, Float u, Float* pmf) const {
@@ -173,7 +183,7 @@ TESSERA_HOST_DEVICE inline Float guide_value(const GuideView& g, int32_t cell, u
 
 // Solid-angle density of guided sampling in cell for directions in bin.
 TESSERA_HOST_DEVICE inline Float guide_bin_pdf(const GuideView& g, int32_t cell, uint32_t bin) {
-  return g.dir_pmf_of(cell, bin) * (static_cast<Float>(g.bins) * kInv4Pi);
+  return g.entry_pdf(*g.bin_entry(cell, bin));
 }
 // Solid-angle density of guided sampling in cell for a unit world direction.
 TESSERA_HOST_DEVICE inline Float guide_pdf(const GuideView& g, int32_t cell, const Vec3& dir) {

@@ -12,6 +12,14 @@
 #define TESSERA_INLINE inline __attribute__((always_inline))
 #endif
 
+// Hint that memory will be read soon (a no-op on the GPU, whose caches are
+// fed by other warps while one waits).
+#if defined(__CUDA_ARCH__)
+#define TESSERA_PREFETCH(p) ((void)(p))
+#else
+#define TESSERA_PREFETCH(p) __builtin_prefetch(p)
+#endif
+
 #if defined(__CUDA_ARCH__)
 #define TESSERA_IS_GPU_CODE 1
 #else

@@ -238,6 +238,12 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     const Float guide_p = kGuide && !delta_lobe ? guide_probability(g, cell, bsdf, (Spec & kSpecNonDiffuse) == 0) : 0.f;
     const bool guided_vertex = guide_p > 0.f;
 
+    // The direction's random numbers are drawn before next-event estimation so
+    // that the guide's alias entry can be fetched while the shadow ray is traced.
+    const Float uc = rng.uniform();
+    const Vec2 u = rng.uniform2();
+    if (guided_vertex) TESSERA_PREFETCH(g.alias_entry(cell, uc));
+
     // Next-event estimation at non-specular vertices (pbrt-v4's SampleLd).
     Float direct_estimate = 0.f;  // its unweighted estimate of light reflected here (guide targets)
     const bool nee_vertex = settings.nee && lobes_have_non_specular(lobes) && s.num_lights > 0;
@@ -269,11 +275,19 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           if (!ls.infinite) tmax = glm::length(ls.p_light - o) * 0.9999f;
           ++c.shadow_rays;
           Float light_pdf = pmf * ls.pdf;
+          // The guide's density of the light direction, for the MIS weight: its
+          // alias entry is fetched while the shadow ray is traced.
+          const GuideAlias* light_dir_entry = nullptr;
+          if (guided_vertex && !ls.delta) {
+            light_dir_entry = g.bin_entry(cell, guide_bin_of(g, ls.wi));
+            TESSERA_PREFETCH(light_dir_entry);
+          }
           if (light_pdf > 0.f && !tracer.occluded(o, ls.wi, tmax)) {
             Float w = 1.f;
             if (!ls.delta) {
               Float scatter_pdf = eval_pdf<Spec>(bsdf, wo_l, wi_l);
-              if (guided_vertex) scatter_pdf = guide_p * guide_pdf(g, cell, ls.wi) + (1.f - guide_p) * scatter_pdf;
+              if (light_dir_entry)
+                scatter_pdf = guide_p * g.entry_pdf(*light_dir_entry) + (1.f - guide_p) * scatter_pdf;
               w = power_heuristic(light_pdf, scatter_pdf);
             }
             L += beta * f * ls.L * (w / light_pdf);
@@ -307,8 +321,6 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       if (sets_expectation) path_expected = luminance(beta) * reflected;
     }
 
-    Float uc = rng.uniform();
-    Vec2 u = rng.uniform2();
     BsdfSample bs;
     Vec3 wi;  // world space
     Float scatter_pdf;
