@@ -125,14 +125,13 @@ struct GuideView {
   }
   // The alias entry sample_bin(cell, u) reads first.
   TESSERA_HOST_DEVICE const GuideAlias* alias_entry(int32_t cell, Float u) const {
-    const uint32_t i = glm::min(static_cast<uint32_t>(u * static_cast<Float>(bins)), bins - 1);
-    return &dir_alias[static_cast<size_t>(cell) * bins + i];
+    return bin_entry(cell, glm::min(static_cast<uint32_t>(u * static_cast<Float>(bins)), bins - 1));
   }
   // Draws a bin with one uniform number (alias method); *pmf is its probability.
   TESSERA_HOST_DEVICE uint32_t sample_bin(int32_t cell, Float u, Float* pmf) const {
     Float x = u * static_cast<Float>(bins);
     uint32_t i = glm::min(static_cast<uint32_t>(x), bins - 1);
-    const GuideAlias& a = dir_alias[static_cast<size_t>(cell) * bins + i];
+    const GuideAlias& a = *bin_entry(cell, i);
     const bool keep = (x - static_cast<Float>(i)) < a.keep;
     *pmf = keep ? a.pmf : a.alias_pmf;
     return keep ? i : a.alias;
