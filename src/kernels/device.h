@@ -12,18 +12,14 @@
 #define TESSERA_INLINE inline __attribute__((always_inline))
 #endif
 
-// Hint that memory will be read soon (a no-op on the GPU, whose caches are
-// fed by other warps while one waits).
-#if defined(__CUDA_ARCH__)
-#define TESSERA_PREFETCH(p) ((void)(p))
-#else
-#define TESSERA_PREFETCH(p) __builtin_prefetch(p)
-#endif
-
+// TESSERA_PREFETCH hints that memory will be read soon: a no-op on the GPU,
+// whose caches are fed by other warps while one waits.
 #if defined(__CUDA_ARCH__)
 #define TESSERA_IS_GPU_CODE 1
+#define TESSERA_PREFETCH(p) ((void)(p))
 #else
 #define TESSERA_IS_GPU_CODE 0
+#define TESSERA_PREFETCH(p) __builtin_prefetch(p)
 #endif
 
 #define GLM_FORCE_XYZW_ONLY
