@@ -102,6 +102,7 @@ GuideView GuideField::view() {
   g.acc = acc_.data();
   g.acc_normal = acc_.data() + acc_normal_offset();
   g.rejected = acc_.data() + acc_rejected_offset();
+  g.acc_words = acc_.size();
   g.fixed_scale = fixed_scale_;
   g.max_target = max_target_;
   g.guide_prob = config_.guide_prob;

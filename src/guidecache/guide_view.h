@@ -93,11 +93,15 @@ struct GuideView {
   // and the MIS weights stay unbiased (light pdfs carry this factor).
   const Float* nee_prob = nullptr;
 
-  // Accumulators for the running pass (relaxed atomics).
+  // Accumulators for the running pass: one block of acc_words integers that
+  // starts at acc. Threads that share the block add with relaxed atomics; a
+  // CPU thread whose view points into its own copy (acc_private) adds plainly.
   uint64_t* acc = nullptr;         // cells * stride pairs (sum in fixed point = target * fixed_scale, count)
   uint64_t* acc_normal = nullptr;  // cells * 3, fixed point (kGuideNormalScale)
   uint64_t* rejected = nullptr;    // [0] NaN/Inf/negative targets, [1] targets too large for the fixed point,
                                    // [2] mixture statistics out of the fixed point's range (not recorded)
+  uint64_t acc_words = 0;          // size of the block: pairs, normals, rejections
+  bool acc_private = false;        // the block is the calling thread's own (CPU only)
   Float fixed_scale = 1.f;
   Float max_target = 1e30f;        // larger targets are rejected (and counted), never clamped
 
@@ -199,7 +203,7 @@ TESSERA_HOST_DEVICE inline bool guide_sample(const GuideView& g, int32_t cell, F
   if (!(pmf > 0.f)) return false;
   Float inv_grid = 1.f / static_cast<Float>(g.grid);
   Vec2 sq((static_cast<Float>(bin % g.grid) + u.x) * inv_grid, (static_cast<Float>(bin / g.grid) + u.y) * inv_grid);
-  *dir = glm::normalize(equal_area_square_to_sphere(sq));
+  *dir = equal_area_square_to_sphere(sq);  // unit length by construction
   // The density is the chosen bin's. Mapping the direction back could, for a
   // point within float rounding of a bin edge, land in the neighbour: that
   // set has measure ~1e-7 of the sphere and is not worth a second mapping.
@@ -208,21 +212,31 @@ TESSERA_HOST_DEVICE inline bool guide_sample(const GuideView& g, int32_t cell, F
   return true;
 }
 
+// Adds v to an accumulator of the view's block.
+TESSERA_HOST_DEVICE inline void guide_acc_add(const GuideView& g, uint64_t* p, uint64_t v) {
+#if TESSERA_IS_GPU_CODE
+  atomic_add_u64(p, v);
+#else
+  if (g.acc_private) *p += v;
+  else atomic_add_u64(p, v);
+#endif
+}
+
 // Adds one learning target to entry (a bin, or bins + light) of a cell.
 // Returns false (and counts it) when the target is rejected.
 TESSERA_HOST_DEVICE inline bool guide_record(const GuideView& g, int32_t cell, uint32_t entry, Float target) {
   if (!(target >= 0.f) || !(target <= 3.4e38f)) {  // NaN, negative or infinite
-    atomic_add_u64(&g.rejected[0], 1);
+    guide_acc_add(g, &g.rejected[0], 1);
     return false;
   }
   if (target > g.max_target) {
-    atomic_add_u64(&g.rejected[1], 1);
+    guide_acc_add(g, &g.rejected[1], 1);
     return false;
   }
   size_t i = static_cast<size_t>(cell) * g.stride + entry;
   // float is exact enough here: targets are below 2^44 units, rounded to 24 bits.
-  atomic_add_u64(&g.acc[2 * i], static_cast<uint64_t>(target * g.fixed_scale + 0.5f));
-  atomic_add_u64(&g.acc[2 * i + 1], 1);
+  guide_acc_add(g, &g.acc[2 * i], static_cast<uint64_t>(target * g.fixed_scale + 0.5f));
+  guide_acc_add(g, &g.acc[2 * i + 1], 1);
   return true;
 }
 
@@ -232,7 +246,7 @@ TESSERA_HOST_DEVICE inline void guide_record_normal(const GuideView& g, int32_t 
   if (!g.learn_normal[cell]) return;
   uint64_t* a = g.acc_normal + 3 * static_cast<size_t>(cell);
   for (int k = 0; k < 3; ++k)
-    atomic_add_u64(&a[k], static_cast<uint64_t>(static_cast<int64_t>(n[k] * kGuideNormalScale)));
+    guide_acc_add(g, &a[k], static_cast<uint64_t>(static_cast<int64_t>(n[k] * kGuideNormalScale)));
 }
 
 }  // namespace tessera

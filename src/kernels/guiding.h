@@ -97,7 +97,7 @@ TESSERA_HOST_DEVICE inline void guide_record_mix(const GuideView& g, int32_t cel
     largest = glm::max(largest, s[k]);
   }
   if (!(largest <= g.max_target)) {
-    atomic_add_u64(&g.rejected[2], 1);
+    guide_acc_add(g, &g.rejected[2], 1);
     return;
   }
   for (uint32_t k = 0; k < kGuideMixEntries; ++k) guide_record(g, cell, g.mix_entry + k, s[k]);

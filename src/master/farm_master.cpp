@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "comm/farm_protocol.h"
+#include "worker/thread_guide_accumulators.h"
 
 namespace tessera {
 namespace {
@@ -56,6 +57,7 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
   // queue is empty, they keep answering until every worker is done.
   std::atomic<size_t> next{0};
   std::atomic<uint32_t> empty_replies{0};
+  ThreadGuideAccumulators guide_acc(settings);
   std::atomic<bool> failed{false};
   const uint32_t all_done = kRequestsInFlight * static_cast<uint32_t>(workers);
   std::mutex comm_mutex, counters_mutex;
@@ -104,7 +106,7 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
             serve();
             const size_t i = next.fetch_add(1);  // one tile at a time, so the workers find the rest
             if (i >= jobs.size()) break;
-            TileCounters tc = render_tile(view_, tracer_, settings, jobs[i], film_tile(film, jobs[i]));
+            TileCounters tc = render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]));
             {
               std::lock_guard<std::mutex> lock(counters_mutex);
               counters->add(tc);
@@ -125,6 +127,7 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
     failed = true;
     throw;
   }
+  guide_acc.gather();
 }
 
 void FarmMaster::reduce_guide(GuideField& guide) {

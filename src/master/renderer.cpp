@@ -13,6 +13,7 @@
 #include "master/error_estimate.h"
 #include "master/progress.h"
 #include "worker/cpu_affinity.h"
+#include "worker/thread_guide_accumulators.h"
 
 namespace tessera {
 
@@ -49,10 +50,11 @@ LocalPassExecutor::LocalPassExecutor(const EmbreeScene& embree, const SceneView&
 void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film,
                                     TileCounters* counters, const std::function<void(uint64_t)>& on_tile_done) {
   std::mutex counters_mutex;
+  ThreadGuideAccumulators guide_acc(settings);
   tbb::task_arena arena(threads_);
   arena.execute([&] {
     tbb::parallel_for(size_t(0), jobs.size(), [&](size_t i) {
-      TileCounters tc = render_tile(view_, tracer_, settings, jobs[i], film_tile(film, jobs[i]));
+      TileCounters tc = render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]));
       {
         std::lock_guard<std::mutex> lock(counters_mutex);
         counters->add(tc);  // integer sums: order-independent
@@ -60,6 +62,7 @@ void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vec
       if (on_tile_done) on_tile_done(tc.samples);
     });
   });
+  guide_acc.gather();
 }
 
 RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& opt, GuideField* guide,

@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include "comm/farm_protocol.h"
+#include "worker/thread_guide_accumulators.h"
 
 namespace tessera {
 namespace {
@@ -17,6 +18,7 @@ void render_pass_tiles(Transport& t, const SceneView& view, const EmbreeTracer& 
   for (uint32_t k = 0; k < kRequestsInFlight; ++k) t.send(0, kTagRequest, encode(TileRequest{capacity, {}, {}}));
   uint32_t open = kRequestsInFlight;
   std::mutex mutex;
+  ThreadGuideAccumulators guide_acc(settings);
   while (open > 0) {
     Message m = t.receive(0);
     if (m.tag != kTagJobs) throw std::runtime_error("unexpected message from the master");
@@ -29,7 +31,8 @@ void render_pass_tiles(Transport& t, const SceneView& view, const EmbreeTracer& 
         TileWork& w = jobs.jobs[i];
         if (w.pixels.size() != static_cast<size_t>(w.job.x1 - w.job.x0) * (w.job.y1 - w.job.y0))
           throw std::runtime_error("malformed tile job");
-        TileCounters tc = render_tile(view, tracer, settings, w.job, TilePixels{w.pixels.data(), w.job.x1 - w.job.x0});
+        TileCounters tc =
+            render_tile(view, tracer, guide_acc.for_this_thread(), w.job, TilePixels{w.pixels.data(), w.job.x1 - w.job.x0});
         std::lock_guard<std::mutex> lock(mutex);
         req.counters.add(tc);
       });
@@ -38,6 +41,7 @@ void render_pass_tiles(Transport& t, const SceneView& view, const EmbreeTracer& 
     t.send(0, kTagRequest, encode(req));
     ++open;
   }
+  guide_acc.gather();
 }
 
 }  // namespace
