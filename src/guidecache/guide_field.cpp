@@ -80,6 +80,7 @@ void GuideField::build_bin_dirs() {
 GuideView GuideField::view() {
   GuideView g;
   g.nodes = nodes_.data();
+  g.top_nodes = top_nodes_.data();
   g.lo = lo_;
   g.extent = extent_;
   g.grid = config_.grid;
@@ -181,7 +182,34 @@ void GuideField::split(size_t node_index) {
 // normal (the product with a diffuse BSDF), lights proportional to their
 // learned contribution; each mixed with a uniform floor. An untrained cell
 // (all zero) samples uniformly, and its vertices draw no guided directions.
+// For every cube of the top grid, the node that covers it: descend from the
+// root towards the cube's centre until depth kGuideTopLevels or a leaf.
+void GuideField::build_top_nodes() {
+  top_nodes_.resize(size_t(kGuideNormalClasses) * kGuideTopCells);
+  const Float cube = extent_ / static_cast<Float>(kGuideTopSide);
+  for (uint32_t c = 0; c < kGuideNormalClasses; ++c)
+    for (uint32_t i = 0; i < kGuideTopCells; ++i) {
+      const Vec3 grid(static_cast<Float>(i % kGuideTopSide), static_cast<Float>(i / kGuideTopSide % kGuideTopSide),
+                      static_cast<Float>(i / (kGuideTopSide * kGuideTopSide)));
+      const Vec3 centre = lo_ + (grid + 0.5f) * cube;
+      int32_t node = static_cast<int32_t>(c);
+      Vec3 lo = lo_;
+      Float size = extent_;
+      for (uint32_t level = 0; level < kGuideTopLevels && nodes_[node].child >= 0; ++level) {
+        size *= 0.5f;
+        const Vec3 mid = lo + size;
+        const int32_t octant = (centre.x >= mid.x ? 1 : 0) | (centre.y >= mid.y ? 2 : 0) | (centre.z >= mid.z ? 4 : 0);
+        if (octant & 1) lo.x = mid.x;
+        if (octant & 2) lo.y = mid.y;
+        if (octant & 4) lo.z = mid.z;
+        node = nodes_[node].child + octant;
+      }
+      top_nodes_[c * kGuideTopCells + i] = node;
+    }
+}
+
 void GuideField::build_distributions() {
+  build_top_nodes();
   const size_t cells = num_cells(), s = stride();
   dir_alias_.assign(cells * bins_, GuideAlias{});
   light_cdf_.assign(cells * (lights_ + 1), 0.f);

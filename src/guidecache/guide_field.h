@@ -128,6 +128,7 @@ class GuideField {
   int32_t learned_mix_candidate(size_t cell) const;
   Float mix_weight(size_t cell) const;
   void build_bin_dirs();
+  void build_top_nodes();
   // Offsets of the parts of acc_.
   size_t acc_normal_offset() const { return 2 * num_cells() * size_t(stride()); }
   size_t acc_rejected_offset() const { return acc_normal_offset() + 3 * size_t(num_cells()); }
@@ -149,6 +150,7 @@ class GuideField {
 
   // Derived (rebuilt by build_distributions, not serialised).
   std::vector<Vec3> bin_dirs_;
+  std::vector<int32_t> top_nodes_;     // GuideView::top_nodes
   std::vector<Float> light_cdf_, irradiance_, qmax_;
   std::vector<GuideAlias> dir_alias_;
   std::vector<uint8_t> learn_normal_;

@@ -62,10 +62,20 @@ constexpr uint32_t kGuideNormalClasses = 6;
 // Fixed-point scale for normals accumulated per cell (only their direction matters).
 constexpr Float kGuideNormalScale = 1048576.f;
 
+// The first levels of every octree, flattened: for each normal class, a grid
+// of kGuideTopSide^3 equal cubes over the octree's cube, each holding the node
+// that covers it at depth kGuideTopLevels (or the shallower leaf that does).
+// Cell lookups start there instead of at the root.
+constexpr uint32_t kGuideTopLevels = 3;
+constexpr uint32_t kGuideTopSide = 1u << kGuideTopLevels;
+constexpr uint32_t kGuideTopCells = kGuideTopSide * kGuideTopSide * kGuideTopSide;
+
 struct GuideView {
   // Spatial octrees: nodes[0..5] are the roots of the normal classes; each
   // covers the cube [lo, lo + extent]^3.
   const GuideNode* nodes = nullptr;
+  // kGuideNormalClasses * kGuideTopCells node indices (null: start at the roots).
+  const int32_t* top_nodes = nullptr;
   Vec3 lo{0.f};
   Float extent = 1.f;
 
@@ -158,9 +168,21 @@ TESSERA_HOST_DEVICE inline uint32_t guide_normal_class(const Vec3& n) {
 // The leaf cell holding point p on a surface whose normal (on the side the
 // path is on) is n.
 TESSERA_HOST_DEVICE inline int32_t guide_find_cell(const GuideView& g, const Vec3& p, const Vec3& n) {
+  const uint32_t normal_class = guide_normal_class(n);
   Vec3 lo = g.lo;
   Float size = g.extent;
-  const GuideNode* node = &g.nodes[guide_normal_class(n)];
+  const GuideNode* node = &g.nodes[normal_class];
+  if (g.top_nodes) {
+    // The octree's first levels in one step: the grid cube holding p (points
+    // outside the cube go to the nearest one, as the descent would take them).
+    size = g.extent * (1.f / static_cast<Float>(kGuideTopSide));
+    const Vec3 rel = (p - g.lo) / size;
+    const uint32_t ix = glm::min(static_cast<uint32_t>(glm::max(rel.x, 0.f)), kGuideTopSide - 1);
+    const uint32_t iy = glm::min(static_cast<uint32_t>(glm::max(rel.y, 0.f)), kGuideTopSide - 1);
+    const uint32_t iz = glm::min(static_cast<uint32_t>(glm::max(rel.z, 0.f)), kGuideTopSide - 1);
+    lo = g.lo + Vec3(static_cast<Float>(ix), static_cast<Float>(iy), static_cast<Float>(iz)) * size;
+    node = &g.nodes[g.top_nodes[normal_class * kGuideTopCells + (iz * kGuideTopSide + iy) * kGuideTopSide + ix]];
+  }
   while (node->child >= 0) {
     size *= 0.5f;
     Vec3 mid = lo + size;

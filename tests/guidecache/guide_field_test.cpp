@@ -245,6 +245,35 @@ TEST(GuideField, SplittingStopsAtTheMemoryBudget) {
   EXPECT_LE(f.stats().bytes, cfg.budget_bytes);
 }
 
+// Lookups start from the flattened top levels (GuideView::top_nodes); they
+// must find the leaf the plain descent from the root finds, for trees that
+// are deep in one corner and shallow elsewhere, and for points outside.
+TEST(GuideField, TopGridFindsTheSameLeafAsTheDescentFromTheRoot) {
+  GuideConfig cfg;
+  cfg.split_updates = 10;
+  cfg.budget_bytes = 64ull << 20;
+  GuideField f = make_field(cfg);
+  for (int pass = 0; pass < 6; ++pass) {
+    GuideView g = f.view();
+    for (int k = 0; k < 40; ++k) {  // busy near one corner, for every normal class
+      const Vec3 p(0.3f + 0.004f * k, 0.3f, 0.31f);
+      for (Vec3 n : {Vec3(1, 0, 0), Vec3(0, -1, 0), Vec3(0, 0, 1)}) guide_record(g, guide_find_cell(g, p, n), 0, 1.f);
+    }
+    f.fold();
+  }
+  ASSERT_GT(f.num_cells(), 8u * 6u);  // deeper than the top grid somewhere
+  const GuideView with_top = f.view();
+  ASSERT_NE(with_top.top_nodes, nullptr);
+  GuideView from_root = with_top;
+  from_root.top_nodes = nullptr;
+  Rng rng = Rng::for_sample(5, 0, 0);
+  for (int i = 0; i < 200000; ++i) {
+    const Vec3 p = Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 1.4f - 0.2f;
+    const Vec3 n = glm::normalize(Vec3(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5f);
+    ASSERT_EQ(guide_find_cell(with_top, p, n), guide_find_cell(from_root, p, n)) << p.x << " " << p.y << " " << p.z;
+  }
+}
+
 TEST(GuideField, OppositeNormalsNeverShareACell) {
   GuideField f = make_field();
   for (Vec3 n : {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)})
