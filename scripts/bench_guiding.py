@@ -8,6 +8,9 @@ is compared with a reference image:
   none       plain path tracing
   qtable     expected-SARSA Q-table guiding (Dahm & Keller), the default
   qlearning  the Q-learning "max" rule, for the comparison the paper makes
+  qtable-throughput  qtable with pbrt-v4's throughput roulette alone (not run
+             by default): what guided sampling costs per sample without the
+             longer light-carrying paths of guided roulette
 Reported per scene and method (median over --repeats seeds): relMSE against
 the reference, the same minus the reference's own noise (the relMSE its
 variance layer predicts; independent errors add, so this is the error against
@@ -30,6 +33,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import reference as ref_cache  # noqa: E402
 
 ROOT = ref_cache.ROOT
+# Each method's render options (a method that is not here is a --guide value).
+METHOD_ARGS = {"qtable-throughput": ["--guide", "qtable", "--guide-roulette", "throughput"]}
 SCENES = ["cornell-box", "door-ajar", "shelter", "pillars", "glossy"]
 # relMSE(qtable) / relMSE(none) targets from issue 3.
 TARGETS = {"door-ajar": 0.25, "shelter": 0.5, "pillars": 0.5, "cornell-box": 1.1}
@@ -76,7 +81,8 @@ def main():
                 img = os.path.join(a.out, f"{scene}-{method}.exr")
                 st = os.path.join(a.out, f"{scene}-{method}.json")
                 extra = a.guide_args.split() if method != "none" else []
-                run([a.tessera, "render", path, "-q", "--no-preview", "--guide", method, "--time", str(a.time),
+                method_args = METHOD_ARGS.get(method, ["--guide", method])
+                run([a.tessera, "render", path, "-q", "--no-preview", *method_args, "--time", str(a.time),
                      "--seed", str(rep + 1), "--stats", st, "-o", img, *threads, *extra])
                 s = json.load(open(st))
                 c = compare(a.tessera, img, ref)
@@ -122,6 +128,12 @@ def main():
         e["ratio_time_per_vertex"] = tpv
         print(f"{scene:12s}  {ratio:8.3f} ({raw:.3f})      {('<= ' + str(target)) if target else '   -   ':8s} {verdict:6s}"
               f"  {tps:6.2f} (target <= 1.25)      {tpv:6.2f}        {ql}")
+        if "qtable-throughput" in m:
+            t = m["qtable-throughput"]
+            e["ratio_relmse_throughput_roulette_vs_none"] = t["relmse_vs_truth"] / max(m["none"]["relmse_vs_truth"], 1e-30)
+            e["ratio_time_per_sample_throughput_roulette"] = t["ns_per_sample"] / max(m["none"]["ns_per_sample"], 1e-30)
+            print(f"{'':12s}  with throughput roulette: {e['ratio_relmse_throughput_roulette_vs_none']:8.3f}"
+                  f"   time/sample {e['ratio_time_per_sample_throughput_roulette']:6.2f}")
     with open(os.path.join(a.out, a.results), "w") as f:
         json.dump(results, f, indent=2)
     print(f"\nwrote {os.path.join(a.out, a.results)}")
