@@ -34,6 +34,10 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
                   "Russian roulette of guided renders: guided (by the guide's prediction of what a path will "
                   "bring) or throughput (pbrt-v4's rule)")
       ->check(CLI::IsMember({"guided", "throughput"}));
+  cmd->add_option("--guide-roulette-window", a.roulette_window,
+                  "Guided roulette: a path the guide expects to bring at least 1/W of its predicted light always "
+                  "survives. Smaller W: shorter paths, less time per sample, more noise per sample (default 2)")
+      ->check(CLI::Range(0.01, 100.0));
   cmd->add_option("--guide-nee", a.nee,
                   "Next-event estimation of guided renders: learned (cells whose shadow rays bring little trace "
                   "them less often) or always (every vertex)")
@@ -45,6 +49,7 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
 void apply_guide_render_options(const GuideArgs& a, RenderOptions* opt) {
   opt->guide_learn = {static_cast<uint32_t>(a.learn_spp), static_cast<uint32_t>(a.learn_every)};
   opt->guide_roulette = a.roulette == "guided";
+  opt->guide_roulette_window = static_cast<float>(a.roulette_window);
 }
 
 bool guiding_helps(uint32_t effects) {

@@ -24,6 +24,7 @@ struct GuideArgs {
   int64_t learn_spp = GuideLearnSchedule{}.all_spp;
   int64_t learn_every = GuideLearnSchedule{}.every;
   std::string roulette = "guided";  // guided | throughput
+  double roulette_window = kGuidedRouletteWindow;
   std::string nee = "learned";      // learned | always: next-event estimation's probability per cell
   std::string in, out;
 };

@@ -116,15 +116,16 @@ TESSERA_HOST_DEVICE inline void guide_record_mix(const GuideView& g, int32_t cel
 // gap it left 97 % of the paths without a contribution), while a field that
 // has learned nothing, or something wrong, can never make roulette harsher
 // than it was. Unbiased for any survival probability, as the caller divides
-// by it. Measured at equal time on door-ajar and pillars: window 2 beat 1 and
-// 4; letting the guide also kill paths (down to a floor of 0.2) was no
-// better, and with a floor of 0.05 paths the field had not learned about yet
-// came back 20-fold as fireflies.
+// by it. The window (PathSettings::guided_roulette_window) trades time per
+// sample for error: on door-ajar at equal time, window 2 (the default) beat 1
+// and 4; 0.5 and 0.25 give shorter paths and higher error. Letting the guide
+// also kill paths (down to a floor of 0.2) was no better, and with a floor of
+// 0.05 paths the field had not learned about yet came back 20-fold as fireflies.
 constexpr Float kGuidedRouletteWindow = 2.f;
 TESSERA_HOST_DEVICE inline Float guided_survival(const GuideView& g, int32_t cell, uint32_t bin, Float throughput,
-                                                 Float path_expected) {
+                                                 Float path_expected, Float window) {
   const Float expected = throughput * guide_value(g, cell, bin);
-  return glm::min(kGuidedRouletteWindow * expected / path_expected, 1.f);
+  return glm::min(window * expected / path_expected, 1.f);
 }
 
 // The part of a learning target that looks beyond vertex y: an estimate of

@@ -48,6 +48,10 @@ struct PathSettings {
   // Guide-driven Russian roulette (kSpecGuiding only; see guided_survival).
   // Off: pbrt-v4's throughput rule everywhere.
   bool guided_roulette = true;
+  // A continuation the guide expects to bring at least 1/window of the path's
+  // predicted radiance always survives (see guided_survival): smaller windows
+  // give shorter paths, less time per sample and more noise per sample.
+  Float guided_roulette_window = kGuidedRouletteWindow;
 };
 
 namespace detail {
@@ -390,7 +394,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     if (depth > 1) {
       Float survive = glm::min(1.f, max_component(rr_beta * eta_scale));
       if (kGuide && path_expected > 0.f && g.learned(cell)) {
-        survive = glm::max(survive, guided_survival(g, cell, wi_bin, luminance(beta), path_expected));
+        survive = glm::max(survive, guided_survival(g, cell, wi_bin, luminance(beta), path_expected,
+                                                         settings.guided_roulette_window));
         ++c.guided_roulette;
       }
       if (survive < 1.f) {

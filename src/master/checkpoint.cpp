@@ -40,6 +40,7 @@ uint64_t render_options_fingerprint(const RenderOptions& o, int32_t width, int32
   s << width << 'x' << height << ' ' << o.seed << ' ' << o.max_depth << ' ' << o.nee << ' ' << o.max_pass_spp << ' '
     << o.guide_learn.all_spp << ' ' << o.guide_learn.every << ' ' << o.guide_roulette << ' ' << guide_mode << ' '
     << o.force_full_specialisation;
+  if (o.guide_roulette_window != kGuidedRouletteWindow) s << " window " << o.guide_roulette_window;
   return fnv1a(s.str());
 }
 

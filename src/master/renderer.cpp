@@ -30,6 +30,7 @@ TileSettings make_tile_settings(const RenderOptions& opt, uint32_t specialisatio
   ts.specialisation = specialisation;
   ts.learn = opt.guide_learn;
   ts.path.guided_roulette = guiding && opt.guide_roulette;
+  ts.path.guided_roulette_window = opt.guide_roulette_window;
   return ts;
 }
 
@@ -96,6 +97,7 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
   TileSettings settings = make_tile_settings(opt, stats.specialisation, guide != nullptr);
   stats.guide_learn = opt.guide_learn;
   stats.guide_roulette = guide != nullptr && opt.guide_roulette;
+  stats.guide_roulette_window = opt.guide_roulette_window;
 
   const uint64_t pixels = static_cast<uint64_t>(w) * h;
   Progress progress(opt.progress, opt.spp > 0 ? pixels * opt.spp : 0, opt.time_budget_s);

@@ -29,6 +29,7 @@ struct RenderOptions {
   uint32_t max_pass_spp = 8;
   GuideLearnSchedule guide_learn;
   bool guide_roulette = true;   // guide-driven Russian roulette (guided renders)
+  float guide_roulette_window = kGuidedRouletteWindow;  // its window (PathSettings::guided_roulette_window)
   bool force_full_specialisation = false;  // benchmark switch: ignore the effects set
   bool progress = true;
 };
@@ -69,6 +70,7 @@ struct RenderStats {
   std::string guide_sync = "pass";  // pass | off (each rank learns alone)
   GuideLearnSchedule guide_learn;  // the learning schedule the render ran with
   bool guide_roulette = false;     // whether guide-driven roulette was on
+  float guide_roulette_window = 0.f;  // and its window
 };
 
 struct RenderResult {

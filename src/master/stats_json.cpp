@@ -95,6 +95,7 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
     j.add("guide_learn_spp", uint64_t{s.guide_learn.all_spp});
     j.add("guide_learn_every", uint64_t{s.guide_learn.every});
     j.add_string("guide_roulette", s.guide_roulette ? "guided" : "throughput");
+    if (s.guide_roulette) j.add("guide_roulette_window", s.guide_roulette_window);
     j.add("guided_roulette_fraction",
           c.path.vertices > 0 ? double(c.path.guided_roulette) / double(c.path.vertices) : 0.0);
     j.add("guide_mix_learned_cells", s.guide.mix_learned_cells);

@@ -225,6 +225,24 @@ TEST_F(CliTest, GuideRouletteOption) {
   EXPECT_NE(bad.output.find("--guide-roulette"), std::string::npos) << bad.output;
 }
 
+// --guide-roulette-window reaches the render: a smaller window lets fewer of
+// the paths the guide expects light from survive, so paths are shorter (on
+// door-ajar, where guided roulette keeps light-carrying paths alive); the
+// stats record it; bad values are refused.
+TEST_F(CliTest, GuideRouletteWindowOption) {
+  const std::string scene = testing::source_dir() + "/scenes/door-ajar.pbrt";
+  auto stats_of = [&](const std::string& args, const std::string& name) {
+    return render_stats(scene + " --res 32x24 --spp 64 --seed 3 --guide qtable " + args, name);
+  };
+  const std::string wide = stats_of("", "wide.json"), narrow = stats_of("--guide-roulette-window 0.25", "narrow.json");
+  EXPECT_EQ(json_number(wide, "guide_roulette_window"), 2.0) << wide;
+  EXPECT_EQ(json_number(narrow, "guide_roulette_window"), 0.25) << narrow;
+  EXPECT_LT(json_number(narrow, "mean_path_length"), 0.9 * json_number(wide, "mean_path_length")) << narrow;
+  RunResult bad = run("render --guide-roulette-window 0");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--guide-roulette-window"), std::string::npos) << bad.output;
+}
+
 // --guide-nee learned (default) skips shadow rays where the guide learned
 // they bring little (door-ajar's room behind a door gap); always never does.
 TEST_F(CliTest, GuideNextEventOption) {
