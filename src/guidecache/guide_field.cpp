@@ -195,15 +195,8 @@ void GuideField::build_top_nodes() {
       int32_t node = static_cast<int32_t>(c);
       Vec3 lo = lo_;
       Float size = extent_;
-      for (uint32_t level = 0; level < kGuideTopLevels && nodes_[node].child >= 0; ++level) {
-        size *= 0.5f;
-        const Vec3 mid = lo + size;
-        const int32_t octant = (centre.x >= mid.x ? 1 : 0) | (centre.y >= mid.y ? 2 : 0) | (centre.z >= mid.z ? 4 : 0);
-        if (octant & 1) lo.x = mid.x;
-        if (octant & 2) lo.y = mid.y;
-        if (octant & 4) lo.z = mid.z;
-        node = nodes_[node].child + octant;
-      }
+      for (uint32_t level = 0; level < kGuideTopLevels && nodes_[node].child >= 0; ++level)
+        node = nodes_[node].child + static_cast<int32_t>(guide_octant_step(centre, &lo, &size));
       top_nodes_[c * kGuideTopCells + i] = node;
     }
 }

@@ -165,6 +165,18 @@ TESSERA_HOST_DEVICE inline uint32_t guide_normal_class(const Vec3& n) {
   return n.z >= 0.f ? 4u : 5u;
 }
 
+// One level of an octree descent: the octant of the cube (*lo, *size) that
+// holds p; *lo and *size become that octant's.
+TESSERA_HOST_DEVICE inline uint32_t guide_octant_step(const Vec3& p, Vec3* lo, Float* size) {
+  *size *= 0.5f;
+  const Vec3 mid = *lo + *size;
+  const uint32_t octant = (p.x >= mid.x ? 1u : 0u) | (p.y >= mid.y ? 2u : 0u) | (p.z >= mid.z ? 4u : 0u);
+  if (octant & 1u) lo->x = mid.x;
+  if (octant & 2u) lo->y = mid.y;
+  if (octant & 4u) lo->z = mid.z;
+  return octant;
+}
+
 // The leaf cell holding point p on a surface whose normal (on the side the
 // path is on) is n.
 TESSERA_HOST_DEVICE inline int32_t guide_find_cell(const GuideView& g, const Vec3& p, const Vec3& n) {
@@ -183,15 +195,7 @@ TESSERA_HOST_DEVICE inline int32_t guide_find_cell(const GuideView& g, const Vec
     lo = g.lo + Vec3(static_cast<Float>(ix), static_cast<Float>(iy), static_cast<Float>(iz)) * size;
     node = &g.nodes[g.top_nodes[normal_class * kGuideTopCells + (iz * kGuideTopSide + iy) * kGuideTopSide + ix]];
   }
-  while (node->child >= 0) {
-    size *= 0.5f;
-    Vec3 mid = lo + size;
-    uint32_t octant = (p.x >= mid.x ? 1u : 0u) | (p.y >= mid.y ? 2u : 0u) | (p.z >= mid.z ? 4u : 0u);
-    if (octant & 1u) lo.x = mid.x;
-    if (octant & 2u) lo.y = mid.y;
-    if (octant & 4u) lo.z = mid.z;
-    node = &g.nodes[node->child + static_cast<int32_t>(octant)];
-  }
+  while (node->child >= 0) node = &g.nodes[node->child + static_cast<int32_t>(guide_octant_step(p, &lo, &size))];
   return node->cell;
 }
 
