@@ -178,10 +178,6 @@ void GuideField::split(size_t node_index) {
   ++totals_.splits;
 }
 
-// Per cell: directions proportional to Q max(cos, 0) about the cell's mean
-// normal (the product with a diffuse BSDF), lights proportional to their
-// learned contribution; each mixed with a uniform floor. An untrained cell
-// (all zero) samples uniformly, and its vertices draw no guided directions.
 // For every cube of the top grid, the node that covers it: descend from the
 // root towards the cube's centre until depth kGuideTopLevels or a leaf.
 void GuideField::build_top_nodes() {
@@ -201,6 +197,10 @@ void GuideField::build_top_nodes() {
     }
 }
 
+// Per cell: directions proportional to Q max(cos, 0) about the cell's mean
+// normal (the product with a diffuse BSDF), lights proportional to their
+// learned contribution; each mixed with a uniform floor. An untrained cell
+// (all zero) samples uniformly, and its vertices draw no guided directions.
 void GuideField::build_distributions() {
   build_top_nodes();
   const size_t cells = num_cells(), s = stride();
