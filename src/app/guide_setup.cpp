@@ -30,6 +30,11 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
   cmd->add_option("--guide-learn-every", a.learn_every,
                   "After --guide-learn-spp, every N-th sample per pixel trains the guide (0 = none do)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 30));
+  cmd->add_option("--guide-learn-taper", a.learn_taper,
+                  "on: past N*K samples per pixel (--guide-learn-spp N, --guide-learn-every K) the gap between "
+                  "learning samples doubles each time the sample count doubles; off: every K-th sample learns "
+                  "throughout")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--guide-roulette", a.roulette,
                   "Russian roulette of guided renders: guided (by the guide's prediction of what a path will "
                   "bring) or throughput (pbrt-v4's rule)")
@@ -47,7 +52,7 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
 }
 
 void apply_guide_render_options(const GuideArgs& a, RenderOptions* opt) {
-  opt->guide_learn = {static_cast<uint32_t>(a.learn_spp), static_cast<uint32_t>(a.learn_every)};
+  opt->guide_learn = {static_cast<uint32_t>(a.learn_spp), static_cast<uint32_t>(a.learn_every), a.learn_taper == "on"};
   opt->guide_roulette = a.roulette == "guided";
   opt->guide_roulette_window = static_cast<float>(a.roulette_window);
 }

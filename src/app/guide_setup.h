@@ -20,9 +20,11 @@ struct GuideArgs {
   int64_t split = 0;
   int64_t grid = 12;          // direction bins per side of the equal-area square
   // Learning schedule: every sample trains the guide up to learn_spp samples
-  // per pixel, then every learn_every-th sample does.
+  // per pixel, then every learn_every-th sample does (with the taper, ever
+  // more rarely: GuideLearnSchedule).
   int64_t learn_spp = GuideLearnSchedule{}.all_spp;
   int64_t learn_every = GuideLearnSchedule{}.every;
+  std::string learn_taper = "on";  // on | off
   std::string roulette = "guided";  // guided | throughput
   double roulette_window = kGuidedRouletteWindow;
   std::string nee = "learned";      // learned | always: next-event estimation's probability per cell

@@ -41,6 +41,8 @@ uint64_t render_options_fingerprint(const RenderOptions& o, int32_t width, int32
     << o.guide_learn.all_spp << ' ' << o.guide_learn.every << ' ' << o.guide_roulette << ' ' << guide_mode << ' '
     << o.force_full_specialisation;
   if (o.guide_roulette_window != kGuidedRouletteWindow) s << " window " << o.guide_roulette_window;
+  // Checkpoints from before the taper learned every K-th sample throughout.
+  if (o.guide_learn.taper) s << " taper";
   return fnv1a(s.str());
 }
 

@@ -94,6 +94,7 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
     }
     j.add("guide_learn_spp", uint64_t{s.guide_learn.all_spp});
     j.add("guide_learn_every", uint64_t{s.guide_learn.every});
+    j.add_string("guide_learn_taper", s.guide_learn.taper ? "on" : "off");
     j.add_string("guide_roulette", s.guide_roulette ? "guided" : "throughput");
     if (s.guide_roulette) j.add("guide_roulette_window", s.guide_roulette_window);
     j.add("guided_roulette_fraction",

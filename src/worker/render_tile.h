@@ -2,6 +2,7 @@
 // indices into the film, a pure function of (scene, job, seed).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 
 #include "kernels/integrator.h"
@@ -21,11 +22,28 @@ struct TileJob {
 // first passes the field changes little, so most samples just use it
 // (measured at equal time: every 8th and every 4th gave the same error, every
 // 8th is faster).
+//
+// With `taper`, the gap between learning samples doubles each time the sample
+// index doubles past 16 * every (128 by default; all_spp if that is larger):
+// each doubling of a render adds kTaperLearnPerDoubling learning samples per
+// pixel. The field keeps being refined, while the share of samples that pay
+// for learning, 1/every forever without the taper, falls towards zero in long
+// renders.
 struct GuideLearnSchedule {
+  static constexpr uint32_t kTaperLearnPerDoubling = 8;
   uint32_t all_spp = 16;
   uint32_t every = 8;
+  bool taper = true;
+  // Gap between learning sample indices around sample_index (past all_spp).
+  uint64_t period(uint32_t sample_index) const {
+    const uint64_t start = std::max<uint64_t>(uint64_t{2 * kTaperLearnPerDoubling} * every, all_spp);
+    if (!taper || sample_index < start) return every;
+    uint32_t doublings = 1;
+    while ((start << doublings) <= sample_index) ++doublings;
+    return uint64_t{every} << doublings;
+  }
   bool learns(uint32_t sample_index) const {
-    return sample_index < all_spp || (every > 0 && sample_index % every == 0);
+    return sample_index < all_spp || (every > 0 && sample_index % period(sample_index) == 0);
   }
 };
 

@@ -207,6 +207,18 @@ TEST_F(CliTest, GuideLearningScheduleOptions) {
   EXPECT_LT(some_updates, json_number(all, "guide_updates")) << all;
   EXPECT_NE(run("render --guide-learn-every -1").exit_code, 0);
   EXPECT_NE(run("render --guide-learn-spp x").exit_code, 0);
+  // The taper is on by default and says so; off reaches the render too.
+  EXPECT_NE(some.find("\"guide_learn_taper\": \"on\""), std::string::npos) << some;
+  // Every sample learns up to 16 spp either way; of samples 16-39, all without
+  // the taper, 10 with it (16, 18, ..., 30 and 32, 36).
+  const std::string base = "--res 16x16 --spp 40 --seed 2 --guide qtable --guide-learn-spp 0 --guide-learn-every 1";
+  const std::string flat = render_stats(base + " --guide-learn-taper off", "flat.json");
+  EXPECT_NE(flat.find("\"guide_learn_taper\": \"off\""), std::string::npos) << flat;
+  const std::string tapered = render_stats(base, "tapered.json");
+  EXPECT_LT(json_number(tapered, "guide_updates"), json_number(flat, "guide_updates")) << tapered;
+  const RunResult bad = run("render --guide-learn-taper maybe");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--guide-learn-taper"), std::string::npos) << bad.output;
 }
 
 // --guide-roulette reaches the render: the stats say which rule ran, and only

@@ -219,6 +219,41 @@ AttributeEnd
   expect_agree(channel_stats(g.film), mu, "tiny light");
 }
 
+// The tapered schedule: every sample below all_spp, every `every`-th up to
+// every * all_spp, then all_spp / 2 learning samples per doubling of the
+// sample count; without the taper every `every`-th throughout.
+TEST(GuidedLearningSchedule, TaperDoublesTheGapWithEveryDoublingOfTheSampleCount) {
+  GuideLearnSchedule tapered;  // 16, 8, taper on
+  GuideLearnSchedule flat = tapered;
+  flat.taper = false;
+  auto count = [](const GuideLearnSchedule& s, uint32_t begin, uint32_t end) {
+    uint32_t n = 0;
+    for (uint32_t i = begin; i < end; ++i) n += s.learns(i) ? 1u : 0u;
+    return n;
+  };
+  EXPECT_EQ(count(tapered, 0, 16), 16u);
+  EXPECT_EQ(count(tapered, 16, 128), 14u);  // 16, 24, ..., 120
+  EXPECT_EQ(count(flat, 16, 128), 14u);
+  for (uint32_t octave = 128; octave < (1u << 20); octave *= 2) {
+    EXPECT_EQ(count(tapered, octave, 2 * octave), 8u) << octave;
+    EXPECT_EQ(count(flat, octave, 2 * octave), octave / 8) << octave;
+  }
+  EXPECT_TRUE(tapered.learns(128));
+  EXPECT_FALSE(tapered.learns(136));
+  EXPECT_TRUE(tapered.learns(144));
+  EXPECT_TRUE(tapered.learns(256));
+  EXPECT_FALSE(tapered.learns(272));
+  EXPECT_TRUE(tapered.learns(288));
+  // Near the top of the index range the gap stays finite and the rule total.
+  EXPECT_EQ(tapered.period(UINT32_MAX), uint64_t{8} << 25);
+  GuideLearnSchedule none = tapered;
+  none.every = 0;
+  EXPECT_EQ(count(none, 16, 4096), 0u);
+  GuideLearnSchedule all = tapered;
+  all.all_spp = UINT32_MAX;
+  EXPECT_EQ(count(all, 0, 4096), 4096u);
+}
+
 // The learning schedule: past learn_all_spp only every learn_every-th sample
 // index trains the guide, so the number of updates follows the number of
 // learning samples; the image stays unbiased and bit-identical across thread
