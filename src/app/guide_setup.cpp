@@ -31,9 +31,9 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
                   "After --guide-learn-spp, every N-th sample per pixel trains the guide (0 = none do)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 30));
   cmd->add_option("--guide-learn-taper", a.learn_taper,
-                  "on: past N*K samples per pixel (--guide-learn-spp N, --guide-learn-every K) the gap between "
-                  "learning samples doubles each time the sample count doubles; off: every K-th sample learns "
-                  "throughout")
+                  "on: past 16*K samples per pixel (--guide-learn-every K; or --guide-learn-spp if larger) the "
+                  "gap between learning samples doubles each time the sample count doubles; off: every K-th "
+                  "sample learns throughout")
       ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--guide-roulette", a.roulette,
                   "Russian roulette of guided renders: guided (by the guide's prediction of what a path will "

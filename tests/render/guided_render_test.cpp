@@ -220,8 +220,8 @@ AttributeEnd
 }
 
 // The tapered schedule: every sample below all_spp, every `every`-th up to
-// every * all_spp, then all_spp / 2 learning samples per doubling of the
-// sample count; without the taper every `every`-th throughout.
+// 16 * every, then kTaperLearnPerDoubling (8) learning samples per doubling
+// of the sample count; without the taper every `every`-th throughout.
 TEST(GuidedLearningSchedule, TaperDoublesTheGapWithEveryDoublingOfTheSampleCount) {
   GuideLearnSchedule tapered;  // 16, 8, taper on
   GuideLearnSchedule flat = tapered;
@@ -244,7 +244,7 @@ TEST(GuidedLearningSchedule, TaperDoublesTheGapWithEveryDoublingOfTheSampleCount
   EXPECT_TRUE(tapered.learns(256));
   EXPECT_FALSE(tapered.learns(272));
   EXPECT_TRUE(tapered.learns(288));
-  // Near the top of the index range the gap stays finite and the rule total.
+  // The gap stays finite up to the largest sample index.
   EXPECT_EQ(tapered.period(UINT32_MAX), uint64_t{8} << 25);
   GuideLearnSchedule none = tapered;
   none.every = 0;
