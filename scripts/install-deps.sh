@@ -13,7 +13,8 @@ PACKAGES=(
   libtbb-dev                      # CPU parallelism
   libgtest-dev                    # tests
   libcli11-dev                    # command line
-  libassimp-dev                   # PLY meshes (ASCII and binary)
+  zlib1g-dev                      # .ply.gz meshes
+  libopenimageio-dev              # texture and environment images (EXR, PFM, PNG, TGA, HDR...)
   libstb-dev                      # PNG/JPEG read, PNG write
   python3                         # benchmark and test helper scripts
   python3-matplotlib              # benchmark plots (scripts/bench_*.py)

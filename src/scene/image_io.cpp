@@ -1,6 +1,6 @@
 #include "scene/image_io.h"
 
-#include <stb/stb_image.h>
+#include <OpenImageIO/imageio.h>
 
 #include <ImfArray.h>
 #include <ImfChannelList.h>
@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <exception>
+#include <memory>
 #include <vector>
 
 namespace tessera {
@@ -25,6 +26,15 @@ std::string lower_extension(const std::string& path) {
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return ext;
 }
+
+// OpenImageIO's errors can span lines; our messages are one line.
+std::string first_line(const std::string& text) {
+  std::string line = text.substr(0, text.find('\n'));
+  return line.empty() ? "unknown error" : line;
+}
+
+// 2^28 texels (3 GiB of RGB floats): larger images are refused with a message, not a bad_alloc.
+constexpr int64_t kMaxImageTexels = int64_t(1) << 28;
 
 [[noreturn]] void fail(const std::string& path, const std::string& reason) {
   throw SceneError("cannot read image '" + path + "': " + reason);
@@ -100,36 +110,46 @@ ImageDesc load_exr(const std::string& path) {
   }
 }
 
-ImageDesc load_with_stb(const std::string& path, const ColorEncoding& encoding) {
-  int w = 0, h = 0, channels = 0;
+// Every other format pbrt scenes use (PNG, TGA, JPEG, BMP, PFM, HDR...)
+// through OpenImageIO. 8- and 16-bit data are decoded with `encoding`;
+// floating-point data (PFM, HDR) is linear, as pbrt-v4 reads it.
+ImageDesc load_with_oiio(const std::string& path, const ColorEncoding& encoding) {
+  // RGB as stored: OpenImageIO would otherwise premultiply PNG/TGA colour by alpha.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path, &config);
+  if (!in) fail(path, first_line(OIIO::geterror()));
+  const OIIO::ImageSpec spec = in->spec();
+  const int w = spec.width, h = spec.height, nc = spec.nchannels;
+  if (w <= 0 || h <= 0 || nc <= 0) fail(path, "empty image");
+  if (static_cast<int64_t>(w) * h > kMaxImageTexels) fail(path, "larger than " + std::to_string(kMaxImageTexels) + " texels");
   ImageDesc img;
   img.path = path;
-  if (stbi_is_hdr(path.c_str())) {
-    float* data = stbi_loadf(path.c_str(), &w, &h, &channels, 3);
-    if (!data) fail(path, stbi_failure_reason() ? stbi_failure_reason() : "unknown error");
-    img.texels.resize(static_cast<size_t>(w) * h);
-    for (size_t i = 0; i < img.texels.size(); ++i) img.texels[i] = Rgb(data[3 * i], data[3 * i + 1], data[3 * i + 2]);
-    stbi_image_free(data);
-  } else if (stbi_is_16_bit(path.c_str())) {
-    stbi_us* data = stbi_load_16(path.c_str(), &w, &h, &channels, 3);
-    if (!data) fail(path, stbi_failure_reason() ? stbi_failure_reason() : "unknown error");
-    img.texels.resize(static_cast<size_t>(w) * h);
+  img.width = w;
+  img.height = h;
+  img.texels.resize(static_cast<size_t>(w) * h);
+  // Grey images give grey RGB; extra channels (alpha) are dropped here.
+  auto store = [&](auto&& channel_value) {
     for (size_t i = 0; i < img.texels.size(); ++i)
-      for (int c = 0; c < 3; ++c) img.texels[i][c] = decode(data[3 * i + c] / 65535.f, encoding);
-    stbi_image_free(data);
+      for (int c = 0; c < 3; ++c) img.texels[i][c] = channel_value(i * nc + (nc >= 3 ? c : 0));
+  };
+  const OIIO::TypeDesc stored = spec.format;
+  if (stored.is_floating_point()) {
+    std::vector<float> px(img.texels.size() * nc);
+    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, px.data())) fail(path, first_line(in->geterror()));
+    store([&](size_t k) { return px[k]; });
+  } else if (stored.size() > 1) {
+    std::vector<uint16_t> px(img.texels.size() * nc);
+    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT16, px.data())) fail(path, first_line(in->geterror()));
+    store([&](size_t k) { return decode(px[k] / 65535.f, encoding); });
   } else {
-    stbi_uc* data = stbi_load(path.c_str(), &w, &h, &channels, 3);
-    if (!data) fail(path, stbi_failure_reason() ? stbi_failure_reason() : "unknown error");
+    std::vector<uint8_t> px(img.texels.size() * nc);
+    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, px.data())) fail(path, first_line(in->geterror()));
     // 256-entry table: decoding is the slow part for big textures.
     Float table[256];
     for (int v = 0; v < 256; ++v) table[v] = decode(v / 255.f, encoding);
-    img.texels.resize(static_cast<size_t>(w) * h);
-    for (size_t i = 0; i < img.texels.size(); ++i)
-      img.texels[i] = Rgb(table[data[3 * i]], table[data[3 * i + 1]], table[data[3 * i + 2]]);
-    stbi_image_free(data);
+    store([&](size_t k) { return table[px[k]]; });
   }
-  img.width = w;
-  img.height = h;
   return img;
 }
 
@@ -158,7 +178,7 @@ std::optional<ColorEncoding> parse_color_encoding(const std::string& text) {
 ImageDesc load_image(const std::string& path) { return load_image(path, ColorEncoding{}); }
 
 ImageDesc load_image(const std::string& path, const ColorEncoding& encoding) {
-  ImageDesc img = lower_extension(path) == "exr" ? load_exr(path) : load_with_stb(path, encoding);
+  ImageDesc img = lower_extension(path) == "exr" ? load_exr(path) : load_with_oiio(path, encoding);
   if (img.width <= 0 || img.height <= 0) fail(path, "empty image");
   return img;
 }

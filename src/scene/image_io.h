@@ -20,7 +20,7 @@ struct ColorEncoding {
 // "sRGB", "linear", "gamma 2.2"; nullopt if not one of those.
 std::optional<ColorEncoding> parse_color_encoding(const std::string& text);
 
-// PNG/JPEG/TGA/BMP/HDR (stb_image) or EXR (OpenEXR). Row 0 is the top of the
+// EXR (OpenEXR), or PNG/TGA/JPEG/BMP/PFM/HDR and the rest OpenImageIO reads. Row 0 is the top of the
 // file. Throws SceneError("cannot read image '<path>': <reason>").
 ImageDesc load_image(const std::string& path);  // 8-bit data treated as sRGB
 

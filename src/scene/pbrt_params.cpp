@@ -220,7 +220,8 @@ std::optional<Rgb> ParamSet::get_rgb(const std::string& name, bool allow_float) 
   }
   std::vector<Float> pairs(p->numbers.begin(), p->numbers.end());
   if (warnings)
-    warnings->push_back(p->where + ": \"spectrum " + name + "\" given as samples; using an approximate RGB");
+    warnings->push_back(p->where + ": \"spectrum " + name + "\" given as samples" +
+                        (p->file.empty() ? std::string() : " (file '" + p->file + "')") + "; using an approximate RGB");
   return sampled_spectrum_rgb(pairs);
 }
 

@@ -19,6 +19,7 @@ struct Param {
   std::vector<std::string> strings;  // string, texture, named spectrum
   std::vector<bool> bools;
   std::string where;  // "file:line" of the declaration
+  std::string file;   // spectrum read from a file: the name as written (numbers hold its pairs)
   mutable bool used = false;
 };
 

@@ -12,6 +12,8 @@
 #include "scene/pbrt_paths.h"
 #include "scene/pbrt_shapes.h"
 #include "scene/pbrt_textures.h"
+#include "scene/named_spectra.h"
+#include "scene/spectrum_file.h"
 
 namespace tessera {
 namespace {
@@ -65,8 +67,33 @@ void skip_arguments(const std::vector<Token>& tokens, size_t& pos) {
   }
 }
 
-ParamSet read_params(const std::vector<Token>& tokens, size_t& pos, std::string owner, std::vector<std::string>& warnings) {
-  ParamSet ps(parse_param_list(tokens, pos), std::move(owner));
+// A spectrum named by a string that is not one of pbrt's named spectra is a
+// file of wavelength/value pairs (pbrt-v4: relative to the scene's
+// directory); it is read here, so the parameter holds its pairs from now on.
+void read_spectrum_files(std::vector<Param>& params, const std::string& including_dir, const std::string& search_dir) {
+  for (Param& p : params) {
+    if (p.type != "spectrum" || p.strings.size() != 1 || named_spectrum_rgb(p.strings[0])) continue;
+    const std::string path = resolve_scene_path(p.strings[0], including_dir, search_dir);
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+      throw SceneError(p.where + ": unknown named spectrum \"" + p.strings[0] + "\" (and no spectrum file '" + path +
+                       "')");
+    try {
+      const std::vector<Float> pairs = read_spectrum_file(path);
+      p.numbers.assign(pairs.begin(), pairs.end());
+    } catch (const SceneError& e) {
+      throw SceneError(p.where + ": " + e.what());
+    }
+    p.file = p.strings[0];
+    p.strings.clear();
+  }
+}
+
+ParamSet read_params(const std::vector<Token>& tokens, size_t& pos, std::string owner, std::vector<std::string>& warnings,
+                     const std::string& including_dir, const std::string& search_dir) {
+  std::vector<Param> params = parse_param_list(tokens, pos);
+  read_spectrum_files(params, including_dir, search_dir);
+  ParamSet ps(std::move(params), std::move(owner));
   ps.warnings = &warnings;
   return ps;
 }
@@ -211,10 +238,10 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     warn("WorldEnd is pbrt-v3 syntax; ignored");
   } else if (d == "Camera") {
     std::string type = read_string(tokens, pos, at);
-    camera(at, type, read_params(tokens, pos, quoted(d, type), warnings));
+    camera(at, type, read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_));
   } else if (d == "Film") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
     if (type != "rgb" && type != "gbuffer" && type != "spectral") warn("film \"" + type + "\" treated as \"rgb\"");
     scene_.film.xres = ps.get_int("xresolution", 1280);
     scene_.film.yres = ps.get_int("yresolution", 720);
@@ -227,7 +254,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     ps.report_unused(warnings);
   } else if (d == "Sampler") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
     scene_.spp = ps.get_int("pixelsamples", 16);
     if (scene_.spp <= 0) fail(at, "pixelsamples must be positive");
     scene_.seed = static_cast<uint64_t>(ps.get_int("seed", static_cast<int>(scene_.seed)));
@@ -236,7 +263,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     ps.report_unused(warnings);
   } else if (d == "Integrator") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
     if (type != "path" && type != "volpath") warn("integrator \"" + type + "\" is rendered with \"path\"");
     scene_.max_depth = ps.get_int("maxdepth", 5);
     if (scene_.max_depth < 0) fail(at, "maxdepth must not be negative");
@@ -244,7 +271,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     ps.report_unused(warnings);
   } else if (d == "PixelFilter") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
     FilterDesc f;
     if (type == "box") {
       f.type = FilterType::Box;
@@ -264,13 +291,13 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     ps.report_unused(warnings);
   } else if (d == "Material") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
     scene_.materials.push_back(make_material(type, ps, context(at, including_dir)));
     state_.material = static_cast<int32_t>(scene_.materials.size() - 1);
     ps.report_unused(warnings);
   } else if (d == "MakeNamedMaterial") {
     std::string name = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings);
+    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_);
     std::string type = ps.get_string("type", "");
     if (type.empty()) fail(at, "MakeNamedMaterial \"" + name + "\" needs \"string type\"");
     if (names_.materials.count(name)) warn("named material \"" + name + "\" redefined");
@@ -286,12 +313,12 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     std::string name = read_string(tokens, pos, at);
     std::string kind = read_string(tokens, pos, at);
     std::string cls = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings);
+    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_);
     make_named_texture(name, kind, cls, ps, context(at, including_dir));
     ps.report_unused(warnings);
   } else if (d == "LightSource") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
     if (auto light = make_light(type, ps, ctm, context(at, including_dir))) {
       if (!open_instance_.empty()) warn("lights inside ObjectBegin are not instanced; added once");
       scene_.lights.push_back(*light);
@@ -299,13 +326,13 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     ps.report_unused(warnings);
   } else if (d == "AreaLightSource") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
     scene_.area_lights.push_back(make_area_light(type, ps, context(at, including_dir)));
     state_.area_light = static_cast<int32_t>(scene_.area_lights.size() - 1);
     ps.report_unused(warnings);
   } else if (d == "Shape") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
     shape(at, type, ps, including_dir);
     ps.report_unused(warnings);
   } else if (d == "ObjectBegin") {

@@ -98,6 +98,9 @@ MeshDesc ply_mesh(const ParamSet& params, const ShapeContext& ctx) {
   } catch (const SceneError& e) {
     fail(ctx, e.what());
   }
+  if (ply.skipped_faces > 0)
+    warn(ctx, "plymesh '" + name + "': " + std::to_string(ply.skipped_faces) +
+                  " faces that are neither triangles nor quads ignored (as pbrt-v4 does)");
   MeshDesc m;
   m.p = std::move(ply.p);
   m.n = std::move(ply.n);

@@ -1,4 +1,5 @@
-// Reading PLY triangle meshes (ASCII and binary) through Assimp.
+// Reading PLY triangle meshes as pbrt-v4 does: ASCII and binary (either byte
+// order), plain or gzip-compressed (.ply.gz).
 #pragma once
 
 #include <string>
@@ -8,16 +9,26 @@
 
 namespace tessera {
 
-// Object-space geometry as stored in the file; quads and polygons are split
-// into triangles. n and uv are empty when the file has none.
+// Object-space geometry as stored in the file. Quads are split into two
+// triangles (0,1,2) and (0,2,3), as pbrt-v4 does when it needs triangles;
+// faces of other sizes are skipped (pbrt-v4 ignores them too) and counted.
+// n and uv are empty when the file has none.
 struct PlyMesh {
   std::vector<Vec3> p;
   std::vector<Vec3> n;
   std::vector<Vec2> uv;
   std::vector<uint32_t> indices;
+  size_t skipped_faces = 0;  // faces with fewer than 3 or more than 4 vertices
 };
 
-// Throws SceneError("cannot read PLY '<path>': <reason>").
+// Parses a whole PLY file held in memory. `name` is used in messages only.
+// Never reads out of bounds, never loops without consuming input: any
+// malformed, truncated or hostile content throws
+// SceneError("cannot read PLY '<name>': <reason>").
+PlyMesh parse_ply_mesh(const std::string& bytes, const std::string& name);
+
+// Reads `path` (gzip-compressed or not: the content decides, as zlib does)
+// and parses it. Throws SceneError as parse_ply_mesh.
 PlyMesh load_ply_mesh(const std::string& path);
 
 }  // namespace tessera
