@@ -20,6 +20,16 @@ TESSERA_HOST_DEVICE inline Ray generate_camera_ray(const CameraView& c, Vec2 p_f
   return r;
 }
 
+// A sample's radiance as the film records it (pbrt-v4's RGBFilm::AddSample):
+// through the sensor, then scaled down so that no channel exceeds the
+// film's maxcomponentvalue. With pbrt's defaults this returns L unchanged.
+TESSERA_HOST_DEVICE inline Rgb film_pixel_value(const CameraView& c, Rgb L) {
+  Rgb v = c.pixel_from_radiance * L;
+  const Float m = glm::max(v.x, glm::max(v.y, v.z));
+  if (m > c.max_component_value) v *= c.max_component_value / m;
+  return v;
+}
+
 // Offset within the pixel drawn from the filter (filter importance sampling:
 // every sample lands in its own pixel with weight 1, so tiles never overlap).
 TESSERA_HOST_DEVICE inline Float sample_filter_axis(const FilterView& f, Float u) {

@@ -1,5 +1,6 @@
 #include "scene/pbrt_parser.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -7,6 +8,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "scene/pbrt_film.h"
 #include "scene/pbrt_lights.h"
 #include "scene/pbrt_materials.h"
 #include "scene/pbrt_paths.h"
@@ -242,15 +244,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
   } else if (d == "Film") {
     std::string type = read_string(tokens, pos, at);
     ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
-    if (type != "rgb" && type != "gbuffer" && type != "spectral") warn("film \"" + type + "\" treated as \"rgb\"");
-    scene_.film.xres = ps.get_int("xresolution", 1280);
-    scene_.film.yres = ps.get_int("yresolution", 720);
-    scene_.film.filename = ps.get_string("filename", scene_.film.filename);
-    if (scene_.film.xres <= 0 || scene_.film.yres <= 0) fail(at, "film resolution must be positive");
-    if (scene_.film.xres > kMaxFilmDimension || scene_.film.yres > kMaxFilmDimension ||
-        int64_t(scene_.film.xres) * scene_.film.yres > kMaxFilmPixels)
-      fail(at, "film resolution " + std::to_string(scene_.film.xres) + "x" + std::to_string(scene_.film.yres) +
-                   " is larger than supported (" + std::to_string(kMaxFilmPixels) + " pixels)");
+    read_film(type, ps, at.where(), scene_.film, warnings);
     ps.report_unused(warnings);
   } else if (d == "Sampler") {
     std::string type = read_string(tokens, pos, at);
@@ -272,22 +266,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
   } else if (d == "PixelFilter") {
     std::string type = read_string(tokens, pos, at);
     ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
-    FilterDesc f;
-    if (type == "box") {
-      f.type = FilterType::Box;
-      f.radius = ps.get_float("xradius", 0.5f);
-      ps.get_float("yradius", f.radius);
-    } else {
-      if (type != "gaussian") {
-        warn("pixel filter \"" + type + "\" is not supported; using \"gaussian\"");
-        ps.mark_all_used();
-      }
-      f.type = FilterType::Gaussian;
-      f.radius = ps.get_float("xradius", 1.5f);
-      ps.get_float("yradius", f.radius);
-      f.sigma = ps.get_float("sigma", 0.5f);
-    }
-    scene_.filter = f;
+    scene_.filter = read_filter(type, ps, at.where(), warnings);
     ps.report_unused(warnings);
   } else if (d == "Material") {
     std::string type = read_string(tokens, pos, at);
@@ -379,6 +358,15 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   if (glm::determinant(state_.ctm) == 0.f) fail(at, "camera transform is singular");
   scene_.camera.world_from_camera = glm::inverse(state_.ctm);
   scene_.camera.fov_degrees = params.get_float("fov", 90.f);
+  // pbrt-v4 swaps reversed shutter times and refuses a shutter that never opens.
+  Float open = params.get_float("shutteropen", 0.f), close = params.get_float("shutterclose", 1.f);
+  if (close < open) {
+    warnings.push_back(at.where() + ": shutterclose is before shutteropen; swapped");
+    std::swap(open, close);
+  }
+  if (!(close > open) || !std::isfinite(close - open))
+    fail(at, "the shutter never opens (shutterclose equals shutteropen): the image would be black");
+  scene_.camera.exposure_time = close - open;
   scene_.camera.where = at.where();
   coordinate_systems_["camera"] = scene_.camera.world_from_camera;
   if (params.find_any("lensradius") || params.find_any("focaldistance"))
@@ -415,6 +403,7 @@ SceneDesc PbrtParser::finish(const std::string& file_name, int last_line) {
   for (const StackEntry& e : stack_)
     if (e.kind != 'o') scene_.warnings.push_back(e.where + ": block not closed before end of file");
   if (scene_.meshes.empty() && scene_.lights.empty()) throw SceneError(where + ": empty scene (no shapes and no lights)");
+  scene_.film.pixel_from_radiance = film_pixel_from_radiance(scene_.film, scene_.camera.exposure_time);
   return std::move(scene_);
 }
 

@@ -45,6 +45,7 @@ struct ImageDesc {
 struct CameraDesc {
   Mat4 world_from_camera{1.f};  // pbrt camera space: x right, y up, z forward (left-handed)
   Float fov_degrees = 90.f;     // pbrt-v4: angle spanned by the shorter image axis
+  Float exposure_time = 1.f;    // shutterclose - shutteropen (scales the image, as in pbrt-v4)
   std::string where;
 };
 
@@ -55,6 +56,13 @@ constexpr int64_t kMaxFilmPixels = int64_t(1) << 27;
 struct FilmDesc {
   int32_t xres = 1280, yres = 720;
   std::string filename = "pbrt.exr";
+  Float iso = 100.f;
+  Float whitebalance = 0.f;      // kelvin; 0 = none
+  Float max_component_value = INFINITY;  // pbrt-v4 scales a sample down to this largest channel
+  std::string sensor = "cie1931";
+  // Linear sRGB radiance -> recorded pixel value (exposure and white balance;
+  // see pbrt_film.h). Set when loading ends; identity for pbrt's defaults.
+  Mat3 pixel_from_radiance{1.f};
 };
 
 enum class FilterType : uint32_t { Gaussian = 0, Box };

@@ -30,6 +30,7 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
           L = glm::max(L, Rgb(0.f));
         }
         if (is_black(L)) ++tc.zero_radiance;
+        L = film_pixel_value(s.camera, L);
         for (int c = 0; c < 3; ++c) {
           acc.sum[c] += L[c];
           acc.sum_sq[c] += static_cast<double>(L[c]) * L[c];

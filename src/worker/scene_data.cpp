@@ -124,6 +124,8 @@ void SceneData::build_camera() {
     camera_.screen_max = Vec2(1.f, 1.f / aspect);
   }
   camera_.tan_half_fov = std::tan(glm::radians(desc_.camera.fov_degrees) * 0.5f);
+  camera_.pixel_from_radiance = desc_.film.pixel_from_radiance;
+  camera_.max_component_value = desc_.film.max_component_value;
 }
 
 void SceneData::build_filter() {
@@ -208,6 +210,12 @@ uint64_t SceneData::fingerprint() const {
   }
   uint64_t materials = desc_.materials.size();
   f.add(&materials, sizeof materials);
+  // What the film records (exposure, white balance, clamp): only when not
+  // pbrt's defaults, so that fingerprints of default scenes stay as they were.
+  if (camera_.pixel_from_radiance != Mat3(1.f) || std::isfinite(camera_.max_component_value)) {
+    f.add(&camera_.pixel_from_radiance, sizeof camera_.pixel_from_radiance);
+    f.add(&camera_.max_component_value, sizeof camera_.max_component_value);
+  }
   return f.h;
 }
 

@@ -69,10 +69,10 @@ TEST(PbrtOptions, CameraTypesAndLensWarn) {
 }
 
 TEST(PbrtOptions, UnknownParametersAndDirectivesWarnWithLocation) {
-  SceneDesc s = load_pbrt_string("Film \"rgb\" \"float iso\" 100\nWorldBegin\nFoo 1 2 \"x\"\nColorSpace \"aces2065-1\"\n"
+  SceneDesc s = load_pbrt_string("Film \"rgb\" \"float isoo\" 100\nWorldBegin\nFoo 1 2 \"x\"\nColorSpace \"aces2065-1\"\n"
                                  "Shape \"sphere\" \"float radius\" 1 \"float bogus\" 2\n",
                                  "w.pbrt", ".");
-  EXPECT_TRUE(has_warning(s, "w.pbrt:1: unknown parameter 'iso' for Film \"rgb\""));
+  EXPECT_TRUE(has_warning(s, "w.pbrt:1: unknown parameter 'isoo' for Film \"rgb\""));
   EXPECT_TRUE(has_warning(s, "w.pbrt:3: unknown directive 'Foo'"));
   EXPECT_TRUE(has_warning(s, "w.pbrt:4: 'ColorSpace' is not supported"));
   EXPECT_TRUE(has_warning(s, "w.pbrt:5: unknown parameter 'bogus' for Shape \"sphere\""));
