@@ -1,4 +1,4 @@
-// tessera compare IMAGE.exr REFERENCE.exr [--json]
+// tessera compare IMAGE.exr REFERENCE.exr [--json] [--block B]
 #include <cstdio>
 #include <filesystem>
 
@@ -27,26 +27,33 @@ double own_estimate(const std::string& path, const ImageRgb& mean) {
   }
 }
 
-int run_compare(const std::string& image, const std::string& reference, bool json) {
+int run_compare(const std::string& image, const std::string& reference, bool json, int32_t block) {
   ImageRgb a = to_image_rgb(load_image(image)), f = to_image_rgb(load_image(reference));
   ImageErrors e;
+  BlockAgreement b;
   try {
     e = compare_images(a, f);
+    b = compare_blocks(a, f, block);
   } catch (const std::invalid_argument& ex) {
     throw std::runtime_error(image + " vs " + reference + ": " + ex.what());
   }
   // From the variance layers: the error the image expects of itself, and the
   // reference's own noise, which the measured relMSE includes (about additively).
   const double image_est = own_estimate(image, a), reference_est = own_estimate(reference, f);
+  // JSON has no NaN: null says no block was bright enough to judge.
+  char worst[32] = "null";
+  if (b.judged_blocks > 0) std::snprintf(worst, sizeof worst, "%.6g", b.worst_ratio);
   if (json) {
     std::printf("{\"relmse\": %.9g, \"mape\": %.9g, \"rmse\": %.9g, \"estimated_relmse\": %.9g, "
                 "\"reference_estimated_relmse\": %.9g, \"nonfinite_pixels\": %llu, "
                 "\"reference_nonfinite_pixels\": %llu, \"pixels\": %llu, \"mean_rgb\": [%.6g, %.6g, %.6g], "
-                "\"reference_mean_rgb\": [%.6g, %.6g, %.6g]}\n",
+                "\"reference_mean_rgb\": [%.6g, %.6g, %.6g], \"block\": %d, \"blocks_judged\": %llu, "
+                "\"worst_block_ratio\": %s, \"worst_block_x\": %d, \"worst_block_y\": %d, \"blocks_off_fraction\": %.6g}\n",
                 e.rel_mse, e.mape, e.rmse, image_est, reference_est, static_cast<unsigned long long>(e.nonfinite_pixels),
                 static_cast<unsigned long long>(e.reference_nonfinite_pixels), static_cast<unsigned long long>(e.pixels),
                 e.mean_image[0], e.mean_image[1], e.mean_image[2], e.mean_reference[0], e.mean_reference[1],
-                e.mean_reference[2]);
+                e.mean_reference[2], b.block, static_cast<unsigned long long>(b.judged_blocks), worst, b.worst_x,
+                b.worst_y, b.fraction_off);
   } else {
     std::printf("relMSE:           %.6g\n", e.rel_mse);
     std::printf("MAPE:             %.6g\n", e.mape);
@@ -57,6 +64,14 @@ int run_compare(const std::string& image, const std::string& reference, bool jso
                 e.mean_image[2], e.mean_reference[0], e.mean_reference[1], e.mean_reference[2]);
     std::printf("NaN/Inf pixels:   %llu (reference: %llu) of %llu\n", static_cast<unsigned long long>(e.nonfinite_pixels),
                 static_cast<unsigned long long>(e.reference_nonfinite_pixels), static_cast<unsigned long long>(e.pixels));
+    if (b.judged_blocks == 0) {
+      std::printf("%dx%d blocks:       none bright enough to judge\n", b.block, b.block);
+    } else {
+      std::printf("worst %dx%d block:  %.4g (image/reference luminance) at block (%d, %d), pixels (%d, %d)\n", b.block,
+                  b.block, b.worst_ratio, b.worst_x, b.worst_y, b.worst_x * b.block, b.worst_y * b.block);
+      std::printf("blocks off >%g%%:  %.4g%% of %llu judged (%dx%d blocks)\n", 100 * kBlockTolerance,
+                  100 * b.fraction_off, static_cast<unsigned long long>(b.judged_blocks), b.blocks_x, b.blocks_y);
+    }
   }
   return 0;
 }
@@ -64,13 +79,21 @@ int run_compare(const std::string& image, const std::string& reference, bool jso
 }  // namespace
 
 CommandRunner add_compare_command(CLI::App& app) {
-  struct Args { std::string image, reference; bool json = false; };
+  struct Args {
+    std::string image, reference;
+    bool json = false;
+    int32_t block = kDefaultBlockSize;
+  };
   auto a = std::make_shared<Args>();
-  CLI::App* c = app.add_subcommand("compare", "Error metrics of an image against a reference (relMSE, MAPE, RMSE, NaN/Inf)");
+  CLI::App* c = app.add_subcommand("compare", "Error metrics of an image against a reference (relMSE, MAPE, RMSE, NaN/Inf, block agreement)");
   c->add_option("image", a->image, "Image to judge (EXR)")->required()->check(CLI::ExistingFile);
   c->add_option("reference", a->reference, "Reference image (EXR)")->required()->check(CLI::ExistingFile);
   c->add_flag("--json", a->json, "Machine-readable output");
-  return [a] { return run_compare(a->image, a->reference, a->json); };
+  c->add_option("--block", a->block,
+                "Block side in pixels for block agreement: the worst ratio of block mean luminances and the share of "
+                "blocks off by more than 10 %")
+      ->check(CLI::Range(1, 1 << 20));
+  return [a] { return run_compare(a->image, a->reference, a->json, a->block); };
 }
 
 }  // namespace tessera

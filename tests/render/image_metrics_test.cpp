@@ -1,9 +1,12 @@
 // compare_images on tiny hand-made images whose relMSE, MAPE and RMSE are
 // worked out by hand: the regulariser kRelMseEpsilon, MAPE on luminance
 // with the reference in the denominator, NaN/Inf pixels counted and left
-// out, and a size mismatch refused.
+// out, and a size mismatch refused. compare_blocks: the worst block ratio,
+// where it is, the share of blocks off by more than 10 %, partial edge
+// blocks, and too-dark reference blocks left unjudged.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -167,6 +170,103 @@ TEST(ImageMetrics, SizeMismatchThrowsNamingBothSizes) {
     EXPECT_NE(msg.find("3x2"), std::string::npos) << msg;
   }
   EXPECT_THROW(compare_images(uniform(4, 4, 1.f, 1.f, 1.f), uniform(4, 5, 1.f, 1.f, 1.f)), std::invalid_argument);
+}
+
+// Multiplies every pixel of block (bx, by) of side `block` by s.
+void scale_block(ImageRgb& img, int32_t block, int32_t bx, int32_t by, float s) {
+  for (int32_t y = by * block; y < std::min(img.height, (by + 1) * block); ++y) {
+    for (int32_t x = bx * block; x < std::min(img.width, (bx + 1) * block); ++x) {
+      for (int c = 0; c < 3; ++c) img.rgb[3 * (static_cast<size_t>(y) * img.width + x) + c] *= s;
+    }
+  }
+}
+
+TEST(ImageMetrics, IdenticalImagesAgreeInEveryBlock) {
+  // 20 x 12 with 8-pixel blocks: 3 x 2 blocks, the right column and bottom row partial.
+  ImageRgb a = uniform(20, 12, 0.25f, 4.f, 0.5f);
+  BlockAgreement b = compare_blocks(a, a);
+  EXPECT_EQ(b.block, kDefaultBlockSize);
+  EXPECT_EQ(b.blocks_x, 3);
+  EXPECT_EQ(b.blocks_y, 2);
+  EXPECT_EQ(b.judged_blocks, 6u);
+  EXPECT_EQ(b.worst_ratio, 1.0);
+  EXPECT_EQ(b.fraction_off, 0.0);
+}
+
+TEST(ImageMetrics, OneBrightBlockIsTheWorst) {
+  // Block (2, 1) is a partial edge block (4 x 4 pixels): scaled by 1.5 it is
+  // the worst, the one block of six off by more than 10 %.
+  ImageRgb ref = uniform(20, 12, 1.f, 0.5f, 0.25f), img = ref;
+  scale_block(img, 8, 2, 1, 1.5f);
+  BlockAgreement b = compare_blocks(img, ref);
+  EXPECT_NEAR(b.worst_ratio, 1.5, 1e-6);
+  EXPECT_EQ(b.worst_x, 2);
+  EXPECT_EQ(b.worst_y, 1);
+  EXPECT_EQ(b.judged_blocks, 6u);
+  EXPECT_NEAR(b.fraction_off, 1.0 / 6.0, kTol);
+
+  // A block 5 % too dark is within tolerance and not the worst; one 20 % too
+  // dark is off, but 1.5 stays the worst (|0.8 - 1| < |1.5 - 1|).
+  scale_block(img, 8, 0, 0, 0.95f);
+  scale_block(img, 8, 1, 0, 0.8f);
+  b = compare_blocks(img, ref);
+  EXPECT_NEAR(b.worst_ratio, 1.5, 1e-6);
+  EXPECT_NEAR(b.fraction_off, 2.0 / 6.0, kTol);
+
+  // Block size 4 on the same images: 5 x 3 blocks, the scaled 4 x 4 corner is one of them.
+  b = compare_blocks(img, ref, 4);
+  EXPECT_EQ(b.blocks_x, 5);
+  EXPECT_EQ(b.blocks_y, 3);
+  EXPECT_EQ(b.worst_x, 4);
+  EXPECT_EQ(b.worst_y, 2);
+}
+
+TEST(ImageMetrics, DarkReferenceBlocksAreNotJudged) {
+  // Reference block (1, 0) is at 1e-4 of the rest (below kBlockDarkFraction
+  // of the image mean); the image is 10x brighter there, yet no block is off.
+  ImageRgb ref = uniform(16, 8, 1.f, 1.f, 1.f);
+  scale_block(ref, 8, 1, 0, 1e-4f);
+  ImageRgb img = ref;
+  scale_block(img, 8, 1, 0, 10.f);
+  BlockAgreement b = compare_blocks(img, ref);
+  EXPECT_EQ(b.judged_blocks, 1u);
+  EXPECT_EQ(b.worst_x, 0);
+  EXPECT_NEAR(b.worst_ratio, 1.0, kTol);
+  EXPECT_EQ(b.fraction_off, 0.0);
+
+  // At 1e-2 of the rest the block is bright enough to judge, and it is 10x off.
+  ref = uniform(16, 8, 1.f, 1.f, 1.f);
+  scale_block(ref, 8, 1, 0, 1e-2f);
+  img = ref;
+  scale_block(img, 8, 1, 0, 10.f);
+  b = compare_blocks(img, ref);
+  EXPECT_EQ(b.judged_blocks, 2u);
+  EXPECT_EQ(b.worst_x, 1);
+  EXPECT_NEAR(b.worst_ratio, 10.0, 1e-5);
+  EXPECT_NEAR(b.fraction_off, 0.5, kTol);
+
+  // An all-black reference leaves nothing to judge: ratio 1, no block named, not NaN.
+  b = compare_blocks(uniform(16, 8, 1.f, 1.f, 1.f), uniform(16, 8, 0.f, 0.f, 0.f));
+  EXPECT_EQ(b.judged_blocks, 0u);
+  EXPECT_EQ(b.worst_ratio, 1.0);
+  EXPECT_EQ(b.worst_x, -1);
+  EXPECT_EQ(b.fraction_off, 0.0);
+}
+
+TEST(ImageMetrics, BlockMeansSkipNonFinitePixels) {
+  // One NaN pixel of the image in block (0, 0), whose other pixels agree:
+  // the block is judged on the rest and agrees.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  ImageRgb ref = uniform(8, 8, 1.f, 1.f, 1.f), img = ref;
+  set_pixel(img, 9, nan, 1.f, 1.f);
+  BlockAgreement b = compare_blocks(img, ref);
+  EXPECT_EQ(b.judged_blocks, 1u);
+  EXPECT_EQ(b.worst_ratio, 1.0);
+}
+
+TEST(ImageMetrics, BlockComparisonRefusesBadInput) {
+  EXPECT_THROW(compare_blocks(uniform(4, 4, 1.f, 1.f, 1.f), uniform(4, 5, 1.f, 1.f, 1.f)), std::invalid_argument);
+  EXPECT_THROW(compare_blocks(uniform(4, 4, 1.f, 1.f, 1.f), uniform(4, 4, 1.f, 1.f, 1.f), 0), std::invalid_argument);
 }
 
 }  // namespace
