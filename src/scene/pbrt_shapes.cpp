@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "scene/pbrt_paths.h"
+#include "scene/loop_subdivision.h"
 #include "scene/ply_mesh.h"
 
 namespace tessera {
@@ -109,6 +110,27 @@ MeshDesc ply_mesh(const ParamSet& params, const ShapeContext& ctx) {
   return m;
 }
 
+// pbrt-v4's "loopsubdiv": indices and P as trianglemesh, "levels" (default 3).
+MeshDesc loop_subdiv_mesh(const ParamSet& params, const ShapeContext& ctx) {
+  std::vector<Vec3> p = params.get_point3s("P");
+  if (p.empty()) fail(ctx, "loopsubdiv needs \"point3 P\"");
+  std::vector<int> raw = params.get_ints("indices");
+  if (raw.empty()) fail(ctx, "loopsubdiv needs \"integer indices\"");
+  const int levels = params.get_int("levels", 3);
+  if (levels < 0) fail(ctx, "loopsubdiv \"levels\" must not be negative");
+  SubdividedMesh sub;
+  try {
+    sub = loop_subdivide(p, checked_indices(raw, p.size(), 3, "loopsubdiv", ctx), levels);
+  } catch (const SceneError& e) {
+    fail(ctx, e.what());
+  }
+  MeshDesc m;
+  m.p = std::move(sub.p);
+  m.n = std::move(sub.n);
+  m.indices = std::move(sub.indices);
+  return m;
+}
+
 // Grid over (ring, segment) with quads split so that cross(p0 - p2, p1 - p2)
 // follows d(ring) x d(segment). Rows whose first or last ring collapses to a
 // point (sphere poles, disk centre) lose the degenerate half.
@@ -200,6 +222,8 @@ std::optional<MeshDesc> make_shape_mesh(const std::string& type, const ParamSet&
     m = bilinear_mesh(params, ctx);
   } else if (type == "plymesh") {
     m = ply_mesh(params, ctx);
+  } else if (type == "loopsubdiv") {
+    m = loop_subdiv_mesh(params, ctx);
   } else if (type == "sphere") {
     m = sphere_mesh(params, ctx);
     quadric = true;
