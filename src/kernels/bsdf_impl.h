@@ -5,6 +5,7 @@
 
 #include "fresnel.h"
 #include "microfacet.h"
+#include "rng.h"
 #include "sampling.h"
 
 namespace tessera {
@@ -220,68 +221,30 @@ TESSERA_HOST_DEVICE inline bool dielectric_sample(const BsdfParams& b, const Vec
 }
 
 // ---------------------------------------------------------- CoatedDiffuse ---
-// APPROXIMATION (documented deviation from pbrt-v4). pbrt-v4's "coateddiffuse"
-// is a LayeredBxDF evaluated by a stochastic random walk between a dielectric
-// interface and a Lambertian base; that estimator is noisy, needs an RNG inside
-// f()/pdf() and is unbounded in cost, so here it is replaced by the classic
-// closed-form "plastic" model (Mitsuba's plastic / roughplastic, after
-// Weidlich & Wilkie and Kelemen & Szirmay-Kalos):
+// pbrt-v4's "coateddiffuse": the value f(wo, wi) is pbrt-v4's own layered
+// estimate (layered.h: a random walk between the dielectric coat and the
+// Lambertian base, unbiased for the layered BSDF and a pure function of the
+// two directions). Directions are *sampled* from a closed-form stand-in, the
+// classic "plastic" model (Weidlich & Wilkie; Kelemen & Szirmay-Kalos):
 //
-//   f(wo,wi) = f_coat(wo,wi)
-//            + (1 - F(cos_o)) (1 - F(cos_i)) R / (pi eta^2 (1 - R Fdr_int))
+//   q(wo, wi) = p_spec * coat lobe + (1 - p_spec) * cos(wi) / pi
 //
-// * f_coat is the dielectric interface's reflection: a GGX microfacet lobe
-//   D G F(wo.wm) / (4 cos_i cos_o) (alpha_x, alpha_y) or, when both alphas are
-//   below kSmoothAlpha, a mirror delta carrying F(cos_o).
-// * F is the exact dielectric Fresnel term of the flat interface (eta = ior),
-//   so the diffuse lobe is reciprocal; the (1 - F) factors and 1/eta^2 account
-//   for refraction in and out of the coating and the radiance compression.
-// * 1 / (1 - R Fdr_int) sums the inter-reflections between the base and the
-//   inside of the coating; Fdr_int is the coating's internal diffuse Fresnel
-//   reflectance, from the d'Eon-Irving fit via 1 - Fdr_int = (1 - Fdr_ext)/eta^2.
-//   The diffuse albedo is then (1-F(cos_o)) R (1-Fdr_int)/(1-R Fdr_int) <= 1-F(cos_o).
-// * Not modelled: coating thickness / absorption (albedo), roughness-dependent
-//   transmission of the rough coating (F(cos) of the flat interface is used for
-//   the diffuse weights, as Mitsuba's roughplastic does with its table off), and
-//   the energy lost/gained by multiple scattering on the rough coating. Compared to
-//   pbrt-v4's reference, grazing-angle colour and rough-coating highlights differ
-//   slightly; the result is deterministic, noise-free and exactly sampleable.
-// * Two-sided like pbrt's coateddiffuse: for wo.z < 0 both directions are
-//   mirrored to the upper hemisphere. Reflection only.
-//
-// Sampling: the coating lobe with probability
-//   p_spec = clamp(F(cos_o) / (F(cos_o) + (1 - F(cos_o)) lum(R)), 0.05, 0.95),
-// otherwise a cosine-weighted diffuse direction; the pdf is the mixture. When
-// the coating is smooth the coating sample is a delta (pdf = p_spec, f =
-// F/|cos|) and eval/pdf cover the diffuse part only (pdf scaled by 1 - p_spec).
+// whose density is known exactly, so bsdf_pdf() returns the true density of
+// bsdf_sample() and MIS and guided mixtures stay exact; the sample's f is the
+// layered estimate, so f/q is an unbiased weight. The coat lobe is the
+// dielectric's GGX reflection (alpha_x, alpha_y) or, for a smooth coat, the
+// mirror delta with its exact weight F(cos_o) (pbrt's layered f() excludes
+// that delta too). p_spec = clamp(F(cos_o) / (F(cos_o) + (1 - F(cos_o))
+// lum(R)), 0.05, 0.95). Two-sided; reflection only.
 TESSERA_HOST_DEVICE inline Float coated_p_spec(const BsdfParams& b, Float Fo) {
   Float denom = Fo + (1.f - Fo) * luminance(glm::clamp(b.reflectance, Rgb(0.f), Rgb(1.f)));
   Float p = denom > 0.f ? Fo / denom : 0.5f;
   return glm::clamp(p, 0.05f, 0.95f);
 }
 
-// wo, wi both with z > 0.
-TESSERA_HOST_DEVICE inline Rgb coated_f_upper(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
-  Float eta = dielectric_eta(b);
-  Float cos_o = wo.z, cos_i = wi.z;
-  if (!(cos_o > 0.f) || !(cos_i > 0.f)) return Rgb(0.f);
-  Rgb R = glm::clamp(b.reflectance, Rgb(0.f), Rgb(1.f));
-  Float Fo = fr_dielectric(cos_o, eta), Fi = fr_dielectric(cos_i, eta);
-  Float fdr = fresnel_diffuse_reflectance_internal(eta);
-  Rgb denom = glm::max(Rgb(1.f) - R * fdr, Rgb(1e-4f));
-  Rgb f = (1.f - Fo) * (1.f - Fi) * R / (kPi * eta * eta * denom);
-  TrowbridgeReitz d = distrib(b);
-  if (!d.effectively_smooth()) {
-    Vec3 wm = wo + wi;
-    if (len2(wm) > 0.f) {
-      wm = glm::normalize(wm);
-      Float F = fr_dielectric(glm::dot(wo, wm), eta);
-      f += Rgb(d.D(wm) * d.G(wo, wi) * F / (4.f * cos_i * cos_o));
-    }
-  }
-  return finite_or_zero(f);
-}
+#include "layered.h"
 
+// The sampling density q, wo and wi both with z > 0.
 TESSERA_HOST_DEVICE inline Float coated_pdf_upper(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
   if (!(wo.z > 0.f) || !(wi.z > 0.f)) return 0.f;
   Float Fo = fr_dielectric(wo.z, dielectric_eta(b));
@@ -302,9 +265,7 @@ TESSERA_HOST_DEVICE inline Float coated_pdf_upper(const BsdfParams& b, const Vec
 TESSERA_HOST_DEVICE inline Vec3 flip_to_upper(const Vec3& v, bool flip) { return flip ? Vec3(v.x, v.y, -v.z) : v; }
 
 TESSERA_HOST_DEVICE inline Rgb coated_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
-  if (!same_hemisphere(wo, wi)) return Rgb(0.f);
-  bool flip = wo.z < 0.f;
-  return coated_f_upper(b, flip_to_upper(wo, flip), flip_to_upper(wi, flip));
+  return coated_diffuse_layered_f(b, wo, wi);
 }
 TESSERA_HOST_DEVICE inline Float coated_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
   if (!same_hemisphere(wo, wi)) return 0.f;
@@ -335,7 +296,7 @@ TESSERA_HOST_DEVICE inline bool coated_sample(const BsdfParams& b, const Vec3& w
     Vec3 wi = reflect(wo, wm);
     if (!(wi.z > 0.f)) return false;
     s->wi = flip_to_upper(wi, flip);
-    s->f = coated_f_upper(b, wo, wi);
+    s->f = coated_diffuse_layered_f(b, wo_in, s->wi);  // as bsdf_eval sees it: the same estimate
     s->pdf = coated_pdf_upper(b, wo, wi);
     s->lobe = kLobeReflection | kLobeGlossy;
     return true;
@@ -343,7 +304,7 @@ TESSERA_HOST_DEVICE inline bool coated_sample(const BsdfParams& b, const Vec3& w
   Vec3 wi = sample_cosine_hemisphere(u);
   if (!(wi.z > 0.f)) return false;
   s->wi = flip_to_upper(wi, flip);
-  s->f = coated_f_upper(b, wo, wi);
+  s->f = coated_diffuse_layered_f(b, wo_in, s->wi);
   s->pdf = coated_pdf_upper(b, wo, wi);
   s->lobe = kLobeReflection | kLobeDiffuse;
   return true;

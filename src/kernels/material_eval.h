@@ -66,6 +66,9 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
     case MaterialType::CoatedDiffuse:
       b.type = BsdfType::CoatedDiffuse;
       b.reflectance = glm::clamp(refl, Rgb(0.f), Rgb(1.f));
+      b.thickness = m->thickness;
+      b.layer_max_depth = m->layer_max_depth;
+      b.layer_samples = m->layer_samples;
       break;
     default:
       b.type = BsdfType::Diffuse;

@@ -78,10 +78,13 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
     m.reflectance = spectrum_slot(params, "reflectance", Rgb(0.5f), ctx);
     m.ior = read_ior(params, "eta", 1.5f, ctx);
     read_roughness(m, params, ctx);
-    // Layer simulation controls: our coated model is analytic, so they do not apply.
-    params.find_any("thickness");
-    params.find_any("maxdepth");
-    params.find_any("nsamples");
+    m.thickness = constant_float(params, "thickness", 0.01f, ctx);
+    const int max_depth = params.get_int("maxdepth", 10), samples = params.get_int("nsamples", 1);
+    if (!(m.thickness >= 0.f)) ctx.fail("coateddiffuse \"thickness\" must not be negative");
+    if (max_depth < 1 || max_depth > 1000) ctx.fail("coateddiffuse \"maxdepth\" must be in 1..1000");
+    if (samples < 1 || samples > 1000) ctx.fail("coateddiffuse \"nsamples\" must be in 1..1000");
+    m.layer_max_depth = static_cast<uint32_t>(max_depth);
+    m.layer_samples = static_cast<uint32_t>(samples);
     if (params.find_any("albedo") || params.find_any("g"))
       ctx.warn("coateddiffuse medium \"albedo\"/\"g\" are not supported; ignored");
   } else if (type == "coatedconductor") {

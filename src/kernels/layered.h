@@ -1,0 +1,181 @@
+// pbrt-v4's layered BSDF value (LayeredBxDF::f) for "coateddiffuse": a
+// dielectric interface (smooth or GGX) over a Lambertian base, a thin
+// non-scattering layer between them (transmittance exp(-thickness/|cos|)),
+// two-sided. The value is pbrt-v4's stochastic estimate: a random walk
+// between the interfaces with next-event estimation through the exit
+// interface, seeded by the two directions so that f(wo, wi) is a pure
+// function. Its expectation is the layered BSDF exactly; each call is one
+// unbiased sample of it.
+//
+// Included by bsdf_impl.h inside namespace tessera::bsdf_detail; uses the
+// dielectric helpers defined there.
+#pragma once
+
+namespace layered {
+
+// One lobe of the dielectric interface, as pbrt-v4 samples it with
+// BxDFReflTransFlags::Reflection or ::Transmission. `radiance`: transport
+// mode (transmission is divided by eta'^2 only for radiance).
+struct LobeSample {
+  Vec3 wi{0.f};
+  Float f = 0.f;
+  Float pdf = 0.f;
+};
+
+TESSERA_HOST_DEVICE inline bool interface_sample(const BsdfParams& b, const Vec3& wo, Vec2 u, bool transmission,
+                                                 bool radiance, LobeSample* s) {
+  const Float eta = dielectric_eta(b);
+  if (wo.z == 0.f) return false;
+  if (dielectric_is_specular(b)) {
+    const Float R = fr_dielectric(cos_theta(wo), eta), T = 1.f - R;
+    if (!transmission) {
+      if (!(R > 0.f)) return false;
+      s->wi = Vec3(-wo.x, -wo.y, wo.z);
+      s->f = R / abs_cos_theta(s->wi);
+      s->pdf = 1.f;
+      return true;
+    }
+    if (!(T > 0.f)) return false;
+    Float etap = 1.f;
+    if (!refract(wo, Vec3(0.f, 0.f, 1.f), eta, &etap, &s->wi) || s->wi.z == 0.f) return false;
+    s->f = T / abs_cos_theta(s->wi) / (radiance ? sqr(etap) : 1.f);
+    s->pdf = 1.f;
+    return true;
+  }
+  const TrowbridgeReitz d = distrib(b);
+  const Vec3 wm = d.sample_wm(wo, u);
+  const Float dom = glm::dot(wo, wm);
+  const Float R = fr_dielectric(dom, eta), T = 1.f - R;
+  if (!transmission) {
+    if (!(R > 0.f)) return false;
+    const Vec3 wi = reflect(wo, wm);
+    const Float cc = cos_theta(wi) * cos_theta(wo);
+    if (!same_hemisphere(wo, wi) || dom == 0.f || cc == 0.f) return false;
+    s->wi = wi;
+    s->pdf = d.pdf(wo, wm) / (4.f * fabsf(dom));
+    s->f = d.D(wm) * d.G(wo, wi) * R / fabsf(4.f * cc);
+    return s->pdf > 0.f;
+  }
+  if (!(T > 0.f)) return false;
+  Vec3 wi;
+  Float etap = 1.f;
+  if (!refract(wo, wm, eta, &etap, &wi) || same_hemisphere(wo, wi) || wi.z == 0.f) return false;
+  const Float dim = glm::dot(wi, wm), denom = sqr(dim + dom / etap), cc = cos_theta(wi) * cos_theta(wo);
+  if (denom == 0.f || cc == 0.f) return false;
+  s->wi = wi;
+  s->pdf = d.pdf(wo, wm) * fabsf(dim) / denom;
+  s->f = T * d.D(wm) * d.G(wo, wi) * fabsf(dim * dom / (cc * denom)) / (radiance ? sqr(etap) : 1.f);
+  return s->pdf > 0.f && finite_f(s->f);
+}
+
+// pbrt-v4 DielectricBxDF::PDF with BxDFReflTransFlags::Transmission: the
+// density of the transmission lobe alone (0 for reflection configurations).
+TESSERA_HOST_DEVICE inline Float interface_transmission_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  if (dielectric_is_specular(b)) return 0.f;
+  Vec3 wm;
+  Float etap;
+  bool refl;
+  if (!dielectric_half_vector(dielectric_eta(b), wo, wi, &wm, &etap, &refl) || refl) return 0.f;
+  const Float R = fr_dielectric(glm::dot(wo, wm), dielectric_eta(b));
+  if (!(1.f - R > 0.f)) return 0.f;
+  const Float denom = sqr(glm::dot(wi, wm) + glm::dot(wo, wm) / etap);
+  if (denom == 0.f) return 0.f;
+  return finite_or_zero(distrib(b).pdf(wo, wm) * fabsf(glm::dot(wi, wm)) / denom);
+}
+
+TESSERA_HOST_DEVICE inline Float transmittance(Float dz, const Vec3& w) {
+  if (fabsf(dz) <= 1.17549435e-38f) return 1.f;
+  return expf(-fabsf(dz / w.z));
+}
+
+TESSERA_HOST_DEVICE inline uint64_t direction_bits(const Vec3& w) {
+  auto bits = [](Float f) {
+    union { Float f; uint32_t u; } c;
+    c.f = f;
+    return static_cast<uint64_t>(c.u);
+  };
+  return mix_bits(bits(w.x) ^ (bits(w.y) << 21) ^ (bits(w.z) << 42));
+}
+
+// The random numbers of one evaluation: a pure function of (wo, wi).
+TESSERA_HOST_DEVICE inline Rng rng_for(const Vec3& wo, const Vec3& wi) {
+  Rng r;
+  r.set_sequence(direction_bits(wo), direction_bits(wi));
+  return r;
+}
+
+}  // namespace layered
+
+// LayeredBxDF<DielectricBxDF, DiffuseBxDF, twoSided = true>::f for reflection
+// (wo and wi in the same hemisphere; transmission through a coated diffuse
+// surface is zero). b.reflectance is the base's albedo.
+TESSERA_HOST_DEVICE inline Rgb coated_diffuse_layered_f(const BsdfParams& b, Vec3 wo, Vec3 wi) {
+  if (!same_hemisphere(wo, wi)) return Rgb(0.f);
+  if (wo.z < 0.f) {  // two-sided
+    wo = -wo;
+    wi = -wi;
+  }
+  const Rgb R = glm::clamp(b.reflectance, Rgb(0.f), Rgb(1.f));
+  const Float thickness = glm::max(b.thickness, 1.17549435e-38f);
+  const uint32_t n_samples = b.layer_samples > 0 ? b.layer_samples : 1;
+  const bool top_specular = dielectric_is_specular(b);
+  // Reflection at the entrance (top) interface: deterministic.
+  Rgb f = top_specular ? Rgb(0.f) : Rgb(static_cast<Float>(n_samples) * dielectric_f(b, wo, wi).x);
+  Rng rng = layered::rng_for(wo, wi);
+  auto r = [&rng]() { return rng.uniform(); };
+  for (uint32_t s = 0; s < n_samples; ++s) {
+    // Into the layer through the top, and the "virtual light" path from wi
+    // into the layer (importance transport: no 1/eta^2).
+    layered::LobeSample wos, wis;
+    { Vec2 u(r(), r()); if (!layered::interface_sample(b, wo, u, true, true, &wos)) continue; }
+    { Vec2 u(r(), r()); if (!layered::interface_sample(b, wi, u, true, false, &wis)) continue; }
+    Rgb beta(wos.f * abs_cos_theta(wos.wi) / wos.pdf);
+    Vec3 w = wos.wi;
+    bool at_top = true;  // z == thickness
+    for (uint32_t depth = 0; depth < b.layer_max_depth; ++depth) {
+      // Russian roulette, as pbrt-v4.
+      const Float max_beta = glm::max(beta.x, glm::max(beta.y, beta.z));
+      if (depth > 3 && max_beta < 0.25f) {
+        const Float q = glm::max(0.f, 1.f - max_beta);
+        if (r() < q) break;
+        beta /= 1.f - q;
+      }
+      // Across the layer to the other interface.
+      at_top = !at_top;
+      beta *= layered::transmittance(thickness, w);
+      if (at_top) {
+        // Internal reflection at the exit (top) interface.
+        layered::LobeSample bs;
+        Vec2 u(r(), r());
+        if (!layered::interface_sample(b, -w, u, false, true, &bs)) break;
+        beta *= bs.f * abs_cos_theta(bs.wi) / bs.pdf;
+        w = bs.wi;
+      } else {
+        // At the diffuse base: next-event estimation along wis...
+        const Vec3 to_light = -wis.wi;
+        Float wt = 1.f;
+        if (!top_specular) wt = power_heuristic(wis.pdf, diffuse_pdf(b, -w, to_light));
+        if (same_hemisphere(-w, to_light))
+          f += beta * (R * kInvPi) * abs_cos_theta(wis.wi) * wt * layered::transmittance(thickness, wis.wi) *
+               (wis.f / wis.pdf);
+        // ...then a new direction from the base.
+        Vec2 u(r(), r());
+        Vec3 wi_base = sample_cosine_hemisphere(u);
+        if (-w.z < 0.f) wi_base.z = -wi_base.z;
+        const Float pdf = cosine_hemisphere_pdf(abs_cos_theta(wi_base));
+        if (!(pdf > 0.f) || wi_base.z == 0.f || is_black(R)) break;
+        beta *= R * kInvPi * abs_cos_theta(wi_base) / pdf;
+        w = wi_base;
+        if (!top_specular) {
+          // ...and through the rough top along the base's own sample.
+          const Float f_exit = dielectric_f(b, -w, wi).x;
+          if (f_exit > 0.f) {
+            const Float exit_pdf = layered::interface_transmission_pdf(b, -w, wi);
+            f += beta * layered::transmittance(thickness, w) * f_exit * power_heuristic(pdf, exit_pdf);
+          }
+        }
+      }
+    }
+  }
+  return finite_or_zero(f / static_cast<Float>(n_samples));
+}
