@@ -31,15 +31,34 @@ TESSERA_HOST_DEVICE inline Rgb film_pixel_value(const CameraView& c, Rgb L) {
 }
 
 // Offset within the pixel drawn from the filter (filter importance sampling:
-// every sample lands in its own pixel with weight 1, so tiles never overlap).
-TESSERA_HOST_DEVICE inline Float sample_filter_axis(const FilterView& f, Float u) {
-  Float x = u * static_cast<Float>(f.n - 1);
-  uint32_t i = glm::min(static_cast<uint32_t>(x), f.n - 2);
+// every sample lands in its own pixel, so tiles never overlap), and the
+// sample's weight: 1, or for filters with negative lobes +-integral|f|/integral f.
+TESSERA_HOST_DEVICE inline Float sample_filter_axis(const Float* inverse_cdf, uint32_t n, Float u) {
+  Float x = u * static_cast<Float>(n - 1);
+  uint32_t i = glm::min(static_cast<uint32_t>(x), n - 2);
   Float t = x - static_cast<Float>(i);
-  return (1.f - t) * f.inverse_cdf[i] + t * f.inverse_cdf[i + 1];
+  return (1.f - t) * inverse_cdf[i] + t * inverse_cdf[i + 1];
 }
-TESSERA_HOST_DEVICE inline Vec2 sample_filter_offset(const FilterView& f, Vec2 u) {
-  return Vec2(sample_filter_axis(f, u.x), sample_filter_axis(f, u.y));
+
+TESSERA_HOST_DEVICE inline Float filter_axis_weight(const Float* weight, uint32_t bins, Float offset, Float radius) {
+  const Float x = (offset / radius + 1.f) * 0.5f * static_cast<Float>(bins);
+  const uint32_t i = static_cast<uint32_t>(glm::clamp(x, 0.f, static_cast<Float>(bins - 1)));
+  return weight[i];
+}
+
+struct FilterSample {
+  Vec2 offset;
+  Float weight;
+};
+
+TESSERA_HOST_DEVICE inline FilterSample sample_filter(const FilterView& f, Vec2 u) {
+  FilterSample s;
+  s.offset = Vec2(sample_filter_axis(f.inverse_cdf_x, f.n, u.x), sample_filter_axis(f.inverse_cdf_y, f.n, u.y));
+  s.weight = 1.f;
+  if (f.weight_x)
+    s.weight = filter_axis_weight(f.weight_x, f.bins, s.offset.x, f.radius_x) *
+               filter_axis_weight(f.weight_y, f.bins, s.offset.y, f.radius_y);
+  return s;
 }
 
 }  // namespace tessera

@@ -19,10 +19,10 @@ __global__ void trace_pixels_kernel(SceneView scene, PathSettings settings, uint
   if (x >= scene.camera.width || y >= scene.camera.height) return;
   const uint64_t pixel = static_cast<uint64_t>(y) * scene.camera.width + x;
   Rng rng = Rng::for_sample(seed, pixel, 0);
-  Vec2 offset = sample_filter_offset(scene.filter, rng.uniform2());
-  Ray ray = generate_camera_ray(scene.camera, Vec2(x + 0.5f + offset.x, y + 0.5f + offset.y));
+  const FilterSample fs = sample_filter(scene.filter, rng.uniform2());
+  Ray ray = generate_camera_ray(scene.camera, Vec2(x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y));
   PathCounters counters;
-  out[pixel] = trace_path<Spec>(scene, NoGeometryTracer{}, ray, rng, settings, counters);
+  out[pixel] = film_pixel_value(scene.camera, trace_path<Spec>(scene, NoGeometryTracer{}, ray, rng, settings, counters)) * fs.weight;
 }
 
 // Instantiate the lean and the full specialisation.

@@ -32,11 +32,20 @@ struct CameraView {
   Float max_component_value = INFINITY;
 };
 
-// Inverse cdf of one axis of a separable pixel filter, tabulated at n evenly
-// spaced u in [0,1] and interpolated linearly: O(1) per sample, no search.
+// A separable pixel filter, sampled per axis in proportion to |f| (filter
+// importance sampling). Each axis: its inverse cdf tabulated at n evenly
+// spaced u in [0,1] and interpolated linearly (O(1) per sample), and, for
+// filters with negative lobes (mitchell, sinc), the sample weight
+// sign(f) * integral|f| / integral f per bin, so that the mean of weighted
+// samples is the filtered image exactly. weight_* are null when every weight is 1.
 struct FilterView {
-  const Float* inverse_cdf = nullptr;  // offsets in [-radius, radius]
+  const Float* inverse_cdf_x = nullptr;  // offsets in [-radius_x, radius_x]
+  const Float* inverse_cdf_y = nullptr;
   uint32_t n = 0;
+  const Float* weight_x = nullptr;
+  const Float* weight_y = nullptr;
+  uint32_t bins = 0;
+  Float radius_x = 0.5f, radius_y = 0.5f;
 };
 
 struct SceneView {

@@ -77,21 +77,59 @@ void read_film(const std::string& type, const ParamSet& ps, const std::string& w
 FilterDesc read_filter(const std::string& type, const ParamSet& ps, const std::string& where,
                        std::vector<std::string>& warnings) {
   FilterDesc f;
+  Float default_radius = 1.5f;
   if (type == "box") {
     f.type = FilterType::Box;
-    f.radius = ps.get_float("xradius", 0.5f);
-    ps.get_float("yradius", f.radius);
-  } else {
-    if (type != "gaussian") {
-      warnings.push_back(where + ": pixel filter \"" + type + "\" is not supported; using \"gaussian\"");
-      ps.mark_all_used();
-    }
+    default_radius = 0.5f;
+  } else if (type == "gaussian") {
     f.type = FilterType::Gaussian;
-    f.radius = ps.get_float("xradius", 1.5f);
-    ps.get_float("yradius", f.radius);
     f.sigma = ps.get_float("sigma", 0.5f);
+    if (!(f.sigma > 0.f)) fail(where, "gaussian filter \"sigma\" must be positive");
+  } else if (type == "triangle") {
+    f.type = FilterType::Triangle;
+    default_radius = 2.f;
+  } else if (type == "mitchell") {
+    f.type = FilterType::Mitchell;
+    default_radius = 2.f;
+    f.b = ps.get_float("B", 1.f / 3.f);
+    f.c = ps.get_float("C", 1.f / 3.f);
+  } else if (type == "sinc") {
+    f.type = FilterType::LanczosSinc;
+    default_radius = 4.f;
+    f.tau = ps.get_float("tau", 3.f);
+    if (!(f.tau > 0.f)) fail(where, "sinc filter \"tau\" must be positive");
+  } else {
+    warnings.push_back(where + ": pixel filter \"" + type + "\" is unknown; using \"gaussian\"");
+    ps.mark_all_used();
   }
+  f.radius = ps.get_float("xradius", default_radius);
+  f.radius_y = ps.get_float("yradius", default_radius);
+  if (!(f.radius > 0.f) || !(f.radius_y > 0.f) || f.radius > 64.f || f.radius_y > 64.f)
+    fail(where, "pixel filter radii must be in (0, 64]");
   return f;
+}
+
+Float pixel_filter_1d(const FilterDesc& f, Float x, Float radius) {
+  const double ax = std::abs(static_cast<double>(x));
+  if (ax > radius) return 0.f;
+  switch (f.type) {
+    case FilterType::Box: return 1.f;
+    case FilterType::Triangle: return static_cast<Float>(radius - ax);
+    case FilterType::Gaussian: {
+      auto g = [&](Float v) { return std::exp(-v * v / (2.f * f.sigma * f.sigma)); };
+      return std::max(0.f, g(x) - g(radius));
+    }
+    case FilterType::Mitchell: {
+      const double t = 2.0 * ax / radius, b = f.b, c = f.c;
+      if (t <= 1.0) return static_cast<Float>(((12 - 9 * b - 6 * c) * t * t * t + (-18 + 12 * b + 6 * c) * t * t + (6 - 2 * b)) / 6.0);
+      return static_cast<Float>(((-b - 6 * c) * t * t * t + (6 * b + 30 * c) * t * t + (-12 * b - 48 * c) * t + (8 * b + 24 * c)) / 6.0);
+    }
+    case FilterType::LanczosSinc: {
+      auto sinc = [](double v) { return std::abs(v) < 1e-5 ? 1.0 : std::sin(kPi * v) / (kPi * v); };
+      return static_cast<Float>(sinc(ax) * sinc(ax / f.tau));
+    }
+  }
+  return 0.f;
 }
 
 }  // namespace tessera

@@ -19,6 +19,10 @@ void read_film(const std::string& type, const ParamSet& params, const std::strin
 FilterDesc read_filter(const std::string& type, const ParamSet& params, const std::string& where,
                        std::vector<std::string>& warnings);
 
+// One axis of a separable pixel filter at offset x (pbrt-v4's definitions);
+// `radius` is that axis's radius. Mitchell and windowed sinc are negative in places.
+Float pixel_filter_1d(const FilterDesc& f, Float x, Float radius);
+
 // pbrt-v4's white balance (von Kries in Bradford LMS) from a daylight
 // illuminant of `kelvin` to sRGB's D65 white, as a linear sRGB -> linear sRGB matrix.
 Mat3 white_balance_srgb(Float kelvin);

@@ -65,11 +65,15 @@ struct FilmDesc {
   Mat3 pixel_from_radiance{1.f};
 };
 
-enum class FilterType : uint32_t { Gaussian = 0, Box };
+enum class FilterType : uint32_t { Gaussian = 0, Box, Triangle, Mitchell, LanczosSinc };
+// pbrt-v4's pixel filters, all separable: f(x, y) = f1(x, radius) f1(y, radius_y).
 struct FilterDesc {
   FilterType type = FilterType::Gaussian;
-  Float radius = 1.5f;  // pbrt-v4 defaults: gaussian radius 1.5, sigma 0.5; box radius 0.5
-  Float sigma = 0.5f;
+  Float radius = 1.5f;    // x radius. pbrt-v4 defaults: gaussian 1.5, box 0.5, triangle 2, mitchell 2, sinc 4
+  Float radius_y = 1.5f;
+  Float sigma = 0.5f;     // gaussian
+  Float b = 1.f / 3.f, c = 1.f / 3.f;  // mitchell
+  Float tau = 3.f;        // sinc
 };
 
 struct SceneDesc {

@@ -17,8 +17,8 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
       PixelAccum& acc = pixels.at(job, x, y);
       for (uint32_t si = job.sample_begin; si < job.sample_end; ++si) {
         Rng rng = Rng::for_sample(settings.seed, pixel_index, si);
-        Vec2 offset = sample_filter_offset(s.filter, rng.uniform2());
-        Vec2 p_film(x + 0.5f + offset.x, y + 0.5f + offset.y);
+        const FilterSample fs = sample_filter(s.filter, rng.uniform2());
+        Vec2 p_film(x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y);
         Ray ray = generate_camera_ray(s.camera, p_film);
         path.learn = settings.learn.learns(si);
         Rgb L = trace_path<Spec>(s, tracer, ray, rng, path, tc.path);
@@ -30,7 +30,7 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
           L = glm::max(L, Rgb(0.f));
         }
         if (is_black(L)) ++tc.zero_radiance;
-        L = film_pixel_value(s.camera, L);
+        L = film_pixel_value(s.camera, L) * fs.weight;
         for (int c = 0; c < 3; ++c) {
           acc.sum[c] += L[c];
           acc.sum_sq[c] += static_cast<double>(L[c]) * L[c];

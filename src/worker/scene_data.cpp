@@ -1,5 +1,7 @@
 #include "worker/scene_data.h"
 
+#include "scene/pbrt_film.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -129,27 +131,44 @@ void SceneData::build_camera() {
 }
 
 void SceneData::build_filter() {
-  // Tabulate one axis of the separable filter; sampling it with weight 1 is
-  // filter importance sampling (pbrt-v4's default for the Gaussian).
+  // Tabulate each axis of the separable filter; sampling |f| and weighting
+  // each sample by sign(f) integral|f| / integral f is filter importance
+  // sampling (pbrt-v4's FilterSampler, without its per-pixel weight sum).
   const FilterDesc& f = desc_.filter;
-  constexpr int kBins = 256;
-  std::vector<Float> table(kBins, 1.f);
-  if (f.type == FilterType::Gaussian) {
-    auto g = [&](Float x) { return std::exp(-x * x / (2.f * f.sigma * f.sigma)); };
+  constexpr int kBins = 256, kInverseSize = 1025;
+  bool negative_lobes = false;
+  auto build_axis = [&](Float radius, std::vector<Float>& inverse_cdf, std::vector<Float>& weight) {
+    std::vector<Float> table(kBins);
+    double sum_abs = 0, sum = 0;
     for (int i = 0; i < kBins; ++i) {
-      Float x = ((i + 0.5f) / kBins * 2.f - 1.f) * f.radius;
-      table[i] = std::max(0.f, g(x) - g(f.radius));
+      Float x = ((i + 0.5f) / kBins * 2.f - 1.f) * radius;
+      Float v = pixel_filter_1d(f, x, radius);
+      table[i] = std::abs(v);
+      sum_abs += std::abs(v);
+      sum += v;
+      negative_lobes |= v < 0.f;
     }
+    if (!(sum > 0.0)) throw SceneError("pixel filter: its integral is not positive");
+    weight.resize(kBins);
+    for (int i = 0; i < kBins; ++i) {
+      Float x = ((i + 0.5f) / kBins * 2.f - 1.f) * radius;
+      weight[i] = static_cast<Float>((pixel_filter_1d(f, x, radius) < 0.f ? -1.0 : 1.0) * sum_abs / sum);
+    }
+    Distribution1D dist(table);
+    inverse_cdf.resize(kInverseSize);
+    for (int i = 0; i < kInverseSize; ++i) {
+      Float u = std::min(static_cast<Float>(i) / (kInverseSize - 1), 0x1.fffffep-1f);
+      Float x = dist.view().sample_continuous(u, nullptr, nullptr);
+      inverse_cdf[i] = (2.f * x - 1.f) * radius;
+    }
+    inverse_cdf.back() = radius;
+  };
+  build_axis(f.radius, filter_inverse_cdf_x_, filter_weight_x_);
+  build_axis(f.radius_y, filter_inverse_cdf_y_, filter_weight_y_);
+  if (!negative_lobes) {
+    filter_weight_x_.clear();
+    filter_weight_y_.clear();
   }
-  Distribution1D dist(table);
-  constexpr int kInverseSize = 1025;
-  filter_inverse_cdf_.resize(kInverseSize);
-  for (int i = 0; i < kInverseSize; ++i) {
-    Float u = std::min(static_cast<Float>(i) / (kInverseSize - 1), 0x1.fffffep-1f);
-    Float x = dist.view().sample_continuous(u, nullptr, nullptr);
-    filter_inverse_cdf_[i] = (2.f * x - 1.f) * f.radius;
-  }
-  filter_inverse_cdf_.back() = f.radius;
 }
 
 void SceneData::build_view() {
@@ -172,8 +191,14 @@ void SceneData::build_view() {
   v.num_infinite_lights = static_cast<uint32_t>(infinite_lights_.size());
   v.env_distributions = env_views_.data();
   v.camera = camera_;
-  v.filter.inverse_cdf = filter_inverse_cdf_.data();
-  v.filter.n = static_cast<uint32_t>(filter_inverse_cdf_.size());
+  v.filter.inverse_cdf_x = filter_inverse_cdf_x_.data();
+  v.filter.inverse_cdf_y = filter_inverse_cdf_y_.data();
+  v.filter.n = static_cast<uint32_t>(filter_inverse_cdf_x_.size());
+  v.filter.weight_x = filter_weight_x_.empty() ? nullptr : filter_weight_x_.data();
+  v.filter.weight_y = filter_weight_y_.empty() ? nullptr : filter_weight_y_.data();
+  v.filter.bins = static_cast<uint32_t>(filter_weight_x_.size());
+  v.filter.radius_x = desc_.filter.radius;
+  v.filter.radius_y = desc_.filter.radius_y;
 }
 
 namespace {

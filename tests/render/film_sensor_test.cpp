@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "render_helpers.h"
+#include "scene/pbrt_film.h"
 
 namespace tessera {
 namespace {
@@ -49,6 +50,68 @@ TEST(FilmSensor, MaxComponentValueBoundsEverySample) {
   // Scaled, not clipped per channel: a pixel keeps its hue (red:green 2:1).
   const size_t centre = 3 * (8 * 16 + 8);
   EXPECT_NEAR(capped.rgb[centre] / capped.rgb[centre + 1], base.rgb[centre] / base.rgb[centre + 1], 0.05f);
+}
+
+// A sharp vertical edge (emission 1 on one side, 0 on the other) seen through
+// each pixel filter: a column at distance d from the edge records the share
+// of the filter on the bright side, integral f over (-r, d) / integral f.
+// Mitchell and sinc overshoot beyond 1 and below 0 there: their negative
+// lobes carry negative sample weights.
+double edge_column(const ImageRgb& img, int x) {
+  double s = 0;
+  for (int y = 0; y < img.height; ++y) s += img.rgb[3 * (y * img.width + x)];
+  return s / img.height;
+}
+
+TEST(FilmSensor, EveryPixelFilterGivesItsEdgeProfile) {
+  for (const char* type : {"box", "gaussian", "triangle", "mitchell", "sinc"}) {
+    SCOPED_TRACE(type);
+    const std::string scene = std::string(R"(
+LookAt 0 0 0  0 0 1  0 1 0
+Camera "perspective" "float fov" [ 20 ]
+Film "rgb" "integer xresolution" [ 32 ] "integer yresolution" [ 8 ]
+Sampler "independent" "integer pixelsamples" [ 2048 ]
+Integrator "path" "integer maxdepth" [ 1 ]
+PixelFilter ")") + type + R"("
+WorldBegin
+AreaLightSource "diffuse" "rgb L" [ 1 1 1 ] "bool twosided" true
+Shape "trianglemesh" "point3 P" [ -100 -100 10  0 -100 10  0 100 10  -100 100 10 ] "integer indices" [ 0 1 2 0 2 3 ]
+)";
+    SceneDesc desc = load_pbrt_string(scene, "<edge>", ".");
+    const FilterDesc filter = desc.filter;
+    const ImageRgb img = film_mean(testing::render_desc(std::move(desc), RenderOptions{}).film);
+    // Which side is lit depends on the camera's handedness; the test does not care.
+    const bool left_lit = edge_column(img, 0) > 0.5;
+    auto bright_share = [&](double d) {  // integral of f over the lit side of a pixel centre d from the edge
+      double lit = 0, all = 0;
+      const int n = 20000;
+      for (int i = 0; i < n; ++i) {
+        const double x = (i + 0.5) / n * 2 * filter.radius - filter.radius;
+        const double f = pixel_filter_1d(filter, static_cast<Float>(x), filter.radius);
+        all += f;
+        if ((left_lit && x + d < 0) || (!left_lit && x + d > 0)) lit += f;
+      }
+      return lit / all;
+    };
+    const bool negative_lobes = std::string(type) == "mitchell" || std::string(type) == "sinc";
+    double worst = 0, lowest_expected = 1, got_at_lowest = 0;
+    for (int x = 0; x < 32; ++x) {
+      const double d = x + 0.5 - 16.0, got = edge_column(img, x), expected = bright_share(d);
+      worst = std::max(worst, std::abs(got - expected));
+      if (expected < lowest_expected) lowest_expected = expected, got_at_lowest = got;
+      if (!negative_lobes) {
+        EXPECT_GE(got, 0.0);
+        EXPECT_LE(got, 1.0 + 1e-6);
+      }
+    }
+    // 16384 samples per column; signed weights (sinc's most) add noise.
+    EXPECT_LT(worst, negative_lobes ? 0.04 : 0.015);
+    if (negative_lobes) {
+      // The undershoot on the dark side of the edge is there, in sign and size.
+      ASSERT_LT(lowest_expected, -0.005);
+      EXPECT_LT(got_at_lowest, 0.5 * lowest_expected);
+    }
+  }
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 // Camera, Film, Sampler, Integrator and PixelFilter, and warnings.
+#include "scene/pbrt_film.h"
 #include "scene_test_helpers.h"
 
 namespace tessera {
@@ -57,8 +58,40 @@ TEST(PbrtOptions, PixelFilters) {
   EXPECT_FLOAT_EQ(s.filter.radius, 2.f);
   EXPECT_FLOAT_EQ(s.filter.sigma, 0.25f);
   s = load_with_options("PixelFilter \"mitchell\" \"float B\" 0.3\n");
+  EXPECT_EQ(s.filter.type, FilterType::Mitchell);
+  EXPECT_FLOAT_EQ(s.filter.b, 0.3f);
+  EXPECT_FLOAT_EQ(s.filter.c, 1.f / 3.f);
+  EXPECT_FLOAT_EQ(s.filter.radius, 2.f);
+  s = load_with_options("PixelFilter \"triangle\" \"float yradius\" 1\n");
+  EXPECT_EQ(s.filter.type, FilterType::Triangle);
+  EXPECT_FLOAT_EQ(s.filter.radius, 2.f);
+  EXPECT_FLOAT_EQ(s.filter.radius_y, 1.f);
+  s = load_with_options("PixelFilter \"sinc\"\n");
+  EXPECT_EQ(s.filter.type, FilterType::LanczosSinc);
+  EXPECT_FLOAT_EQ(s.filter.radius, 4.f);
+  EXPECT_FLOAT_EQ(s.filter.tau, 3.f);
+  s = load_with_options("PixelFilter \"catmullrom\"\n");
   EXPECT_EQ(s.filter.type, FilterType::Gaussian);
-  EXPECT_TRUE(has_warning(s, "opt.pbrt:1: pixel filter \"mitchell\""));
+  EXPECT_TRUE(has_warning(s, "opt.pbrt:1: pixel filter \"catmullrom\" is unknown"));
+  EXPECT_NE(test::load_error("PixelFilter \"box\" \"float xradius\" 0\nWorldBegin\n").find("radii must be in"), std::string::npos);
+}
+
+TEST(PbrtOptions, FilterFunctionsArePbrtsDefinitions) {
+  FilterDesc m;
+  m.type = FilterType::Mitchell;
+  // Mitchell-Netravali at B = C = 1/3: (6 - 2B)/6 at the centre, B/6 at half the radius, negative beyond.
+  EXPECT_NEAR(pixel_filter_1d(m, 0.f, 2.f), (6.f - 2.f / 3.f) / 6.f, 1e-6f);
+  EXPECT_NEAR(pixel_filter_1d(m, 1.f, 2.f), 1.f / 18.f, 1e-6f);
+  EXPECT_LT(pixel_filter_1d(m, 1.5f, 2.f), 0.f);
+  EXPECT_EQ(pixel_filter_1d(m, 2.1f, 2.f), 0.f);
+  FilterDesc t;
+  t.type = FilterType::Triangle;
+  EXPECT_FLOAT_EQ(pixel_filter_1d(t, -0.5f, 2.f), 1.5f);
+  FilterDesc l;
+  l.type = FilterType::LanczosSinc;
+  EXPECT_NEAR(pixel_filter_1d(l, 0.f, 4.f), 1.f, 1e-6f);
+  EXPECT_NEAR(pixel_filter_1d(l, 1.f, 4.f), 0.f, 1e-6f);  // sinc's first zero
+  EXPECT_LT(pixel_filter_1d(l, 1.5f, 4.f), 0.f);
 }
 
 TEST(PbrtOptions, CameraTypesAndLensWarn) {
