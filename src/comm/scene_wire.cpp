@@ -6,7 +6,7 @@ namespace tessera {
 
 template <class Archive>
 void serialize(Archive& ar, MeshDesc& m) {
-  ar(raw(m.p), raw(m.n), raw(m.uv), raw(m.indices), m.material, m.flip_normals, m.area_light, m.where);
+  ar(raw(m.p), raw(m.n), raw(m.uv), raw(m.indices), m.material, m.flip_normals, m.area_light, raw_value(m.alpha), m.where);
 }
 template <class Archive>
 void serialize(Archive& ar, ImageDesc& i) {

@@ -19,6 +19,7 @@ enum Effect : uint32_t {
   kEffectMix = 1u << 8,
   kEffectInterface = 1u << 9,
   kEffectShadingNormals = 1u << 10,
+  kEffectAlpha = 1u << 11,        // alpha cutouts (a ray-query filter, only where present)
 };
 
 // What the integrator template is specialised on: each bit removes work from

@@ -58,6 +58,8 @@ struct SceneView {
   // already negated for kTriFlipNormal (precomputed: every hit needs it).
   const Vec3* face_normals = nullptr;
   uint32_t num_triangles = 0;
+  // Per triangle, its alpha (pbrt-v4 cutouts); null when no shape has one.
+  const TextureSlot* triangle_alpha = nullptr;
 
   const Material* materials = nullptr;
   uint32_t num_materials = 0;

@@ -385,6 +385,11 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
   }
   mesh->material = state_.material;
   mesh->area_light = state_.area_light;
+  mesh->alpha = float_slot(params, "alpha", 1.f, context(at, including_dir));
+  if (mesh->alpha.texture < 0 && !(mesh->alpha.value.x >= 0.f && mesh->alpha.value.x <= 1.f))
+    fail(at, "shape \"alpha\" must be in [0, 1]");
+  if ((mesh->alpha.texture >= 0 || mesh->alpha.value.x < 1.f) && mesh->area_light >= 0)
+    scene_.warnings.push_back(at.where() + ": \"alpha\" on an emissive shape cuts out its surface but not its emission");
   if (!open_instance_.empty()) {
     if (mesh->area_light >= 0) {
       scene_.warnings.push_back(at.where() + ": area lights inside ObjectBegin are not supported (as in pbrt-v4); not emissive");

@@ -28,6 +28,9 @@ struct MeshDesc {
   // (when shading normals exist, it is instead flipped to their side).
   bool flip_normals = false;
   int32_t area_light = -1;      // index into SceneDesc::area_lights, -1 = not emissive
+  // pbrt-v4 "alpha": a float constant or float texture; hits where it is
+  // below 1 are ignored with probability 1 - alpha. Constant 1 = opaque.
+  TextureSlot alpha{-1, Rgb(1.f)};
   std::string where;            // "file:line" of the Shape directive, for messages
 };
 

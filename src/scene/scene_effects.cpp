@@ -54,6 +54,7 @@ uint32_t compute_effects(const SceneDesc& scene) {
     }
     if (m.area_light >= 0) e |= kEffectAreaLights;
     if (!m.n.empty()) e |= kEffectShadingNormals;
+    if (m.alpha.texture >= 0 || m.alpha.value.x < 1.f) e |= kEffectAlpha;
   }
   for (const Light& l : scene.lights) {
     if (l.type == LightType::Infinite) e |= kEffectEnvironment;
@@ -64,7 +65,7 @@ uint32_t compute_effects(const SceneDesc& scene) {
 
 std::string describe_effects(uint32_t e) {
   static const char* names[] = {"diffuse", "glossy", "specular", "transmission", "textures", "area-lights",
-                                "delta-lights", "environment", "mix", "interface", "shading-normals"};
+                                "delta-lights", "environment", "mix", "interface", "shading-normals", "alpha-cutouts"};
   std::string out;
   for (uint32_t i = 0; i < sizeof(names) / sizeof(names[0]); ++i) {
     if (e & (1u << i)) {

@@ -1,5 +1,7 @@
 #include "worker/embree_backend.h"
 
+#include "kernels/alpha.h"
+
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -12,6 +14,22 @@ namespace {
 void embree_error(void* user, RTCError code, const char* message) {
   auto* first = static_cast<std::string*>(user);
   if (code != RTC_ERROR_NONE && first->empty()) *first = message ? message : "unknown error";
+}
+
+// Closest-hit and shadow rays alike: candidate hits on cut-out surfaces are
+// rejected here, so Embree continues to the next candidate.
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* view = static_cast<const SceneView*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const Vec3 o(RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+                 RTCRayN_org_z(args->ray, args->N, i));
+    const Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                 RTCRayN_dir_z(args->ray, args->N, i));
+    if (alpha_ignores_hit(*view, RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i),
+                          RTCHitN_v(args->hit, args->N, i), o, d))
+      args->valid[i] = 0;
+  }
 }
 
 }  // namespace
@@ -43,6 +61,11 @@ void EmbreeScene::build(const SceneData& data) {
     }
     std::memcpy(v, data.positions().data(), nv * 3 * sizeof(float));
     std::memcpy(ix, data.indices().data(), nt * 3 * sizeof(uint32_t));
+    if (data.view().triangle_alpha) {  // only scenes with cutouts pay for the filter
+      rtcSetGeometryUserData(geom, const_cast<SceneView*>(&data.view()));
+      rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
+    }
     rtcCommitGeometry(geom);
     rtcAttachGeometry(scene_, geom);
     rtcReleaseGeometry(geom);

@@ -25,6 +25,7 @@ SceneData::SceneData(SceneDesc desc) : desc_(std::move(desc)) {
 
 void SceneData::flatten_meshes() {
   for (const MeshDesc& m : desc_.meshes) {
+    has_alpha_ |= m.alpha.texture >= 0 || m.alpha.value.x < 1.f;
     const uint32_t base = static_cast<uint32_t>(positions_.size());
     const bool has_n = !m.n.empty(), has_uv = !m.uv.empty();
     for (size_t i = 0; i < m.p.size(); ++i) {
@@ -61,6 +62,7 @@ void SceneData::flatten_meshes() {
         }
       }
       triangles_.push_back(ti);
+      triangle_alpha_.push_back(m.alpha);
     }
   }
 }
@@ -180,6 +182,7 @@ void SceneData::build_view() {
   v.triangles = triangles_.data();
   v.face_normals = face_normals_.data();
   v.num_triangles = static_cast<uint32_t>(triangles_.size());
+  v.triangle_alpha = has_alpha_ ? triangle_alpha_.data() : nullptr;
   v.materials = desc_.materials.data();
   v.num_materials = static_cast<uint32_t>(desc_.materials.size());
   v.textures = desc_.textures.data();

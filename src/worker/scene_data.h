@@ -59,6 +59,8 @@ class SceneData {
   Distribution1D light_select_;
   std::vector<Distribution2D> env_storage_;     // one per light (empty for non-image lights)
   std::vector<Distribution2DView> env_views_;
+  std::vector<TextureSlot> triangle_alpha_;  // per triangle
+  bool has_alpha_ = false;                   // any triangle not opaque
   std::vector<Float> filter_inverse_cdf_x_, filter_inverse_cdf_y_;
   std::vector<Float> filter_weight_x_, filter_weight_y_;  // empty unless the filter has negative lobes
   CameraView camera_;

@@ -138,3 +138,27 @@ TEST(PbrtShapes, BinaryPlyLoads) {
 
 }  // namespace
 }  // namespace tessera
+
+namespace tessera {
+namespace {
+
+TEST(PbrtShapes, AlphaIsAFloatOrAFloatTexture) {
+  SceneDesc s = test::load_world(std::string("Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"float alpha\" 0.25\n") +
+                                 test::kTriangle);
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_EQ(s.meshes[0].alpha.value.x, 0.25f);
+  EXPECT_EQ(s.meshes[1].alpha.value.x, 1.f);
+  s = test::load_world("Texture \"a\" \"float\" \"checkerboard\"\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] "
+                       "\"texture alpha\" \"a\"\n");
+  EXPECT_GE(s.meshes[0].alpha.texture, 0);
+  EXPECT_NE(test::load_error("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"float alpha\" 2\n")
+                .find("bad.pbrt:2: shape \"alpha\" must be in [0, 1]"),
+            std::string::npos);
+  s = test::load_world("AreaLightSource \"diffuse\"\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"float alpha\" 0.5\n");
+  bool warned = false;
+  for (const std::string& w : s.warnings) warned |= w.find("cuts out its surface but not its emission") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+}  // namespace
+}  // namespace tessera
