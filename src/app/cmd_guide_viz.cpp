@@ -100,6 +100,7 @@ int run_guide_viz(VizArgs a) {
     opt.spp = static_cast<uint32_t>(a.train_spp);
     opt.max_depth = scene.desc().max_depth;
     opt.seed = static_cast<uint64_t>(a.seed);
+    opt.sampler = scene.desc().sampler;
     opt.progress = false;
     apply_guide_render_options(a.guide, &opt);
     render(scene, embree, opt, field.get());

@@ -29,6 +29,7 @@ struct RenderArgs {
   std::string scene, output, preview, stats, res;
   int64_t spp = -1, max_depth = -1, threads = 0, tile = 16;
   int64_t seed = -1;
+  std::string sampler;  // "" = the scene's
   double time = 0.0;
   double target_error = 0.0;
   std::string snapshot_every;
@@ -58,6 +59,8 @@ SceneDesc load_desc(const RenderArgs& a) {
   if (a.max_depth >= 0) desc.max_depth = static_cast<int32_t>(a.max_depth);
   if (a.spp >= 0) desc.spp = static_cast<int32_t>(a.spp);
   if (a.seed >= 0) desc.seed = static_cast<uint64_t>(a.seed);
+  if (a.sampler == "independent") desc.sampler = SamplerKind::Independent;
+  else if (a.sampler == "sobol") desc.sampler = SamplerKind::Sobol;
   return desc;
 }
 
@@ -71,6 +74,7 @@ RenderOptions make_options(const RenderArgs& a, const SceneDesc& desc) {
   opt.target_error = a.target_error;
   opt.max_depth = desc.max_depth;
   opt.seed = desc.seed;
+  opt.sampler = desc.sampler;
   opt.threads = static_cast<int32_t>(a.threads);
   opt.tile_size = static_cast<int32_t>(a.tile);
   opt.progress = !a.quiet;
@@ -195,6 +199,7 @@ void write_atomically(const std::string& path, Write write) {
 ExrMetadata base_metadata(const MasterSetup& m, uint32_t spec) {
   ExrMetadata meta;
   meta.strings["seed"] = std::to_string(m.opt.seed);
+  meta.strings["sampler"] = m.opt.sampler == SamplerKind::Sobol ? "sobol" : "independent";
   meta.strings["effects"] = describe_effects(m.scene->effects());
   meta.strings["specialisation"] = describe_specialisation(spec);
   meta.strings["software"] = "tessera " TESSERA_VERSION;
@@ -385,6 +390,9 @@ CommandRunner add_render_command(CLI::App& app) {
   c->add_option("--res", a->res, "Resolution WxH (overrides the scene's Film)");
   c->add_option("--max-depth", a->max_depth, "Maximum path depth, counted as pbrt-v4 does (overrides the Integrator)")->check(CLI::Range(0, 1 << 20));
   c->add_option("--seed", a->seed, "Random seed (same seed -> bit-identical image)")->check(CLI::NonNegativeNumber);
+  c->add_option("--sampler", a->sampler,
+                "independent | sobol (Owen-scrambled Sobol points); default: the scene's Sampler (pbrt's default zsobol -> sobol)")
+      ->check(CLI::IsMember({"independent", "sobol"}));
   c->add_option("--threads", a->threads, "Worker threads per process (0 = all cores, shared out among the ranks on a machine)")->check(CLI::Range(0, 4096));
   c->add_option("--tile", a->tile, "Tile size in pixels")->check(CLI::Range(1, 4096));
   c->add_option("--stats", a->stats, "Write render statistics as JSON");

@@ -6,6 +6,7 @@
 #include "bsdf.h"
 #include "guidecache/guide_view.h"
 #include "rng.h"
+#include "sampler.h"
 #include "scene_view.h"
 
 namespace tessera {
@@ -138,7 +139,7 @@ TESSERA_HOST_DEVICE inline Float guided_survival(const GuideView& g, int32_t cel
 // The BSDF is given in its local frame; w_j is taken to it by `to_local`.
 template <class ToLocal>
 TESSERA_HOST_DEVICE inline Float guide_bins_integral(const GuideView& g, int32_t cell, const BsdfParams& b, bool lambertian,
-                                                     const Vec3& wo_local, const ToLocal& to_local, Rng& rng) {
+                                                     const Vec3& wo_local, const ToLocal& to_local, PixelSampler& rng) {
   if (lambertian) {
     Float rho = luminance(b.reflectance);
     return g.target == GuideTarget::QLearning ? rho * g.qmax[cell] : rho * kInvPi * g.irradiance[cell];

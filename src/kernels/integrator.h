@@ -13,6 +13,7 @@
 #include "light_sampling.h"
 #include "material_eval.h"
 #include "rng.h"
+#include "sampler.h"
 
 namespace tessera {
 
@@ -110,7 +111,7 @@ TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, const Vec3& wo, Fl
 // duplicating the light samples; Q stays the full reflected radiance, so
 // light that reaches x over several bounces is still learned.
 template <uint32_t Spec, class Tracer>
-TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray ray, Rng& rng,
+TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray ray, PixelSampler& rng,
                                    const PathSettings& settings, PathCounters& c) {
   constexpr bool kGuide = (Spec & kSpecGuiding) != 0;
   const bool learn = kGuide && settings.learn;

@@ -18,7 +18,7 @@ __global__ void trace_pixels_kernel(SceneView scene, PathSettings settings, uint
   const int32_t y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= scene.camera.width || y >= scene.camera.height) return;
   const uint64_t pixel = static_cast<uint64_t>(y) * scene.camera.width + x;
-  Rng rng = Rng::for_sample(seed, pixel, 0);
+  PixelSampler rng = PixelSampler::start(SamplerKind::Sobol, seed, pixel, 0);
   const FilterSample fs = sample_filter(scene.filter, rng.uniform2());
   Ray ray = generate_camera_ray(scene.camera, Vec2(x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y));
   PathCounters counters;

@@ -43,6 +43,7 @@ uint64_t render_options_fingerprint(const RenderOptions& o, int32_t width, int32
   if (o.guide_roulette_window != kGuidedRouletteWindow) s << " window " << o.guide_roulette_window;
   // Checkpoints from before the taper learned every K-th sample throughout.
   if (o.guide_learn.taper) s << " taper";
+  if (o.sampler == SamplerKind::Sobol) s << " sobol";
   return fnv1a(s.str());
 }
 

@@ -25,6 +25,7 @@ uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& o
 TileSettings make_tile_settings(const RenderOptions& opt, uint32_t specialisation, bool guiding) {
   TileSettings ts;
   ts.seed = opt.seed;
+  ts.sampler = opt.sampler;
   ts.path.max_depth = opt.max_depth;
   ts.path.nee = opt.nee;
   ts.specialisation = specialisation;

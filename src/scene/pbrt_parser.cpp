@@ -252,6 +252,17 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     scene_.spp = ps.get_int("pixelsamples", 16);
     if (scene_.spp <= 0) fail(at, "pixelsamples must be positive");
     scene_.seed = static_cast<uint64_t>(ps.get_int("seed", static_cast<int>(scene_.seed)));
+    if (type == "independent") {
+      scene_.sampler = SamplerKind::Independent;
+    } else {
+      scene_.sampler = SamplerKind::Sobol;
+      if (type != "zsobol" && type != "sobol" && type != "paddedsobol" && type != "halton" && type != "pmj02bn" &&
+          type != "stratified")
+        warn("sampler \"" + type + "\" is unknown; using Owen-scrambled Sobol points");
+      else if (type != "paddedsobol")
+        warn("sampler \"" + type + "\": drawn as Owen-scrambled (padded) Sobol points; the same image in expectation, "
+             "but not pbrt-v4's own point set or pixel ordering");
+    }
     ps.find_any("jitter");
     ps.find_any("randomization");
     ps.report_unused(warnings);

@@ -9,6 +9,7 @@
 
 #include "kernels/light.h"
 #include "kernels/material.h"
+#include "kernels/sampler.h"
 
 namespace tessera {
 
@@ -86,6 +87,10 @@ struct SceneDesc {
   int32_t spp = 16;        // pbrt-v4 default pixelsamples
   int32_t max_depth = 5;   // pbrt-v4 default maxdepth
   uint64_t seed = 0;       // Sampler "integer seed"
+  // Sampler type: pbrt-v4's low-discrepancy samplers (zsobol, the default,
+  // sobol, paddedsobol, halton, pmj02bn, stratified) draw Owen-scrambled
+  // Sobol points here; "independent" draws independent numbers.
+  SamplerKind sampler = SamplerKind::Sobol;
   std::vector<MeshDesc> meshes;
   std::vector<Material> materials;  // never empty after loading (index 0 = pbrt's default diffuse 0.5)
   std::vector<Texture> textures;

@@ -16,7 +16,7 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
       const uint64_t pixel_index = static_cast<uint64_t>(y) * static_cast<uint64_t>(s.camera.width) + x;
       PixelAccum& acc = pixels.at(job, x, y);
       for (uint32_t si = job.sample_begin; si < job.sample_end; ++si) {
-        Rng rng = Rng::for_sample(settings.seed, pixel_index, si);
+        PixelSampler rng = PixelSampler::start(settings.sampler, settings.seed, pixel_index, si);
         const FilterSample fs = sample_filter(s.filter, rng.uniform2());
         Vec2 p_film(x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y);
         Ray ray = generate_camera_ray(s.camera, p_film);

@@ -49,6 +49,7 @@ struct GuideLearnSchedule {
 
 struct TileSettings {
   uint64_t seed = 0;
+  SamplerKind sampler = SamplerKind::Independent;
   PathSettings path;
   GuideLearnSchedule learn;
   uint32_t specialisation = kSpecAll;

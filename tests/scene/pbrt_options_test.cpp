@@ -40,7 +40,12 @@ TEST(PbrtOptions, FilmSamplerIntegrator) {
   EXPECT_EQ(s.spp, 128);
   EXPECT_EQ(s.seed, 7u);
   EXPECT_EQ(s.max_depth, 3);
-  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_EQ(s.sampler, SamplerKind::Sobol);
+  ASSERT_EQ(s.warnings.size(), 1u);  // zsobol's blue-noise ordering is not reproduced: said so
+  EXPECT_NE(s.warnings[0].find("sampler \"zsobol\": drawn as Owen-scrambled"), std::string::npos);
+  EXPECT_EQ(load_with_options("Sampler \"independent\"\n").sampler, SamplerKind::Independent);
+  EXPECT_EQ(load_with_options("").sampler, SamplerKind::Sobol);  // pbrt's default, zsobol
+  EXPECT_TRUE(load_with_options("Sampler \"paddedsobol\"\n").warnings.empty());
 }
 
 TEST(PbrtOptions, OtherIntegratorsWarn) {
