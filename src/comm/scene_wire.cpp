@@ -14,7 +14,8 @@ void serialize(Archive& ar, ImageDesc& i) {
 }
 template <class Archive>
 void serialize(Archive& ar, SceneDesc& d) {
-  ar(raw_value(d.camera.world_from_camera), d.camera.fov_degrees, d.camera.where);
+  ar(raw_value(d.camera.world_from_camera), d.camera.fov_degrees, d.camera.lens_radius, d.camera.focal_distance,
+     d.camera.where);
   ar(d.film.xres, d.film.yres, d.film.filename, raw_value(d.filter), d.spp, d.max_depth, d.seed);
   ar(d.sampler, d.camera.exposure_time, d.film.iso, d.film.whitebalance, d.film.sensor, d.film.max_component_value,
      raw_value(d.film.pixel_from_radiance));

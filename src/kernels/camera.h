@@ -2,6 +2,7 @@
 // spans the shorter image axis, camera space is x right, y up, z forward.
 #pragma once
 
+#include "sampling.h"
 #include "scene_view.h"
 
 namespace tessera {
@@ -10,12 +11,23 @@ struct Ray {
   Vec3 o, d;
 };
 
-TESSERA_HOST_DEVICE inline Ray generate_camera_ray(const CameraView& c, Vec2 p_film) {
+// u_lens: a point on the lens (used only when c.lens_radius > 0; pbrt-v4's
+// thin lens: the ray passes through the point of the focal plane that the
+// pinhole ray meets).
+TESSERA_HOST_DEVICE inline Ray generate_camera_ray(const CameraView& c, Vec2 p_film, Vec2 u_lens = Vec2(0.f)) {
   Float sx = c.screen_min.x + (p_film.x / c.width) * (c.screen_max.x - c.screen_min.x);
   Float sy = c.screen_max.y - (p_film.y / c.height) * (c.screen_max.y - c.screen_min.y);
   Vec3 d_cam(sx * c.tan_half_fov, sy * c.tan_half_fov, 1.f);
   Ray r;
   r.o = c.origin;
+  if (c.lens_radius > 0.f) {
+    d_cam = glm::normalize(d_cam);
+    const Vec2 lens = c.lens_radius * sample_uniform_disk_concentric(u_lens);
+    const Vec3 focus = d_cam * (c.focal_distance / d_cam.z);
+    const Vec3 o_cam(lens.x, lens.y, 0.f);
+    d_cam = focus - o_cam;
+    r.o = c.origin + c.world_from_camera_linear * o_cam;
+  }
   r.d = glm::normalize(c.world_from_camera_linear * d_cam);
   return r;
 }

@@ -26,6 +26,8 @@ struct CameraView {
   Vec2 screen_min{-1.f}, screen_max{1.f};  // screen window, pbrt-v4 convention
   Float tan_half_fov = 1.f;
   int32_t width = 0, height = 0;
+  Float lens_radius = 0.f;      // thin lens; 0 = pinhole (then no lens sample is drawn)
+  Float focal_distance = 1e6f;
   // What the film records of a sample's radiance (pbrt-v4's pixel sensor:
   // exposure, white balance), then pbrt's per-sample "maxcomponentvalue".
   Mat3 pixel_from_radiance{1.f};

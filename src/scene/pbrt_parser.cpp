@@ -380,8 +380,11 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   scene_.camera.exposure_time = close - open;
   scene_.camera.where = at.where();
   coordinate_systems_["camera"] = scene_.camera.world_from_camera;
-  if (params.find_any("lensradius") || params.find_any("focaldistance"))
-    warnings.push_back(at.where() + ": depth of field (lensradius/focaldistance) is not supported; ignored");
+  scene_.camera.lens_radius = params.get_float("lensradius", 0.f);
+  scene_.camera.focal_distance = params.get_float("focaldistance", 1e6f);
+  if (!(scene_.camera.lens_radius >= 0.f) || !std::isfinite(scene_.camera.lens_radius))
+    fail(at, "camera \"lensradius\" must not be negative");
+  if (!(scene_.camera.focal_distance > 0.f)) fail(at, "camera \"focaldistance\" must be positive");
   if (type != "perspective") params.mark_all_used();
   params.report_unused(warnings);
 }

@@ -50,6 +50,8 @@ struct CameraDesc {
   Mat4 world_from_camera{1.f};  // pbrt camera space: x right, y up, z forward (left-handed)
   Float fov_degrees = 90.f;     // pbrt-v4: angle spanned by the shorter image axis
   Float exposure_time = 1.f;    // shutterclose - shutteropen (scales the image, as in pbrt-v4)
+  Float lens_radius = 0.f;      // thin lens (pbrt-v4 "lensradius"); 0 = pinhole
+  Float focal_distance = 1e6f;  // distance of the plane in focus, along the view axis (camera space)
   std::string where;
 };
 

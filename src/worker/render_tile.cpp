@@ -19,7 +19,8 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
         PixelSampler rng = PixelSampler::start(settings.sampler, settings.seed, pixel_index, si);
         const FilterSample fs = sample_filter(s.filter, rng.uniform2());
         Vec2 p_film(x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y);
-        Ray ray = generate_camera_ray(s.camera, p_film);
+        // A lens sample only where there is a lens: pinhole images keep their random streams.
+        Ray ray = generate_camera_ray(s.camera, p_film, s.camera.lens_radius > 0.f ? rng.uniform2() : Vec2(0.f));
         path.learn = settings.learn.learns(si);
         Rgb L = trace_path<Spec>(s, tracer, ray, rng, path, tc.path);
         if (!is_finite(L)) {

@@ -129,6 +129,8 @@ void SceneData::build_camera() {
   }
   camera_.tan_half_fov = std::tan(glm::radians(desc_.camera.fov_degrees) * 0.5f);
   camera_.pixel_from_radiance = desc_.film.pixel_from_radiance;
+  camera_.lens_radius = desc_.camera.lens_radius;
+  camera_.focal_distance = desc_.camera.focal_distance;
   camera_.max_component_value = desc_.film.max_component_value;
 }
 

@@ -103,7 +103,11 @@ TEST(PbrtOptions, CameraTypesAndLensWarn) {
   SceneDesc s = load_with_options("Camera \"orthographic\"\n");
   EXPECT_TRUE(has_warning(s, "opt.pbrt:1: camera \"orthographic\""));
   s = load_with_options("Camera \"perspective\" \"float lensradius\" 0.1 \"float focaldistance\" 3\n");
-  EXPECT_TRUE(has_warning(s, "depth of field"));
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_FLOAT_EQ(s.camera.lens_radius, 0.1f);
+  EXPECT_FLOAT_EQ(s.camera.focal_distance, 3.f);
+  EXPECT_NE(test::load_error("Camera \"perspective\" \"float focaldistance\" 0\nWorldBegin\n").find("focaldistance"),
+            std::string::npos);
 }
 
 TEST(PbrtOptions, UnknownParametersAndDirectivesWarnWithLocation) {
