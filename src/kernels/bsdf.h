@@ -8,7 +8,7 @@
 
 namespace tessera {
 
-enum class BsdfType : uint32_t { Diffuse = 0, Conductor, Dielectric, CoatedDiffuse };
+enum class BsdfType : uint32_t { Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, DiffuseTransmission };
 
 // Lobe flags, combinable.
 enum BsdfLobe : uint32_t {
@@ -24,6 +24,7 @@ enum BsdfLobe : uint32_t {
 struct BsdfParams {
   BsdfType type = BsdfType::Diffuse;
   Rgb reflectance{0.5f};  // Diffuse and CoatedDiffuse albedo, in [0,1]
+  Rgb transmittance{0.f}; // DiffuseTransmission, in [0,1]
   Rgb eta{1.f};           // Conductor: real part of the complex IOR, per channel
   Rgb k{0.f};             // Conductor: imaginary part
   Float ior = 1.5f;       // Dielectric / CoatedDiffuse coating: n_inside / n_outside

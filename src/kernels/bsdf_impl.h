@@ -40,6 +40,35 @@ TESSERA_HOST_DEVICE inline bool diffuse_sample(const BsdfParams& b, const Vec3& 
   return true;
 }
 
+// ---------------------------------------------------- DiffuseTransmission ---
+// pbrt-v4 DiffuseTransmissionBxDF: R/pi on wo's side, T/pi through; the side
+// is chosen in proportion to the largest channel of R and of T.
+TESSERA_HOST_DEVICE inline Rgb diffuse_transmission_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  return (same_hemisphere(wo, wi) ? b.reflectance : b.transmittance) * kInvPi;
+}
+TESSERA_HOST_DEVICE inline Float diffuse_transmission_pr(const BsdfParams& b, bool reflect) {
+  const Float pr = max_component(b.reflectance), pt = max_component(b.transmittance);
+  if (!(pr + pt > 0.f)) return 0.f;
+  return (reflect ? pr : pt) / (pr + pt);
+}
+TESSERA_HOST_DEVICE inline Float diffuse_transmission_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  return diffuse_transmission_pr(b, same_hemisphere(wo, wi)) * cosine_hemisphere_pdf(abs_cos_theta(wi));
+}
+TESSERA_HOST_DEVICE inline bool diffuse_transmission_sample(const BsdfParams& b, const Vec3& wo, Float uc, Vec2 u,
+                                                            BsdfSample* s) {
+  const Float p_reflect = diffuse_transmission_pr(b, true);
+  if (!(p_reflect > 0.f) && !(diffuse_transmission_pr(b, false) > 0.f)) return false;
+  const bool reflect = uc < p_reflect;
+  Vec3 wi = sample_cosine_hemisphere(u);
+  if ((wo.z < 0.f) == reflect) wi.z = -wi.z;  // reflection stays on wo's side
+  s->wi = wi;
+  s->f = diffuse_transmission_f(b, wo, wi);
+  s->pdf = diffuse_transmission_pdf(b, wo, wi);
+  s->lobe = (reflect ? kLobeReflection : kLobeTransmission) | kLobeDiffuse;
+  s->eta = 1.f;
+  return true;
+}
+
 // -------------------------------------------------------------- Conductor ---
 TESSERA_HOST_DEVICE inline Rgb conductor_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
   if (!same_hemisphere(wo, wi)) return Rgb(0.f);
@@ -319,6 +348,7 @@ TESSERA_HOST_DEVICE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, co
     case BsdfType::Conductor: return bsdf_detail::conductor_f(b, wo, wi);
     case BsdfType::Dielectric: return bsdf_detail::dielectric_f(b, wo, wi);
     case BsdfType::CoatedDiffuse: return bsdf_detail::coated_f(b, wo, wi);
+    case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_f(b, wo, wi);
   }
   return Rgb(0.f);
 }
@@ -330,6 +360,7 @@ TESSERA_HOST_DEVICE inline Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, c
     case BsdfType::Conductor: return bsdf_detail::conductor_pdf(b, wo, wi);
     case BsdfType::Dielectric: return bsdf_detail::dielectric_pdf(b, wo, wi);
     case BsdfType::CoatedDiffuse: return bsdf_detail::coated_pdf(b, wo, wi);
+    case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_pdf(b, wo, wi);
   }
   return 0.f;
 }
@@ -345,6 +376,7 @@ TESSERA_HOST_DEVICE inline bool bsdf_sample(const BsdfParams& b, const Vec3& wo,
     case BsdfType::Conductor: ok = bsdf_detail::conductor_sample(b, wo, uc, u, &s); break;
     case BsdfType::Dielectric: ok = bsdf_detail::dielectric_sample(b, wo, uc, u, &s); break;
     case BsdfType::CoatedDiffuse: ok = bsdf_detail::coated_sample(b, wo, uc, u, &s); break;
+    case BsdfType::DiffuseTransmission: ok = bsdf_detail::diffuse_transmission_sample(b, wo, uc, u, &s); break;
   }
   // pbrt-v4 BSDF::Sample_f: reject black f, zero pdf and wi in the tangent plane.
   if (!ok || s.wi.z == 0.f || !is_finite(s.wi) || !is_finite(s.f) || is_black(s.f)) return false;
@@ -365,6 +397,10 @@ TESSERA_HOST_DEVICE inline uint32_t bsdf_lobes(const BsdfParams& b) {
       return kLobeReflection | kLobeTransmission |
              (bsdf_detail::distrib(b).effectively_smooth() ? kLobeSpecular : kLobeGlossy);
     }
+    case BsdfType::DiffuseTransmission:
+      return (is_black(b.reflectance) ? kLobeNone : kLobeReflection) |
+             (is_black(b.transmittance) ? kLobeNone : kLobeTransmission) |
+             (is_black(b.reflectance) && is_black(b.transmittance) ? kLobeNone : kLobeDiffuse);
     case BsdfType::CoatedDiffuse:
       return kLobeReflection | kLobeDiffuse |
              (bsdf_detail::distrib(b).effectively_smooth() ? kLobeSpecular : kLobeGlossy);

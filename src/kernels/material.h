@@ -31,11 +31,13 @@ struct ImageView {
   const Rgb* texels = nullptr;
 };
 
-enum class MaterialType : uint32_t { Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, Interface, Mix };
+enum class MaterialType : uint32_t { Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, Interface, Mix, DiffuseTransmission };
 
 struct Material {
   MaterialType type = MaterialType::Diffuse;
   TextureSlot reflectance{ -1, Rgb(0.5f) };  // diffuse/coateddiffuse albedo; conductor "reflectance"
+  TextureSlot transmittance{ -1, Rgb(0.25f) };  // diffusetransmission
+  Float scale = 1.f;                         // diffusetransmission: multiplies reflectance and transmittance
   bool conductor_from_reflectance = false;  // conductor given by "reflectance" instead of eta/k
   Rgb eta{0.2004f, 0.9240f, 1.1022f};       // conductor eta (pbrt default: metal-Cu)
   Rgb k{3.9129f, 2.4528f, 2.1422f};          // conductor k

@@ -63,6 +63,14 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
     case MaterialType::Dielectric:
       b.type = BsdfType::Dielectric;
       break;
+    case MaterialType::DiffuseTransmission: {
+      b.type = BsdfType::DiffuseTransmission;
+      const Rgb t = (Spec & kSpecTextures) ? eval_slot(s, m->transmittance, h.uv) : m->transmittance.value;
+      b.reflectance = glm::clamp(m->scale * refl, Rgb(0.f), Rgb(1.f));
+      b.transmittance = glm::clamp(m->scale * t, Rgb(0.f), Rgb(1.f));
+      b.ior = 1.f;  // light passes straight through: no refraction, no eta^2 scaling
+      break;
+    }
     case MaterialType::CoatedDiffuse:
       b.type = BsdfType::CoatedDiffuse;
       b.reflectance = glm::clamp(refl, Rgb(0.f), Rgb(1.f));

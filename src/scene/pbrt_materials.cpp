@@ -114,10 +114,11 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
     read_roughness(m, params, ctx);
     params.mark_all_used();
   } else if (type == "diffusetransmission") {
-    ctx.warn("diffusetransmission is approximated by diffuse (no transmission)");
-    m.type = MaterialType::Diffuse;
+    m.type = MaterialType::DiffuseTransmission;
     m.reflectance = spectrum_slot(params, "reflectance", Rgb(0.25f), ctx);
-    params.mark_all_used();
+    m.transmittance = spectrum_slot(params, "transmittance", Rgb(0.25f), ctx);
+    m.scale = params.get_float("scale", 1.f);
+    if (!(m.scale >= 0.f)) ctx.fail("diffusetransmission \"scale\" must not be negative");
   } else {
     ctx.warn("material \"" + type + "\" is not supported; using diffuse 0.5");
     params.mark_all_used();

@@ -14,6 +14,10 @@ void add_material_effects(const SceneDesc& scene, int32_t index, uint32_t& e, in
   const Material& m = scene.materials[index];
   const bool smooth = m.alpha_x < 1e-3f && m.alpha_y < 1e-3f;
   switch (m.type) {
+    case MaterialType::DiffuseTransmission:
+      e |= kEffectDiffuse | kEffectTransmission;
+      if (slot_textured(m.reflectance) || slot_textured(m.transmittance)) e |= kEffectTextures;
+      break;
     case MaterialType::Diffuse:
       e |= kEffectDiffuse;
       if (slot_textured(m.reflectance)) e |= kEffectTextures;

@@ -33,6 +33,14 @@ BsdfParams diffuse(Rgb r) {
   b.reflectance = r;
   return b;
 }
+BsdfParams diffuse_transmission(Rgb r, Rgb t) {
+  BsdfParams b;
+  b.type = BsdfType::DiffuseTransmission;
+  b.reflectance = r;
+  b.transmittance = t;
+  b.ior = 1.f;
+  return b;
+}
 BsdfParams conductor(Float ax, Float ay, Rgb eta = Rgb(0.143f, 0.374f, 1.442f), Rgb k = Rgb(3.983f, 2.385f, 1.603f)) {
   BsdfParams b;  // default: gold-like
   b.type = BsdfType::Conductor;
@@ -99,7 +107,7 @@ double chi2_survival(double chsq, int dof) { return 1.0 - gamma_p(0.5 * dof, 0.5
 constexpr int kThetaRes = 20, kPhiRes = 40;
 constexpr int kSamples = 500000;
 constexpr int kSimpsonSub = 20;    // Simpson sub-intervals per cell edge (even)
-constexpr int kNumChi2Tests = 30;  // configurations x wo in the BsdfChi2 tests (Sidak correction)
+constexpr int kNumChi2Tests = 36;  // configurations x wo in the BsdfChi2 tests (Sidak correction)
 
 struct Chi2Outcome {
   double pvalue = 0;
@@ -225,6 +233,14 @@ TEST(BsdfChi2, Diffuse) {
   for (double t : kWoThetas) expect_chi2("diffuse", diffuse(Rgb(0.5f)), spherical(t, 0.4), 1);
 }
 
+TEST(BsdfChi2, DiffuseTransmission) {
+  for (double t : kWoThetas) {
+    expect_chi2("diffuse transmission", diffuse_transmission(Rgb(0.3f, 0.2f, 0.1f), Rgb(0.6f, 0.4f, 0.8f)),
+                spherical(t, 0.4), 11);
+    expect_chi2("diffuse transmission below", diffuse_transmission(Rgb(0.5f), Rgb(0.25f)), spherical(M_PI - t, 0.4), 12);
+  }
+}
+
 TEST(BsdfChi2, RoughConductor) {
   const BsdfParams cfgs[3] = {conductor(0.05f, 0.05f), conductor(0.3f, 0.3f), conductor(0.1f, 0.4f)};
   for (const BsdfParams& b : cfgs)
@@ -324,6 +340,18 @@ TEST(BsdfEnergy, AlbedoAtMostOne) {
       }
     }
   }
+}
+
+TEST(BsdfEnergy, DiffuseTransmissionReflectsRAndTransmitsT) {
+  for (double t : {0.2, 1.0, 2.5}) {
+    Rgb se;
+    const Rgb a = albedo(diffuse_transmission(Rgb(0.3f, 0.2f, 0.1f), Rgb(0.6f, 0.4f, 0.8f)), spherical(t, 0.3), 40000, 13, &se);
+    EXPECT_NEAR(a.x, 0.9, 0.01);
+    EXPECT_NEAR(a.y, 0.6, 0.01);
+    EXPECT_NEAR(a.z, 0.9, 0.01);
+  }
+  // Transmission only: every sample crosses the surface.
+  EXPECT_EQ(bsdf_lobes(diffuse_transmission(Rgb(0.f), Rgb(0.5f))), kLobeTransmission | kLobeDiffuse);
 }
 
 TEST(BsdfEnergy, WhiteFurnaces) {
@@ -447,7 +475,7 @@ TEST(BsdfConsistency, SampleMatchesEvalAndPdf) {
   const BsdfParams cfgs[] = {diffuse(Rgb(0.4f)),     conductor(0.05f, 0.05f), conductor(0.3f, 0.3f),
                              conductor(0.1f, 0.4f),  dielectric(0.1f),        dielectric(0.5f),
                              dielectric(0.3f, 1.1f), coated(0.2f),            coated(0.f),
-                             coated(0.6f, Rgb(0.9f), 1.8f)};
+                             coated(0.6f, Rgb(0.9f), 1.8f), diffuse_transmission(Rgb(0.3f), Rgb(0.6f))};
   Rng rng = Rng::for_sample(23, 0, 0);
   for (const BsdfParams& b : cfgs) {
     int checked = 0, bad = 0;

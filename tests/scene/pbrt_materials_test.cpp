@@ -75,8 +75,19 @@ TEST(PbrtMaterials, ApproximatedMaterialsWarn) {
                            "Material \"diffusetransmission\"\n" + kTriangle);
   EXPECT_EQ(s.materials[s.meshes[0].material].type, MaterialType::Conductor);
   EXPECT_VEC3_NEAR(s.materials[s.meshes[0].material].eta, Vec3(0.155f, 0.117f, 0.138f), 1e-3f);
-  EXPECT_EQ(s.materials[s.meshes[1].material].type, MaterialType::Diffuse);
-  EXPECT_EQ(s.warnings.size(), 2u);
+  EXPECT_EQ(s.warnings.size(), 1u);  // coatedconductor only
+}
+
+TEST(PbrtMaterials, DiffuseTransmission) {
+  SceneDesc s = load_world(std::string("Material \"diffusetransmission\" \"rgb transmittance\" [ 0.5 0.6 0.7 ] "
+                                       "\"float scale\" 2\n") + kTriangle + "Material \"diffusetransmission\"\n" + kTriangle);
+  const Material& m = s.materials[s.meshes[0].material];
+  EXPECT_EQ(m.type, MaterialType::DiffuseTransmission);
+  EXPECT_VEC3_NEAR(m.transmittance.value, Vec3(0.5f, 0.6f, 0.7f), 1e-6f);
+  EXPECT_VEC3_NEAR(m.reflectance.value, Vec3(0.25f), 1e-6f);  // pbrt-v4's defaults: 0.25 and 0.25
+  EXPECT_FLOAT_EQ(m.scale, 2.f);
+  EXPECT_VEC3_NEAR(s.materials[s.meshes[1].material].transmittance.value, Vec3(0.25f), 1e-6f);
+  EXPECT_TRUE(s.warnings.empty());
 }
 
 TEST(PbrtTextures, ConstantScaleCheckerboard) {
