@@ -124,7 +124,7 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
     params.mark_all_used();
   }
   // Bump and normal maps would need tangent frames we do not carry.
-  if (params.find_any("displacement")) ctx.warn("\"displacement\" is not supported; ignored");
+  if (params.find_any("displacement")) ctx.warn("material \"displacement\" (bump mapping) is not supported; ignored");
   if (params.find_any("normalmap")) ctx.warn("\"normalmap\" is not supported; ignored");
   return m;
 }

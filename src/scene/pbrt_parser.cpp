@@ -391,7 +391,14 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
 
 void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet& params,
                        const std::string& including_dir) {
-  ShapeContext ctx{at.where(), including_dir, search_dir_, state_.ctm, state_.reverse_orientation, &scene_.warnings};
+  ShapeContext ctx{at.where(), including_dir, search_dir_, state_.ctm, state_.reverse_orientation, &scene_.warnings, {}};
+  ctx.float_texture = [this, &at](const std::string& name) -> DisplacementFn {
+    auto it = names_.float_textures.find(name);
+    if (it == names_.float_textures.end()) fail(at, "unknown float texture \"" + name + "\" for \"displacement\"");
+    auto textures = std::make_shared<HostTextures>(scene_);
+    const TextureSlot slot{it->second, Rgb(0.f)};
+    return [textures, slot](Vec2 uv) { return textures->eval(slot, uv); };
+  };
   std::optional<MeshDesc> mesh = make_shape_mesh(type, params, ctx);
   if (!mesh) {
     params.mark_all_used();

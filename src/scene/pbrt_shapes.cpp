@@ -107,6 +107,15 @@ MeshDesc ply_mesh(const ParamSet& params, const ShapeContext& ctx) {
   m.n = std::move(ply.n);
   m.uv = std::move(ply.uv);
   m.indices = std::move(ply.indices);
+  const Float edge_length = params.get_float("edgelength", 1.f);
+  if (std::optional<std::string> tex = params.get_texture("displacement")) {
+    if (!ctx.float_texture) fail(ctx, "plymesh displacement is not available here");
+    try {
+      displace_mesh(m, ctx.world_from_object, edge_length, ctx.float_texture(*tex));
+    } catch (const SceneError& e) {
+      fail(ctx, "plymesh '" + name + "': " + e.what());
+    }
+  }
   return m;
 }
 

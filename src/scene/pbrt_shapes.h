@@ -1,10 +1,12 @@
 // pbrt-v4 shapes as world-space triangle meshes.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "scene/displacement.h"
 #include "scene/pbrt_params.h"
 #include "scene/scene_desc.h"
 
@@ -17,6 +19,9 @@ struct ShapeContext {
   Mat4 world_from_object{1.f};
   bool reverse_orientation = false;
   std::vector<std::string>* warnings = nullptr;
+  // A named float texture as a function of uv (plymesh displacement);
+  // throws SceneError for an unknown name. Unset: displacement is an error.
+  std::function<DisplacementFn(const std::string& name)> float_texture;
 };
 
 // trianglemesh, plymesh, bilinearmesh, sphere, disk. Other shapes: a warning
