@@ -43,6 +43,11 @@ struct Material {
   Rgb k{3.9129f, 2.4528f, 2.1422f};          // conductor k
   Float ior = 1.5f;                          // dielectric eta / coateddiffuse coating eta
   Float alpha_x = 0.f, alpha_y = 0.f;        // GGX alpha, remapped from roughness by the loader
+  // Textured roughness (u, v): evaluated at the hit, then remapped
+  // (alpha = sqrt(roughness), pbrt-v4) when remap_roughness. Unused when both are constant.
+  TextureSlot roughness_u{-1, Rgb(0.f)}, roughness_v{-1, Rgb(0.f)};
+  bool textured_roughness = false;
+  bool remap_roughness = true;
   Float thickness = 0.01f;                   // coateddiffuse layer (pbrt-v4 defaults)
   uint32_t layer_max_depth = 10, layer_samples = 1;
   int32_t mix[2] = {-1, -1};                 // Mix: material indices

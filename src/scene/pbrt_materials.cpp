@@ -10,15 +10,26 @@ namespace {
 // roughness / uroughness / vroughness / remaproughness, shared by the
 // microfacet materials. `prefix` selects e.g. "conductor." for coatedconductor.
 void read_roughness(Material& m, const ParamSet& params, const DirectiveContext& ctx, const std::string& prefix = "") {
-  Float r = constant_float(params, prefix + "roughness", 0.f, ctx);
-  Float u = constant_float(params, prefix + "uroughness", r, ctx);
-  Float v = constant_float(params, prefix + "vroughness", r, ctx);
-  if (params.get_bool("remaproughness", true)) {
-    u = roughness_to_alpha(u);
-    v = roughness_to_alpha(v);
+  const TextureSlot r = float_slot(params, prefix + "roughness", 0.f, ctx);
+  const TextureSlot u = params.find_any(prefix + "uroughness") ? float_slot(params, prefix + "uroughness", 0.f, ctx) : r;
+  const TextureSlot v = params.find_any(prefix + "vroughness") ? float_slot(params, prefix + "vroughness", 0.f, ctx) : r;
+  m.remap_roughness = params.get_bool("remaproughness", true);
+  auto constant = [&](const TextureSlot& s, Float* out) {
+    if (s.texture >= 0 && ctx.scene.textures[s.texture].type != TextureType::Constant) return false;
+    *out = s.texture < 0 ? s.value.x : ctx.scene.textures[s.texture].value.x;
+    return true;
+  };
+  Float cu = 0.f, cv = 0.f;
+  if (constant(u, &cu) && constant(v, &cv)) {
+    m.alpha_x = m.remap_roughness ? roughness_to_alpha(cu) : cu;
+    m.alpha_y = m.remap_roughness ? roughness_to_alpha(cv) : cv;
+    return;
   }
-  m.alpha_x = u;
-  m.alpha_y = v;
+  // Evaluated at every hit (textured materials pay for it, others do not).
+  m.textured_roughness = true;
+  m.roughness_u = u;
+  m.roughness_v = v;
+  m.alpha_x = m.alpha_y = 1.f;  // not smooth: the effects set counts it as glossy
 }
 
 // A dielectric index of refraction: a float, or a spectrum (named glasses)
