@@ -30,6 +30,7 @@ struct BsdfParams {
   Float ior = 1.5f;       // Dielectric / CoatedDiffuse coating: n_inside / n_outside
   Float alpha_x = 0.f;    // GGX (Trowbridge-Reitz) roughness, already remapped;
   Float alpha_y = 0.f;    // both below kSmoothAlpha means perfectly smooth
+  int32_t bump = -1;      // the material's bump texture (applied by the integrator to the shading normal)
   // CoatedDiffuse's layer (pbrt-v4 "thickness", "maxdepth", "nsamples").
   Float thickness = 0.01f;
   uint32_t layer_max_depth = 10;

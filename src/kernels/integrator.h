@@ -13,6 +13,7 @@
 #include "light_sampling.h"
 #include "material_eval.h"
 #include "rng.h"
+#include "bump.h"
 #include "sampler.h"
 
 namespace tessera {
@@ -212,6 +213,10 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       if (++interface_skips > 256) break;
       ray.o = offset_ray_origin(h, ray.d);
       continue;
+    }
+
+    if constexpr ((Spec & kSpecTextures) != 0) {
+      if (bsdf.bump >= 0) h.ns = bumped_shading_normal(s, bsdf.bump, h);
     }
 
     // Anisotropic BSDFs need pbrt's orientation (x along dp/du); any frame

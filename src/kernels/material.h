@@ -47,6 +47,7 @@ struct Material {
   // (alpha = sqrt(roughness), pbrt-v4) when remap_roughness. Unused when both are constant.
   TextureSlot roughness_u{-1, Rgb(0.f)}, roughness_v{-1, Rgb(0.f)};
   bool textured_roughness = false;
+  int32_t bump = -1;                         // "displacement" float texture (bump mapping), -1 = none
   bool remap_roughness = true;
   Float thickness = 0.01f;                   // coateddiffuse layer (pbrt-v4 defaults)
   uint32_t layer_max_depth = 10, layer_samples = 1;

@@ -46,6 +46,7 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
   BsdfParams b;
   b.alpha_x = m->alpha_x;
   b.alpha_y = m->alpha_y;
+  b.bump = m->bump;
   if ((Spec & kSpecTextures) && m->textured_roughness) {
     const Float ru = glm::max(eval_slot(s, m->roughness_u, h.uv).x, 0.f), rv = glm::max(eval_slot(s, m->roughness_v, h.uv).x, 0.f);
     b.alpha_x = m->remap_roughness ? glm::sqrt(ru) : ru;  // pbrt-v4's RoughnessToAlpha

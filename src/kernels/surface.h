@@ -82,4 +82,22 @@ TESSERA_HOST_DEVICE inline Vec3 surface_dpdu(const SceneView& s, uint32_t tri) {
   return dpdu;
 }
 
+// dp/dv of the triangle's uv parametrisation, as surface_dpdu.
+TESSERA_HOST_DEVICE inline Vec3 surface_dpdv(const SceneView& s, uint32_t tri) {
+  const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
+  Vec2 uv0(0.f, 0.f), uv1(1.f, 0.f), uv2(1.f, 1.f);
+  if (s.triangles[tri].flags & kTriHasUv) {
+    uv0 = s.uvs[idx[0]];
+    uv1 = s.uvs[idx[1]];
+    uv2 = s.uvs[idx[2]];
+  }
+  Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
+  Vec3 dp02 = s.positions[idx[0]] - s.positions[idx[2]], dp12 = s.positions[idx[1]] - s.positions[idx[2]];
+  Float det = duv02.x * duv12.y - duv02.y * duv12.x;
+  if (fabsf(det) < 1e-9f) return Frame::from_z(s.face_normals[tri]).t;
+  Vec3 dpdv = (-duv12.x * dp02 + duv02.x * dp12) / det;
+  if (!(glm::dot(dpdv, dpdv) > 0.f) || !is_finite(dpdv)) return Frame::from_z(s.face_normals[tri]).t;
+  return dpdv;
+}
+
 }  // namespace tessera

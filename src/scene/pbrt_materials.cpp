@@ -134,8 +134,12 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
     ctx.warn("material \"" + type + "\" is not supported; using diffuse 0.5");
     params.mark_all_used();
   }
-  // Bump and normal maps would need tangent frames we do not carry.
-  if (params.find_any("displacement")) ctx.warn("material \"displacement\" (bump mapping) is not supported; ignored");
+  // pbrt-v4's bump mapping: a float texture of displacement along the normal.
+  if (params.find_any("displacement")) {
+    const TextureSlot bump = float_slot(params, "displacement", 0.f, ctx);
+    if (bump.texture >= 0) m.bump = bump.texture;
+    else if (bump.value.x != 0.f) ctx.warn("a constant material \"displacement\" does not bump; ignored");
+  }
   if (params.find_any("normalmap")) ctx.warn("\"normalmap\" is not supported; ignored");
   return m;
 }
