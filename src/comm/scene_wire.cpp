@@ -18,7 +18,7 @@ void serialize(Archive& ar, SceneDesc& d) {
      d.camera.where);
   ar(d.film.xres, d.film.yres, d.film.filename, raw_value(d.filter), d.spp, d.max_depth, d.seed);
   ar(d.sampler, d.camera.exposure_time, d.film.iso, d.film.whitebalance, d.film.sensor, d.film.max_component_value,
-     raw_value(d.film.pixel_from_radiance));
+     raw_value(d.film.pixel_from_radiance), raw_value(d.film.sensor_from_radiance), raw_value(d.film.pixel_from_sensor));
   ar(d.meshes, raw(d.materials), raw(d.textures), d.images, raw(d.area_lights), raw(d.lights), d.warnings, d.source);
 }
 

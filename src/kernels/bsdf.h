@@ -23,7 +23,7 @@ enum BsdfLobe : uint32_t {
 // A BSDF with every texture already evaluated at the hit point.
 struct BsdfParams {
   BsdfType type = BsdfType::Diffuse;
-  Rgb reflectance{0.5f};  // Diffuse and CoatedDiffuse albedo, in [0,1]
+  Rgb reflectance{0.5f};  // Diffuse, CoatedDiffuse and DiffuseTransmission albedo, in [0,1]
   Rgb transmittance{0.f}; // DiffuseTransmission, in [0,1]
   Rgb eta{1.f};           // Conductor: real part of the complex IOR, per channel
   Rgb k{0.f};             // Conductor: imaginary part

@@ -252,15 +252,15 @@ TESSERA_HOST_DEVICE inline bool dielectric_sample(const BsdfParams& b, const Vec
 // ---------------------------------------------------------- CoatedDiffuse ---
 // pbrt-v4's "coateddiffuse": the value f(wo, wi) is pbrt-v4's own layered
 // estimate (layered.h: a random walk between the dielectric coat and the
-// Lambertian base, unbiased for the layered BSDF and a pure function of the
-// two directions). Directions are *sampled* from a closed-form stand-in, the
+// Lambertian base, a pure function of the two directions). Directions are
+// *sampled* from a closed-form stand-in, the
 // classic "plastic" model (Weidlich & Wilkie; Kelemen & Szirmay-Kalos):
 //
 //   q(wo, wi) = p_spec * coat lobe + (1 - p_spec) * cos(wi) / pi
 //
 // whose density is known exactly, so bsdf_pdf() returns the true density of
 // bsdf_sample() and MIS and guided mixtures stay exact; the sample's f is the
-// layered estimate, so f/q is an unbiased weight. The coat lobe is the
+// layered estimate, so f/q has the expectation of pbrt-v4's value. The coat lobe is the
 // dielectric's GGX reflection (alpha_x, alpha_y) or, for a smooth coat, the
 // mirror delta with its exact weight F(cos_o) (pbrt's layered f() excludes
 // that delta too). p_spec = clamp(F(cos_o) / (F(cos_o) + (1 - F(cos_o))

@@ -2,6 +2,7 @@
 // spans the shorter image axis, camera space is x right, y up, z forward.
 #pragma once
 
+#include "sampler.h"
 #include "sampling.h"
 #include "scene_view.h"
 
@@ -33,13 +34,15 @@ TESSERA_HOST_DEVICE inline Ray generate_camera_ray(const CameraView& c, Vec2 p_f
 }
 
 // A sample's radiance as the film records it (pbrt-v4's RGBFilm::AddSample):
-// through the sensor, then scaled down so that no channel exceeds the
-// film's maxcomponentvalue. With pbrt's defaults this returns L unchanged.
+// the sensor's values, scaled down so that none exceeds the film's
+// maxcomponentvalue, then white-balanced into sRGB. Without a clamp the one
+// product matrix serves (the identity with pbrt's defaults: L unchanged).
 TESSERA_HOST_DEVICE inline Rgb film_pixel_value(const CameraView& c, Rgb L) {
-  Rgb v = c.pixel_from_radiance * L;
+  if (!(c.max_component_value < INFINITY)) return c.pixel_from_radiance * L;
+  Rgb v = c.sensor_from_radiance * L;
   const Float m = glm::max(v.x, glm::max(v.y, v.z));
   if (m > c.max_component_value) v *= c.max_component_value / m;
-  return v;
+  return c.pixel_from_sensor * v;
 }
 
 // Offset within the pixel drawn from the filter (filter importance sampling:
@@ -71,6 +74,21 @@ TESSERA_HOST_DEVICE inline FilterSample sample_filter(const FilterView& f, Vec2 
     s.weight = filter_axis_weight(f.weight_x, f.bins, s.offset.x, f.radius_x) *
                filter_axis_weight(f.weight_y, f.bins, s.offset.y, f.radius_y);
   return s;
+}
+
+// The camera ray of one pixel sample and its filter weight: a film position
+// from the filter, then a lens position (only when there is a lens, so that
+// pinhole images keep their random streams).
+struct CameraSample {
+  Ray ray;
+  Float filter_weight;
+};
+
+TESSERA_HOST_DEVICE inline CameraSample sample_camera_ray(const SceneView& s, int32_t x, int32_t y, PixelSampler& sampler) {
+  const FilterSample fs = sample_filter(s.filter, sampler.uniform2());
+  const Vec2 p_film(x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y);
+  const Vec2 u_lens = s.camera.lens_radius > 0.f ? sampler.uniform2() : Vec2(0.f);
+  return CameraSample{generate_camera_ray(s.camera, p_film, u_lens), fs.weight};
 }
 
 }  // namespace tessera

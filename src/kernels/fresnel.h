@@ -1,5 +1,4 @@
-// Fresnel equations (pbrt-v4 util/scattering.h semantics) and the diffuse
-// Fresnel reflectance fit used by the CoatedDiffuse (plastic) approximation.
+// Fresnel equations (pbrt-v4 util/scattering.h semantics).
 // Header-only, device-safe.
 #pragma once
 
@@ -78,30 +77,6 @@ TESSERA_HOST_DEVICE inline Float fr_complex(Float cos_i, Complexf eta) {
 TESSERA_HOST_DEVICE inline Rgb fr_complex(Float cos_i, const Rgb& eta, const Rgb& k) {
   return Rgb(fr_complex(cos_i, Complexf(eta.x, k.x)), fr_complex(cos_i, Complexf(eta.y, k.y)),
              fr_complex(cos_i, Complexf(eta.z, k.z)));
-}
-
-// Hemispherical average (cosine-weighted) of fr_dielectric for light arriving
-// from the side where the relative IOR is eta = n_t / n_i. Closed-form fits as
-// chosen by Mitsuba's fresnelDiffuseReflectance: d'Eon & Irving (2011) for
-// eta >= 1 (max rel. error 0.2% up to eta = 10), Egan & Hilgeman (1973) for eta < 1.
-TESSERA_HOST_DEVICE inline Float fresnel_diffuse_reflectance(Float eta) {
-  if (eta < 1.f) {
-    Float e = glm::max(eta, 1e-3f);
-    return glm::clamp(-1.4399f * e * e + 0.7099f * e + 0.6681f + 0.0636f / e, 0.f, 1.f);
-  }
-  Float i1 = 1.f / eta, i2 = i1 * i1, i3 = i2 * i1, i4 = i3 * i1, i5 = i4 * i1;
-  return glm::clamp(0.919317f - 3.4793f * i1 + 6.75335f * i2 - 7.80989f * i3 + 4.98554f * i4 - 1.36881f * i5, 0.f,
-                    1.f);
-}
-
-// Diffuse reflectance seen from *inside* a coating of relative IOR ior
-// (n_inside / n_outside). For ior >= 1 it uses the exact identity
-// 1 - Fdr_int = (1 - Fdr_ext) / ior^2 on top of the accurate external fit, so
-// the plastic model's energy balance holds to the precision of that fit.
-TESSERA_HOST_DEVICE inline Float fresnel_diffuse_reflectance_internal(Float ior) {
-  if (!(ior > 0.f)) return 0.f;
-  if (ior >= 1.f) return glm::clamp(1.f - (1.f - fresnel_diffuse_reflectance(ior)) / (ior * ior), 0.f, 1.f);
-  return fresnel_diffuse_reflectance(1.f / ior);
 }
 
 }  // namespace tessera

@@ -13,20 +13,20 @@ struct NoGeometryTracer {
 };
 
 template <uint32_t Spec>
-__global__ void trace_pixels_kernel(SceneView scene, PathSettings settings, uint64_t seed, Rgb* out) {
+__global__ void trace_pixels_kernel(SceneView scene, PathSettings settings, SamplerKind sampler, uint64_t seed, Rgb* out) {
   const int32_t x = blockIdx.x * blockDim.x + threadIdx.x;
   const int32_t y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= scene.camera.width || y >= scene.camera.height) return;
   const uint64_t pixel = static_cast<uint64_t>(y) * scene.camera.width + x;
-  PixelSampler rng = PixelSampler::start(SamplerKind::Sobol, seed, pixel, 0);
-  const FilterSample fs = sample_filter(scene.filter, rng.uniform2());
-  Ray ray = generate_camera_ray(scene.camera, Vec2(x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y));
+  PixelSampler rng = PixelSampler::start(sampler, seed, pixel, 0);
+  const CameraSample cs = sample_camera_ray(scene, x, y, rng);
   PathCounters counters;
-  out[pixel] = film_pixel_value(scene.camera, trace_path<Spec>(scene, NoGeometryTracer{}, ray, rng, settings, counters)) * fs.weight;
+  out[pixel] = film_pixel_value(scene.camera, trace_path<Spec>(scene, NoGeometryTracer{}, cs.ray, rng, settings, counters)) *
+               cs.filter_weight;
 }
 
 // Instantiate the lean and the full specialisation.
-template __global__ void trace_pixels_kernel<0u>(SceneView, PathSettings, uint64_t, Rgb*);
-template __global__ void trace_pixels_kernel<kSpecAll>(SceneView, PathSettings, uint64_t, Rgb*);
+template __global__ void trace_pixels_kernel<0u>(SceneView, PathSettings, SamplerKind, uint64_t, Rgb*);
+template __global__ void trace_pixels_kernel<kSpecAll>(SceneView, PathSettings, SamplerKind, uint64_t, Rgb*);
 
 }  // namespace tessera

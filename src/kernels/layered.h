@@ -4,8 +4,10 @@
 // two-sided. The value is pbrt-v4's stochastic estimate: a random walk
 // between the interfaces with next-event estimation through the exit
 // interface, seeded by the two directions so that f(wo, wi) is a pure
-// function. Its expectation is the layered BSDF exactly; each call is one
-// unbiased sample of it.
+// function. For a smooth coat its expectation is the layered BSDF; for a
+// rough coat pbrt-v4's MIS weights (which we keep, to match its pictures)
+// compare densities on the two sides of the interface, so the estimate is
+// pbrt-v4's, slightly off the exact layered BSDF and not exactly reciprocal.
 //
 // Included by bsdf_impl.h inside namespace tessera::bsdf_detail; uses the
 // dielectric helpers defined there.
@@ -88,19 +90,10 @@ TESSERA_HOST_DEVICE inline Float transmittance(Float dz, const Vec3& w) {
   return expf(-fabsf(dz / w.z));
 }
 
-TESSERA_HOST_DEVICE inline uint64_t direction_bits(const Vec3& w) {
-  auto bits = [](Float f) {
-    union { Float f; uint32_t u; } c;
-    c.f = f;
-    return static_cast<uint64_t>(c.u);
-  };
-  return mix_bits(bits(w.x) ^ (bits(w.y) << 21) ^ (bits(w.z) << 42));
-}
-
 // The random numbers of one evaluation: a pure function of (wo, wi).
 TESSERA_HOST_DEVICE inline Rng rng_for(const Vec3& wo, const Vec3& wi) {
   Rng r;
-  r.set_sequence(direction_bits(wo), direction_bits(wi));
+  r.set_sequence(hash_vec3(wo), hash_vec3(wi));
   return r;
 }
 

@@ -35,7 +35,7 @@ enum class MaterialType : uint32_t { Diffuse = 0, Conductor, Dielectric, CoatedD
 
 struct Material {
   MaterialType type = MaterialType::Diffuse;
-  TextureSlot reflectance{ -1, Rgb(0.5f) };  // diffuse/coateddiffuse albedo; conductor "reflectance"
+  TextureSlot reflectance{ -1, Rgb(0.5f) };  // diffuse/coateddiffuse/diffusetransmission albedo; conductor "reflectance"
   TextureSlot transmittance{ -1, Rgb(0.25f) };  // diffusetransmission
   Float scale = 1.f;                         // diffusetransmission: multiplies reflectance and transmittance
   bool conductor_from_reflectance = false;  // conductor given by "reflectance" instead of eta/k

@@ -12,14 +12,8 @@ namespace tessera {
 // pbrt-v4 picks a mix component with a hash of the hit, not with a sampler
 // dimension, so the choice is deterministic per point and direction.
 TESSERA_HOST_DEVICE inline Float mix_hash_float(const Vec3& p, const Vec3& wo, int32_t a, int32_t b) {
-  auto bits = [](Float f) {
-    union { Float f; uint32_t u; } c;
-    c.f = f;
-    return static_cast<uint64_t>(c.u);
-  };
-  uint64_t h = mix_bits(bits(p.x) ^ (bits(p.y) << 21) ^ (bits(p.z) << 42));
-  h = mix_bits(h ^ bits(wo.x) ^ (bits(wo.y) << 21) ^ (bits(wo.z) << 42));
-  h = mix_bits(h ^ (static_cast<uint64_t>(a) << 32) ^ static_cast<uint64_t>(b));
+  uint64_t h = mix_bits(hash_vec3(p) ^ (hash_vec3(wo) * 0xd1b54a32d192ed03ull));
+  h = mix_bits(h ^ (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) ^ static_cast<uint32_t>(b));
   return static_cast<Float>(h >> 40) * 0x1p-24f;
 }
 
@@ -48,7 +42,9 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
   b.alpha_y = m->alpha_y;
   b.bump = m->bump;
   if ((Spec & kSpecTextures) && m->textured_roughness) {
-    const Float ru = glm::max(eval_slot(s, m->roughness_u, h.uv).x, 0.f), rv = glm::max(eval_slot(s, m->roughness_v, h.uv).x, 0.f);
+    Float ru = eval_slot(s, m->roughness_u, h.uv).x, rv = eval_slot(s, m->roughness_v, h.uv).x;
+    ru = ru > 0.f && ru < 1e30f ? ru : 0.f;  // NaN, Inf or negative texels: smooth
+    rv = rv > 0.f && rv < 1e30f ? rv : 0.f;
     b.alpha_x = m->remap_roughness ? glm::sqrt(ru) : ru;  // pbrt-v4's RoughnessToAlpha
     b.alpha_y = m->remap_roughness ? glm::sqrt(rv) : rv;
   }

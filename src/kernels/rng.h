@@ -4,6 +4,8 @@
 // in a fixed order by the integrator.
 #pragma once
 
+#include <cstring>
+
 #include "device.h"
 
 namespace tessera {
@@ -16,6 +18,20 @@ TESSERA_HOST_DEVICE inline uint64_t mix_bits(uint64_t v) {
   v *= 0x94d049bb133111ebull;
   v ^= v >> 31;
   return v;
+}
+
+// The bits of a float, without type punning (valid C++ and CUDA).
+TESSERA_HOST_DEVICE inline uint32_t float_bits(Float f) {
+  uint32_t u;
+  memcpy(&u, &f, sizeof u);
+  return u;
+}
+
+// A 64-bit hash of a point or direction in which every bit of all three
+// coordinates counts (a direction and its mirror image hash differently).
+TESSERA_HOST_DEVICE inline uint64_t hash_vec3(const Vec3& v) {
+  return mix_bits(((static_cast<uint64_t>(float_bits(v.x)) << 32) | float_bits(v.y)) ^
+                  mix_bits(float_bits(v.z) + 0x9e3779b97f4a7c15ull));
 }
 
 TESSERA_HOST_DEVICE inline uint64_t hash_stream(uint64_t seed, uint64_t pixel, uint64_t sample) {

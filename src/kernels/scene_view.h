@@ -31,6 +31,7 @@ struct CameraView {
   // What the film records of a sample's radiance (pbrt-v4's pixel sensor:
   // exposure, white balance), then pbrt's per-sample "maxcomponentvalue".
   Mat3 pixel_from_radiance{1.f};
+  Mat3 sensor_from_radiance{1.f}, pixel_from_sensor{1.f};  // the two halves, where the clamp sits between
   Float max_component_value = INFINITY;
 };
 

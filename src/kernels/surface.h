@@ -15,6 +15,14 @@ struct SurfaceHit {
   uint32_t triangle;
 };
 
+// The uv at barycentrics (b1, b2): interpolated, or pbrt's default
+// (0,0), (1,0), (1,1) for triangles without uv.
+TESSERA_HOST_DEVICE inline Vec2 triangle_uv(const SceneView& s, uint32_t tri, Float b1, Float b2) {
+  if (!(s.triangles[tri].flags & kTriHasUv)) return Vec2(b1 + b2, b2);
+  const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
+  return (1.f - b1 - b2) * s.uvs[idx[0]] + b1 * s.uvs[idx[1]] + b2 * s.uvs[idx[2]];
+}
+
 // b1, b2: barycentrics of vertices 1 and 2 (Embree's u, v).
 TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& s, uint32_t tri, Float b1, Float b2) {
   const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
@@ -40,11 +48,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& 
       if (glm::dot(h.ng, h.ns) < 0.f) h.ng = -h.ng;
     }
   }
-  if (info.flags & kTriHasUv) {
-    h.uv = b0 * s.uvs[idx[0]] + b1 * s.uvs[idx[1]] + b2 * s.uvs[idx[2]];
-  } else {
-    h.uv = Vec2(b1 + b2, b2);  // pbrt's default (0,0), (1,0), (1,1)
-  }
+  h.uv = triangle_uv(s, tri, b1, b2);
   return h;
 }
 

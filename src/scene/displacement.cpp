@@ -76,7 +76,7 @@ void displace_mesh(MeshDesc& m, const Mat4& world_from_object, Float edge_length
       const uint64_t key = (uint64_t(std::min(v[0], v[1])) << 32) | std::max(v[0], v[1]);
       auto [it, inserted] = midpoint.try_emplace(key, static_cast<uint32_t>(m.p.size()));
       if (inserted) {
-        if (m.p.size() >= (size_t(1) << 31)) fail("too many vertices");
+        if (m.p.size() >= 2 * kMaxDisplacedTriangles) fail("too many vertices");
         m.p.push_back(0.5f * (m.p[v[0]] + m.p[v[1]]));
         const Vec3 n = m.n[v[0]] + m.n[v[1]];
         m.n.push_back(glm::length(n) > 0.f ? glm::normalize(n) : n);
@@ -84,6 +84,12 @@ void displace_mesh(MeshDesc& m, const Mat4& world_from_object, Float edge_length
       }
       const uint32_t mid = it->second;
       if (!std::isfinite(world_length(v[0], mid))) fail("non-finite vertex positions");
+      // Float precision can stop a split from shortening the edge (huge
+      // coordinates, tiny edgelength): keep the triangle as it is.
+      if (m.p[mid] == m.p[v[0]] || m.p[mid] == m.p[v[1]]) {
+        out.insert(out.end(), tri.begin(), tri.end());
+        continue;
+      }
       stack.push_back({mid, v[1], v[2]});
       stack.push_back({v[0], mid, v[2]});
     }

@@ -21,8 +21,9 @@ void displace_mesh(MeshDesc& mesh, const Mat4& world_from_object, Float edge_len
 
 constexpr size_t kMaxDisplacedTriangles = size_t(1) << 25;
 
-// Area-weighted unit vertex normals from the faces, as pbrt-v4's
-// TriQuadMesh::ComputeNormals (a vertex on no face keeps (0, 0, 0)).
+// Unit vertex normals: the normalised sum of the unit normals of the faces
+// around each vertex, as pbrt-v4's TriQuadMesh::ComputeNormals (a vertex on
+// no face keeps (0, 0, 0)).
 std::vector<Vec3> vertex_normals(const std::vector<Vec3>& p, const std::vector<uint32_t>& indices);
 
 // Evaluates float textures of a scene being loaded, on the host.

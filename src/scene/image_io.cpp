@@ -122,6 +122,8 @@ ImageDesc load_with_oiio(const std::string& path, const ColorEncoding& encoding)
   const OIIO::ImageSpec spec = in->spec();
   const int w = spec.width, h = spec.height, nc = spec.nchannels;
   if (w <= 0 || h <= 0 || nc <= 0) fail(path, "empty image");
+  if (spec.depth > 1 || spec.deep) fail(path, "volume and deep images are not textures");
+  if (nc > 64) fail(path, std::to_string(nc) + " channels");
   if (static_cast<int64_t>(w) * h > kMaxImageTexels) fail(path, "larger than " + std::to_string(kMaxImageTexels) + " texels");
   ImageDesc img;
   img.path = path;

@@ -170,7 +170,7 @@ SubdividedMesh loop_subdivide(const std::vector<Vec3>& p_in, const std::vector<u
     faces.push_back(f);
   }
   if (faces.empty()) fail("no triangles");
-  if (faces.size() > (kMaxSubdividedTriangles >> (2 * std::min(levels, 13))))
+  if (levels > 13 || faces.size() > (kMaxSubdividedTriangles >> (2 * levels)))
     fail(std::to_string(levels) + " levels would make more than " + std::to_string(kMaxSubdividedTriangles) +
          " triangles");
 

@@ -79,6 +79,17 @@ Rgb blackbody_rgb(Float kelvin) {
   return glm::max(xyz_to_linear_srgb(xyz / xyz.y), Rgb(0.f));
 }
 
+Vec2 blackbody_xy(Float kelvin) {
+  const double c = 299792458., h = 6.62606957e-34, kb = 1.3806488e-23;
+  auto planck = [&](double lambda_nm) {
+    double l = lambda_nm * 1e-9;
+    return (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * kelvin)) - 1));
+  };
+  const Vec3 xyz = integrate_xyz(planck);
+  const Float sum = xyz.x + xyz.y + xyz.z;
+  return sum > 0.f ? Vec2(xyz.x / sum, xyz.y / sum) : Vec2(1.f / 3.f);
+}
+
 Rgb sampled_spectrum_rgb(const std::vector<Float>& pairs) {
   if (pairs.size() < 2) return Rgb(0.f);
   const size_t n = pairs.size() / 2;

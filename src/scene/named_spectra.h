@@ -20,6 +20,9 @@ std::optional<Rgb> named_spectrum_rgb(const std::string& name);
 // blackbody emitters photometrically, so only the colour matters).
 Rgb blackbody_rgb(Float kelvin);
 
+// Chromaticity (CIE 1931 x, y) of a blackbody at `kelvin`.
+Vec2 blackbody_xy(Float kelvin);
+
 // A piecewise-linear spectrum given as (wavelength nm, value) pairs, reduced to
 // RGB such that a constant spectrum c gives (c, c, c). A rough approximation.
 Rgb sampled_spectrum_rgb(const std::vector<Float>& lambda_value_pairs);

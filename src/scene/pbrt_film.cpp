@@ -3,15 +3,21 @@
 #include <cmath>
 #include <limits>
 
+#include "scene/named_spectra.h"
+
 namespace tessera {
 namespace {
 
 [[noreturn]] void fail(const std::string& where, const std::string& problem) { throw SceneError(where + ": " + problem); }
 
-// CIE daylight locus: the chromaticity of the D illuminant at `kelvin`
-// (the curve pbrt-v4's Spectra::D is built on).
-Vec2 daylight_xy(double kelvin) {
-  const double t = kelvin, t2 = t * t, t3 = t2 * t;
+// The white of the illuminant pbrt-v4's white balance starts from
+// (Spectra::D): a CIE daylight of the correlated colour temperature
+// kelvin * 1.4388 / 1.4380 (the old second radiation constant), or a
+// blackbody below 4000 K, where the daylight series is undefined.
+Vec2 illuminant_white_xy(Float kelvin) {
+  const double t = kelvin * 1.4388 / 1.4380;
+  if (t < 4000.0) return blackbody_xy(static_cast<Float>(t));
+  const double t2 = t * t, t3 = t2 * t;
   const double x = t <= 7000. ? -4.6070e9 / t3 + 2.9678e6 / t2 + 0.09911e3 / t + 0.244063
                               : -2.0064e9 / t3 + 1.9018e6 / t2 + 0.24748e3 / t + 0.237040;
   const double y = -3.0 * x * x + 2.870 * x - 0.275;
@@ -23,27 +29,35 @@ Vec3 xyz_from_xy(Vec2 xy) { return Vec3(xy.x / xy.y, 1.f, (1.f - xy.x - xy.y) / 
 // glm matrices are column-major: build them from rows as written on paper.
 Mat3 from_rows(const float r[9]) { return glm::transpose(Mat3(r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8])); }
 
+Mat3 xyz_from_srgb() {
+  static const float rows[9] = {0.412453f, 0.357580f, 0.180423f, 0.212671f, 0.715160f,
+                                0.072169f, 0.019334f, 0.119193f, 0.950227f};
+  return from_rows(rows);
+}
+
 }  // namespace
 
-Mat3 white_balance_srgb(Float kelvin) {
+Mat3 white_balance_xyz(Float kelvin) {
   static const float kLmsFromXyz[9] = {0.8951f, 0.2664f, -0.1614f, -0.7502f, 1.7135f, 0.0367f, 0.0389f, -0.0685f, 1.0296f};
-  static const float kXyzFromSrgb[9] = {0.412453f, 0.357580f, 0.180423f, 0.212671f, 0.715160f,
-                                        0.072169f, 0.019334f, 0.119193f, 0.950227f};
-  const Mat3 lms_from_xyz = from_rows(kLmsFromXyz), xyz_from_srgb = from_rows(kXyzFromSrgb);
-  const Vec3 src = lms_from_xyz * xyz_from_xy(daylight_xy(kelvin));
+  const Mat3 lms_from_xyz = from_rows(kLmsFromXyz);
+  const Vec3 src = lms_from_xyz * xyz_from_xy(illuminant_white_xy(kelvin));
   const Vec3 dst = lms_from_xyz * xyz_from_xy(Vec2(0.3127f, 0.3290f));  // sRGB's white, D65
   Mat3 correct(1.f);
   for (int c = 0; c < 3; ++c) correct[c][c] = dst[c] / src[c];
-  const Mat3 xyz_balance = glm::inverse(lms_from_xyz) * correct * lms_from_xyz;
-  return glm::inverse(xyz_from_srgb) * xyz_balance * xyz_from_srgb;
+  return glm::inverse(lms_from_xyz) * correct * lms_from_xyz;
 }
 
-Mat3 film_pixel_from_radiance(const FilmDesc& film, Float exposure_time) {
-  Mat3 m(exposure_time * film.iso / 100.f);
+Mat3 white_balance_srgb(Float kelvin) { return glm::inverse(xyz_from_srgb()) * white_balance_xyz(kelvin) * xyz_from_srgb(); }
+
+void set_film_sensor(FilmDesc& film, Float exposure_time) {
+  const Float ratio = exposure_time * film.iso / 100.f;
   Float kelvin = film.whitebalance;
   if (film.sensor != "cie1931" && kelvin == 0.f) kelvin = 6500.f;  // pbrt-v4's default for camera sensors
-  if (kelvin != 0.f) m = white_balance_srgb(kelvin) * m;
-  return m;
+  // pbrt-v4's CIE 1931 sensor records XYZ times the imaging ratio (where
+  // maxcomponentvalue clamps); the film writes sRGB of the balanced XYZ.
+  film.sensor_from_radiance = ratio * xyz_from_srgb();
+  film.pixel_from_sensor = glm::inverse(xyz_from_srgb()) * (kelvin != 0.f ? white_balance_xyz(kelvin) : Mat3(1.f));
+  film.pixel_from_radiance = kelvin != 0.f ? white_balance_srgb(kelvin) * Mat3(ratio) : Mat3(ratio);
 }
 
 void read_film(const std::string& type, const ParamSet& ps, const std::string& where, FilmDesc& film,

@@ -23,14 +23,18 @@ FilterDesc read_filter(const std::string& type, const ParamSet& params, const st
 // `radius` is that axis's radius. Mitchell and windowed sinc are negative in places.
 Float pixel_filter_1d(const FilterDesc& f, Float x, Float radius);
 
-// pbrt-v4's white balance (von Kries in Bradford LMS) from a daylight
-// illuminant of `kelvin` to sRGB's D65 white, as a linear sRGB -> linear sRGB matrix.
+// pbrt-v4's white balance (von Kries in Bradford LMS) from the white of the
+// illuminant pbrt-v4 names by `kelvin` (daylight, a blackbody below 4000 K)
+// to sRGB's D65 white: as an XYZ -> XYZ matrix, and as linear sRGB -> linear sRGB.
+Mat3 white_balance_xyz(Float kelvin);
 Mat3 white_balance_srgb(Float kelvin);
 
-// Linear sRGB radiance -> the film's pixel values, as pbrt-v4's RGBFilm with
-// its PixelSensor records them: imaging ratio exposure_time * ISO / 100,
-// then white balance when the film asks for it (pbrt-v4: "whitebalance",
-// default 0 = none for the CIE 1931 sensor, 6500 K for camera sensors).
-Mat3 film_pixel_from_radiance(const FilmDesc& film, Float exposure_time);
+// Sets the film's sensor matrices (FilmDesc::sensor_from_radiance,
+// pixel_from_sensor, pixel_from_radiance) as pbrt-v4's RGBFilm with its
+// PixelSensor records radiance: XYZ times the imaging ratio exposure_time *
+// ISO / 100 in the sensor, then white balance when the film asks for it
+// (pbrt-v4: "whitebalance", default 0 = none for the CIE 1931 sensor, 6500 K
+// for camera sensors) and XYZ -> sRGB on output.
+void set_film_sensor(FilmDesc& film, Float exposure_time);
 
 }  // namespace tessera

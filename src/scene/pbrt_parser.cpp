@@ -384,7 +384,8 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   scene_.camera.focal_distance = params.get_float("focaldistance", 1e6f);
   if (!(scene_.camera.lens_radius >= 0.f) || !std::isfinite(scene_.camera.lens_radius))
     fail(at, "camera \"lensradius\" must not be negative");
-  if (!(scene_.camera.focal_distance > 0.f)) fail(at, "camera \"focaldistance\" must be positive");
+  if (!(scene_.camera.focal_distance > 0.f) || !std::isfinite(scene_.camera.focal_distance))
+    fail(at, "camera \"focaldistance\" must be positive and finite");
   if (type != "perspective") params.mark_all_used();
   params.report_unused(warnings);
 }
@@ -429,7 +430,7 @@ SceneDesc PbrtParser::finish(const std::string& file_name, int last_line) {
   for (const StackEntry& e : stack_)
     if (e.kind != 'o') scene_.warnings.push_back(e.where + ": block not closed before end of file");
   if (scene_.meshes.empty() && scene_.lights.empty()) throw SceneError(where + ": empty scene (no shapes and no lights)");
-  scene_.film.pixel_from_radiance = film_pixel_from_radiance(scene_.film, scene_.camera.exposure_time);
+  set_film_sensor(scene_.film, scene_.camera.exposure_time);
   return std::move(scene_);
 }
 

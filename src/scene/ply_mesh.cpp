@@ -12,7 +12,9 @@
 #include <bit>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <optional>
@@ -27,7 +29,7 @@ static_assert(std::endian::native == std::endian::little, "binary PLY decoding a
 
 // Decompressed files larger than this are refused (a gzip bomb would
 // otherwise take all memory before any check could look at it).
-constexpr size_t kMaxPlyBytes = size_t(8) << 30;
+constexpr size_t kMaxPlyBytes = size_t(4) << 30;
 
 enum class PlyFormat { Ascii, BinaryLittleEndian, BinaryBigEndian };
 enum class PlyType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
@@ -101,7 +103,7 @@ PlyHeader parse_header(const std::string& bytes, const PlyFailure& fail) {
     if (eol == std::string::npos) eol = bytes.size();
     std::string line = bytes.substr(pos, eol - pos);
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    pos = eol + 1;
+    pos = eol == bytes.size() ? eol : eol + 1;  // a last line without '\n' ends at the end
     ++line_number;
     return line;
   };
@@ -162,7 +164,7 @@ class BodyReader {
 
   double read(PlyType type) { return format_ == PlyFormat::Ascii ? read_ascii() : read_binary(type); }
 
-  size_t bytes_left() const { return end_ - pos_; }
+  size_t bytes_left() const { return pos_ < end_ ? end_ - pos_ : 0; }
 
   // The fewest bytes one value of `type` can occupy: ASCII values need a
   // character and (but for the last) a separator.
@@ -171,7 +173,7 @@ class BodyReader {
  private:
   double read_binary(PlyType type) {
     const size_t n = type_size(type);
-    if (end_ - pos_ < n) fail_("file is truncated (the body ends inside a value)");
+    if (bytes_left() < n) fail_("file is truncated (the body ends inside a value)");
     unsigned char b[8];
     std::memcpy(b, data_ + pos_, n);
     pos_ += n;
@@ -241,6 +243,14 @@ std::vector<int> vertex_slots(const PlyElement& e, bool& has_normals, bool& has_
   return slots;
 }
 
+// An index as written in the file, for messages (NaN and huge values too).
+std::string format_index(double v) {
+  if (std::isfinite(v) && std::abs(v) < 9e15 && v == std::floor(v)) return std::to_string(static_cast<long long>(v));
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
 // A list's length, checked to be a count the remaining bytes can hold.
 size_t read_list_length(BodyReader& in, const PlyProperty& p, const PlyFailure& fail) {
   const double len = in.read(p.count_type);
@@ -302,8 +312,8 @@ void read_faces(const PlyElement& e, BodyReader& in, PlyMesh& out, uint64_t vert
         const double v = in.read(p.type);
         if (!indices) continue;
         if (!(v >= 0 && v < static_cast<double>(vertex_count)) || v != std::floor(v))
-          fail("face " + std::to_string(f) + ": vertex index " + std::to_string(static_cast<long long>(v)) +
-               " out of range (" + std::to_string(vertex_count) + " vertices)");
+          fail("face " + std::to_string(f) + ": vertex index " + format_index(v) + " out of range (" +
+               std::to_string(vertex_count) + " vertices)");
         if (k < 4) face[k] = static_cast<uint32_t>(v);
       }
       if (!indices) continue;
@@ -355,6 +365,8 @@ PlyMesh parse_ply_mesh(const std::string& bytes, const std::string& name) {
 
 PlyMesh load_ply_mesh(const std::string& path) {
   const PlyFailure fail(path);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) fail("not a regular file");
   // gzread passes uncompressed files through unchanged, so one path serves both.
   gzFile file = gzopen(path.c_str(), "rb");
   if (!file) fail(std::strerror(errno));

@@ -66,8 +66,11 @@ struct FilmDesc {
   Float whitebalance = 0.f;      // kelvin; 0 = none
   Float max_component_value = INFINITY;  // pbrt-v4 scales a sample down to this largest channel
   std::string sensor = "cie1931";
-  // Linear sRGB radiance -> recorded pixel value (exposure and white balance;
-  // see pbrt_film.h). Set when loading ends; identity for pbrt's defaults.
+  // Linear sRGB radiance -> sensor values (pbrt-v4: XYZ times the imaging
+  // ratio; maxcomponentvalue clamps these) -> pixel values (white balance,
+  // XYZ -> sRGB), and the product of the two. Set when loading ends
+  // (pbrt_film.h); pixel_from_radiance is the identity for pbrt's defaults.
+  Mat3 sensor_from_radiance{1.f}, pixel_from_sensor{1.f};
   Mat3 pixel_from_radiance{1.f};
 };
 

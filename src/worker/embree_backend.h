@@ -58,6 +58,7 @@ struct EmbreeTracer {
 
 class EmbreeScene {
  public:
+  // `data` must outlive this scene: alpha cutouts read its view from Embree's filter.
   explicit EmbreeScene(const SceneData& data);
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;

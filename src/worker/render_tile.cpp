@@ -17,12 +17,9 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
       PixelAccum& acc = pixels.at(job, x, y);
       for (uint32_t si = job.sample_begin; si < job.sample_end; ++si) {
         PixelSampler rng = PixelSampler::start(settings.sampler, settings.seed, pixel_index, si);
-        const FilterSample fs = sample_filter(s.filter, rng.uniform2());
-        Vec2 p_film(x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y);
-        // A lens sample only where there is a lens: pinhole images keep their random streams.
-        Ray ray = generate_camera_ray(s.camera, p_film, s.camera.lens_radius > 0.f ? rng.uniform2() : Vec2(0.f));
+        const CameraSample cs = sample_camera_ray(s, x, y, rng);
         path.learn = settings.learn.learns(si);
-        Rgb L = trace_path<Spec>(s, tracer, ray, rng, path, tc.path);
+        Rgb L = trace_path<Spec>(s, tracer, cs.ray, rng, path, tc.path);
         if (!is_finite(L)) {
           ++tc.rejected_nonfinite;
           L = Rgb(0.f);
@@ -31,7 +28,7 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
           L = glm::max(L, Rgb(0.f));
         }
         if (is_black(L)) ++tc.zero_radiance;
-        L = film_pixel_value(s.camera, L) * fs.weight;
+        L = film_pixel_value(s.camera, L) * cs.filter_weight;
         for (int c = 0; c < 3; ++c) {
           acc.sum[c] += L[c];
           acc.sum_sq[c] += static_cast<double>(L[c]) * L[c];

@@ -24,8 +24,9 @@ SceneData::SceneData(SceneDesc desc) : desc_(std::move(desc)) {
 }
 
 void SceneData::flatten_meshes() {
+  // Per-triangle alpha only for scenes with cutouts.
+  for (const MeshDesc& m : desc_.meshes) has_alpha_ |= m.alpha.texture >= 0 || m.alpha.value.x < 1.f;
   for (const MeshDesc& m : desc_.meshes) {
-    has_alpha_ |= m.alpha.texture >= 0 || m.alpha.value.x < 1.f;
     const uint32_t base = static_cast<uint32_t>(positions_.size());
     const bool has_n = !m.n.empty(), has_uv = !m.uv.empty();
     for (size_t i = 0; i < m.p.size(); ++i) {
@@ -62,7 +63,7 @@ void SceneData::flatten_meshes() {
         }
       }
       triangles_.push_back(ti);
-      triangle_alpha_.push_back(m.alpha);
+      if (has_alpha_) triangle_alpha_.push_back(m.alpha);
     }
   }
 }
@@ -129,6 +130,8 @@ void SceneData::build_camera() {
   }
   camera_.tan_half_fov = std::tan(glm::radians(desc_.camera.fov_degrees) * 0.5f);
   camera_.pixel_from_radiance = desc_.film.pixel_from_radiance;
+  camera_.sensor_from_radiance = desc_.film.sensor_from_radiance;
+  camera_.pixel_from_sensor = desc_.film.pixel_from_sensor;
   camera_.lens_radius = desc_.camera.lens_radius;
   camera_.focal_distance = desc_.camera.focal_distance;
   camera_.max_component_value = desc_.film.max_component_value;
@@ -244,6 +247,7 @@ uint64_t SceneData::fingerprint() const {
   // pbrt's defaults, so that fingerprints of default scenes stay as they were.
   if (camera_.pixel_from_radiance != Mat3(1.f) || std::isfinite(camera_.max_component_value)) {
     f.add(&camera_.pixel_from_radiance, sizeof camera_.pixel_from_radiance);
+    f.add(&camera_.sensor_from_radiance, sizeof camera_.sensor_from_radiance);
     f.add(&camera_.max_component_value, sizeof camera_.max_component_value);
   }
   return f.h;

@@ -16,11 +16,11 @@ RenderResult render_cornell(int threads, int tile, uint64_t seed, SamplerKind sa
   d.film.xres = 48;
   d.film.yres = 40;
   d.spp = 6;
+  d.sampler = sampler;
   RenderOptions opt;
   opt.threads = threads;
   opt.tile_size = tile;
   opt.seed = seed;
-  opt.sampler = sampler;
   return testing::render_desc(std::move(d), opt);
 }
 
@@ -62,8 +62,8 @@ Shape "trianglemesh" "point3 P" [ -5 0 -5  5 0 -5  5 0 5  -5 0 5 ] "integer indi
   auto render_with = [&](SamplerKind k, int spp, uint64_t seed) {
     SceneDesc d = load_pbrt_string(scene, "<shadow>", ".");
     d.spp = spp;
+    d.sampler = k;
     RenderOptions opt;
-    opt.sampler = k;
     opt.seed = seed;
     return film_mean(testing::render_desc(std::move(d), opt).film);
   };

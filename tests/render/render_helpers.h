@@ -16,6 +16,7 @@ inline RenderResult render_desc(SceneDesc desc, RenderOptions opt) {
   opt.progress = false;
   opt.spp = static_cast<uint32_t>(desc.spp);  // the scene (as edited by the test) decides
   opt.max_depth = desc.max_depth;
+  opt.sampler = desc.sampler;
   SceneData scene(std::move(desc));
   EmbreeScene embree(scene);
   return render(scene, embree, opt);

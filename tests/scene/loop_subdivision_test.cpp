@@ -107,6 +107,9 @@ TEST(LoopSubdivision, MeshesTheRulesAreNotDefinedOnAreErrors) {
   EXPECT_NE(subdivide_error(bow, {0, 1, 2, 0, 3, 4}, 1).find("one fan"), std::string::npos);
   EXPECT_NE(subdivide_error(p, {0, 0, 1}, 1).find("repeats a vertex"), std::string::npos);
   EXPECT_NE(subdivide_error(kTetP, kTetI, 14).find("more than"), std::string::npos);
+  // A single triangle asking for 4^30 faces is refused before any work.
+  EXPECT_NE(subdivide_error({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2}, 30).find("more than"), std::string::npos);
+  EXPECT_NE(subdivide_error({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2}, 14).find("more than"), std::string::npos);
 }
 
 TEST(LoopSubdivision, SceneShapeSubdividesWithPbrtsDefaultsAndReportsErrorsWithLocation) {

@@ -1,4 +1,5 @@
 // Film: exposure (ISO, shutter), white balance, sensors, maxcomponentvalue.
+#include "scene/named_spectra.h"
 #include "scene/pbrt_film.h"
 #include "scene_test_helpers.h"
 
@@ -36,25 +37,23 @@ TEST(PbrtFilm, IsoAndShutterScaleTheImage) {
             std::string::npos);
 }
 
-Rgb srgb_of_daylight_white(Float kelvin) {
-  // The white of daylight at `kelvin` in linear sRGB (Y = 1), from the same
-  // chromaticities pbrt-v4's white balance starts from.
-  const double t = kelvin, x = t <= 7000. ? -4.6070e9 / (t * t * t) + 2.9678e6 / (t * t) + 0.09911e3 / t + 0.244063
-                                           : -2.0064e9 / (t * t * t) + 1.9018e6 / (t * t) + 0.24748e3 / t + 0.237040;
-  const double y = -3.0 * x * x + 2.870 * x - 0.275;
-  const Vec3 xyz(static_cast<Float>(x / y), 1.f, static_cast<Float>((1 - x - y) / y));
-  return Rgb(3.2404542f * xyz.x - 1.5371385f * xyz.y - 0.4985314f * xyz.z,
-             -0.9692660f * xyz.x + 1.8760108f * xyz.y + 0.0415560f * xyz.z,
-             0.0556434f * xyz.x - 0.2040259f * xyz.y + 1.0572252f * xyz.z);
-}
-
-TEST(PbrtFilm, WhiteBalanceMakesThatIlluminantsWhiteNeutral) {
-  for (Float kelvin : {3000.f, 5000.f, 6500.f, 9000.f}) {
-    SCOPED_TRACE(kelvin);
-    const Rgb balanced = white_balance_srgb(kelvin) * srgb_of_daylight_white(kelvin);
-    EXPECT_NEAR(balanced.x / balanced.y, 1.f, 2e-3f);
-    EXPECT_NEAR(balanced.z / balanced.y, 1.f, 2e-3f);
-  }
+TEST(PbrtFilm, WhiteBalanceStartsFromPbrtsIlluminants) {
+  // pbrt-v4's "6500" is a daylight of 6503.6 K, within a hair of D65: nearly no change.
+  const Mat3 d65 = white_balance_srgb(6500.f);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(d65[i][j], i == j ? 1.f : 0.f, 0.01f) << i << j;
+  // Below 4000 K it starts from a blackbody: the Planckian locus (CIE 1931,
+  // tabulated) at 2000 K and 3000 K.
+  EXPECT_NEAR(blackbody_xy(2000.f).x, 0.5267f, 0.003f);
+  EXPECT_NEAR(blackbody_xy(2000.f).y, 0.4133f, 0.003f);
+  EXPECT_NEAR(blackbody_xy(3000.f).x, 0.4369f, 0.003f);
+  EXPECT_NEAR(blackbody_xy(3000.f).y, 0.4041f, 0.003f);
+  // The balance maps that white to D65's chromaticity.
+  const Vec2 w = blackbody_xy(3000.f * 1.4388f / 1.4380f);
+  const Vec3 balanced = white_balance_xyz(3000.f) * Vec3(w.x / w.y, 1.f, (1.f - w.x - w.y) / w.y);
+  const Float sum = balanced.x + balanced.y + balanced.z;
+  EXPECT_NEAR(balanced.x / sum, 0.3127f, 1e-4f);
+  EXPECT_NEAR(balanced.y / sum, 0.3290f, 1e-4f);
   // Warm light balanced for 3000 K loses its orange cast: blue is boosted.
   const Mat3 m = white_balance_srgb(3000.f);
   EXPECT_GT((m * Rgb(1.f)).z, 1.5f * (m * Rgb(1.f)).x);
@@ -63,6 +62,10 @@ TEST(PbrtFilm, WhiteBalanceMakesThatIlluminantsWhiteNeutral) {
   const Rgb r = s.film.pixel_from_radiance * Rgb(1.f), expected = 2.f * (m * Rgb(1.f));
   EXPECT_NEAR(r.x, expected.x, 1e-5f);
   EXPECT_NEAR(r.z, expected.z, 1e-5f);
+  // The two halves compose to the whole (the clamp sits between them).
+  const Rgb halves = s.film.pixel_from_sensor * (s.film.sensor_from_radiance * Rgb(0.2f, 0.5f, 0.9f));
+  const Rgb whole = s.film.pixel_from_radiance * Rgb(0.2f, 0.5f, 0.9f);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(halves[c], whole[c], 1e-5f);
 }
 
 TEST(PbrtFilm, CameraSensorsWarnAndBalanceForD65ByDefault) {

@@ -206,6 +206,21 @@ TEST(PlyMesh, FacesThatAreNeitherTrianglesNorQuadsAreSkippedAndCounted) {
   EXPECT_TRUE(warned);
 }
 
+TEST(PlyMesh, NothingAfterEndHeaderIsTruncationNotAnOverread) {
+  // end_header as the very last bytes, without a newline, with huge counts.
+  for (const char* format : {"ascii", "binary_little_endian"}) {
+    const std::string h = std::string("ply\nformat ") + format +
+                          " 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\n"
+                          "element face 1\nproperty list uchar int vertex_indices\nend_header";
+    EXPECT_NE(parse_error(h).find("truncated"), std::string::npos) << format;
+  }
+  // An out-of-range index given as a huge or non-integral number is named, not cast.
+  const std::string ascii = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                            "element face 1\nproperty list uchar double vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+                            "3 0 1 1e300\n";
+  EXPECT_NE(parse_error(ascii).find("vertex index 1e+300 out of range"), std::string::npos) << parse_error(ascii);
+}
+
 TEST(PlyMesh, CountsBeyondTheBytesLeftAreRefusedBeforeAllocating) {
   // Four billion vertices declared, a few bytes given: an error, at once.
   std::string bytes = header(Encoding::Little, 4000000000u, 1) + std::string(64, '\0');
