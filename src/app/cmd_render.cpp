@@ -135,7 +135,8 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   m.scene = std::make_unique<SceneData>(std::move(desc));
   m.guide = make_guide(a.guide, *m.scene, &m.guide_why);
   m.options_fingerprint = render_options_fingerprint(m.opt, m.scene->view().camera.width, m.scene->view().camera.height,
-                                                     m.guide ? (m.guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable") : "none");
+                                                     m.guide ? (m.guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable") : "none") ^
+                          m.scene->film_fingerprint();
   if (!a.resume.empty()) {
     if (!a.guide.in.empty()) throw std::runtime_error("--resume and --guide-in contradict each other (the checkpoint holds the guide)");
     m.resume = read_checkpoint(a.resume, m.scene->fingerprint(), m.options_fingerprint);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "kernels/equal_area.h"
 #include "kernels/vecmath.h"
@@ -243,13 +244,24 @@ uint64_t SceneData::fingerprint() const {
   }
   uint64_t materials = desc_.materials.size();
   f.add(&materials, sizeof materials);
-  // What the film records (exposure, white balance, clamp): only when not
-  // pbrt's defaults, so that fingerprints of default scenes stay as they were.
-  if (camera_.pixel_from_radiance != Mat3(1.f) || std::isfinite(camera_.max_component_value)) {
-    f.add(&camera_.pixel_from_radiance, sizeof camera_.pixel_from_radiance);
-    f.add(&camera_.sensor_from_radiance, sizeof camera_.sensor_from_radiance);
-    f.add(&camera_.max_component_value, sizeof camera_.max_component_value);
-  }
+  // Cutouts change what the guide sees (only scenes with them add bytes).
+  if (has_alpha_) f.add_vector(triangle_alpha_);
+  return f.h;
+}
+
+uint64_t SceneData::film_fingerprint() const {
+  // pbrt's defaults give 0, so checkpoints of such scenes keep their fingerprint.
+  const FilterDesc default_filter;
+  const bool defaults = camera_.pixel_from_radiance == Mat3(1.f) && !std::isfinite(camera_.max_component_value) &&
+                        camera_.lens_radius == 0.f && std::memcmp(&desc_.filter, &default_filter, sizeof default_filter) == 0;
+  if (defaults) return 0;
+  Fnv1a f;
+  f.add(&camera_.pixel_from_radiance, sizeof camera_.pixel_from_radiance);
+  f.add(&camera_.sensor_from_radiance, sizeof camera_.sensor_from_radiance);
+  f.add(&camera_.max_component_value, sizeof camera_.max_component_value);
+  f.add(&camera_.lens_radius, sizeof camera_.lens_radius);
+  f.add(&camera_.focal_distance, sizeof camera_.focal_distance);
+  f.add(&desc_.filter, sizeof desc_.filter);
   return f.h;
 }
 

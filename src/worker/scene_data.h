@@ -34,6 +34,9 @@ class SceneData {
   const std::vector<uint32_t>& indices() const { return indices_; }
   // A hash of geometry, materials and lights: ties a saved guide cache to its scene.
   uint64_t fingerprint() const;
+  // What turns radiance into pixels (sensor, clamp, lens, filter): part of a
+  // checkpoint's identity, not of a guide cache's. 0 for pbrt's defaults.
+  uint64_t film_fingerprint() const;
   // The brightest radiance (or intensity, for point-like lights) any light
   // emits, in luminance: the scale of the guide's learning targets.
   Float max_emitted_radiance() const;

@@ -93,6 +93,8 @@ TEST_F(FarmCliTest, BadCheckpointsAreRefusedAndLeaveOutputsAlone) {
   flipped[flipped.size() * 3 / 4] ^= 0x5a;
   std::ofstream(path("flipped.ckpt"), std::ios::binary) << flipped;
   std::ofstream(path("out.exr")) << "a good image";
+  // The same scene through another pixel filter: the same geometry, other pixels.
+  std::ofstream(path("door-box.pbrt")) << "PixelFilter \"box\"\n" << read_text(testing::source_dir() + "/scenes/door-ajar.pbrt");
 
   struct Case {
     std::string args, expect;
@@ -102,6 +104,7 @@ TEST_F(FarmCliTest, BadCheckpointsAreRefusedAndLeaveOutputsAlone) {
       {args + " --resume " + path("flipped.ckpt"), "checksum", 2},
       {args + " --resume " + path("missing.ckpt"), "cannot open", 2},
       {kDoor + " -q --no-preview --res 32x24 --spp 4 --seed 5 --resume " + ck, "other render options", 1},
+      {path("door-box.pbrt") + " -q --no-preview --res 32x24 --spp 4 --seed 4 --resume " + ck, "other render options", 1},
       {testing::source_dir() + "/scenes/cornell-box.pbrt -q --res 32x24 --spp 4 --seed 4 --resume " + ck,
        "another scene", 2},
   };
