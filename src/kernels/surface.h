@@ -66,28 +66,10 @@ TESSERA_HOST_DEVICE TESSERA_INLINE Vec3 offset_ray_origin(const SurfaceHit& h, c
   return offset_ray_origin(h.p, h.p_error, h.ng, w);
 }
 
-// dp/du of the triangle's uv parametrisation (pbrt-v4 Triangle), for shading
-// frames of anisotropic BSDFs; falls back to any tangent when uvs are degenerate.
-TESSERA_HOST_DEVICE inline Vec3 surface_dpdu(const SceneView& s, uint32_t tri) {
-  const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
-  const TriangleInfo& info = s.triangles[tri];
-  Vec2 uv0(0.f, 0.f), uv1(1.f, 0.f), uv2(1.f, 1.f);
-  if (info.flags & kTriHasUv) {
-    uv0 = s.uvs[idx[0]];
-    uv1 = s.uvs[idx[1]];
-    uv2 = s.uvs[idx[2]];
-  }
-  Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
-  Vec3 dp02 = s.positions[idx[0]] - s.positions[idx[2]], dp12 = s.positions[idx[1]] - s.positions[idx[2]];
-  Float det = duv02.x * duv12.y - duv02.y * duv12.x;
-  if (fabsf(det) < 1e-9f) return Frame::from_z(s.face_normals[tri]).s;
-  Vec3 dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
-  if (!(glm::dot(dpdu, dpdu) > 0.f) || !is_finite(dpdu)) return Frame::from_z(s.face_normals[tri]).s;
-  return dpdu;
-}
-
-// dp/dv of the triangle's uv parametrisation, as surface_dpdu.
-TESSERA_HOST_DEVICE inline Vec3 surface_dpdv(const SceneView& s, uint32_t tri) {
+// dp/du (axis 0) or dp/dv (axis 1) of the triangle's uv parametrisation
+// (pbrt-v4 Triangle), for shading frames of anisotropic BSDFs and bump
+// mapping; falls back to a tangent of the face when uvs are degenerate.
+TESSERA_HOST_DEVICE inline Vec3 surface_dp_duv(const SceneView& s, uint32_t tri, int axis) {
   const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
   Vec2 uv0(0.f, 0.f), uv1(1.f, 0.f), uv2(1.f, 1.f);
   if (s.triangles[tri].flags & kTriHasUv) {
@@ -95,13 +77,16 @@ TESSERA_HOST_DEVICE inline Vec3 surface_dpdv(const SceneView& s, uint32_t tri) {
     uv1 = s.uvs[idx[1]];
     uv2 = s.uvs[idx[2]];
   }
-  Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
-  Vec3 dp02 = s.positions[idx[0]] - s.positions[idx[2]], dp12 = s.positions[idx[1]] - s.positions[idx[2]];
-  Float det = duv02.x * duv12.y - duv02.y * duv12.x;
-  if (fabsf(det) < 1e-9f) return Frame::from_z(s.face_normals[tri]).t;
-  Vec3 dpdv = (-duv12.x * dp02 + duv02.x * dp12) / det;
-  if (!(glm::dot(dpdv, dpdv) > 0.f) || !is_finite(dpdv)) return Frame::from_z(s.face_normals[tri]).t;
-  return dpdv;
+  const Vec2 duv02 = uv0 - uv2, duv12 = uv1 - uv2;
+  const Vec3 dp02 = s.positions[idx[0]] - s.positions[idx[2]], dp12 = s.positions[idx[1]] - s.positions[idx[2]];
+  const Float det = duv02.x * duv12.y - duv02.y * duv12.x;
+  const Frame fallback = Frame::from_z(s.face_normals[tri]);
+  if (fabsf(det) < 1e-9f) return axis == 0 ? fallback.s : fallback.t;
+  const Vec3 d = axis == 0 ? (duv12.y * dp02 - duv02.y * dp12) / det : (-duv12.x * dp02 + duv02.x * dp12) / det;
+  if (!(glm::dot(d, d) > 0.f) || !is_finite(d)) return axis == 0 ? fallback.s : fallback.t;
+  return d;
 }
+TESSERA_HOST_DEVICE inline Vec3 surface_dpdu(const SceneView& s, uint32_t tri) { return surface_dp_duv(s, tri, 0); }
+TESSERA_HOST_DEVICE inline Vec3 surface_dpdv(const SceneView& s, uint32_t tri) { return surface_dp_duv(s, tri, 1); }
 
 }  // namespace tessera
