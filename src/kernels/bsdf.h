@@ -31,6 +31,7 @@ struct BsdfParams {
   Float alpha_x = 0.f;    // GGX (Trowbridge-Reitz) roughness, already remapped;
   Float alpha_y = 0.f;    // both below kSmoothAlpha means perfectly smooth
   int32_t bump = -1;      // the material's bump texture (applied by the integrator to the shading normal)
+  int32_t normal_map = -1;  // the material's normal map image (likewise)
   // CoatedDiffuse's layer (pbrt-v4 "thickness", "maxdepth", "nsamples").
   Float thickness = 0.01f;
   uint32_t layer_max_depth = 10;

@@ -217,6 +217,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
 
     if constexpr ((Spec & kSpecTextures) != 0) {
       if (bsdf.bump >= 0) h.ns = bumped_shading_normal(s, bsdf.bump, h);
+      else if (bsdf.normal_map >= 0) h.ns = normal_mapped_shading_normal(s, bsdf.normal_map, h);
     }
 
     // Anisotropic BSDFs need pbrt's orientation (x along dp/du); any frame

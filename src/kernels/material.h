@@ -48,6 +48,7 @@ struct Material {
   TextureSlot roughness_u{-1, Rgb(0.f)}, roughness_v{-1, Rgb(0.f)};
   bool textured_roughness = false;
   int32_t bump = -1;                         // "displacement" float texture (bump mapping), -1 = none
+  int32_t normal_map = -1;                   // "normalmap" image (linear RGB), -1 = none; bump wins
   bool remap_roughness = true;
   Float thickness = 0.01f;                   // coateddiffuse layer (pbrt-v4 defaults)
   uint32_t layer_max_depth = 10, layer_samples = 1;

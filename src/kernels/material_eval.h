@@ -41,6 +41,7 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
   b.alpha_x = m->alpha_x;
   b.alpha_y = m->alpha_y;
   b.bump = m->bump;
+  b.normal_map = m->normal_map;
   if ((Spec & kSpecTextures) && m->textured_roughness) {
     Float ru = eval_slot(s, m->roughness_u, h.uv).x, rv = eval_slot(s, m->roughness_v, h.uv).x;
     ru = ru > 0.f && ru < 1e30f ? ru : 0.f;  // NaN, Inf or negative texels: smooth

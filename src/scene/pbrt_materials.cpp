@@ -140,7 +140,8 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
     if (bump.texture >= 0) m.bump = bump.texture;
     else if (bump.value.x != 0.f) ctx.warn("a constant material \"displacement\" does not bump; ignored");
   }
-  if (params.find_any("normalmap")) ctx.warn("\"normalmap\" is not supported; ignored");
+  const std::string normal_map = params.get_string("normalmap", "");
+  if (!normal_map.empty()) m.normal_map = image_index(normal_map, "linear", false, ctx);
   return m;
 }
 

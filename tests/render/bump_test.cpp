@@ -53,5 +53,29 @@ TEST(Bump, LinearDisplacementTiltsTheNormalByItsSlope) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(Bump, NormalMapRgbIsATangentSpaceNormal) {
+  const auto dir = std::filesystem::temp_directory_path() / "tessera_normal_map_test";
+  std::filesystem::create_directories(dir);
+  // One texel: 2 rgb - 1 = (0.5, 0, 0.866), 30 degrees from the normal towards dp/du.
+  const float rgb[3] = {0.75f, 0.5f, 0.5f + 0.4330127f};
+  std::string bytes = "PF\n1 1\n-1.0\n";
+  bytes.append(reinterpret_cast<const char*>(rgb), sizeof rgb);
+  const std::string path = (dir / "n.pfm").string();
+  std::ofstream(path, std::ios::binary) << bytes;
+  const std::string scene = "WorldBegin\nMaterial \"diffuse\" \"string normalmap\" \"" + path +
+                            "\"\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0  2 0 0  2 2 0  0 2 0 ] "
+                            "\"integer indices\" [ 0 1 2 0 2 3 ] \"point2 uv\" [ 0 0 1 0 1 1 0 1 ]\n";
+  SceneData data(load_pbrt_string(scene, "<normalmap>", "."));
+  const SceneView& s = data.view();
+  const int32_t image = s.materials[s.triangles[0].material].normal_map;
+  ASSERT_GE(image, 0);
+  const SurfaceHit h = make_surface_hit(s, 0, 0.3f, 0.2f);
+  const Vec3 n = normal_mapped_shading_normal(s, image, h);
+  const Vec3 expected = glm::normalize(0.5f * glm::normalize(surface_dpdu(s, 0)) + 0.8660254f * h.ns);
+  EXPECT_NEAR(glm::dot(n, expected), 1.f, 1e-5f);
+  EXPECT_NEAR(glm::dot(n, h.ns), 0.8660254f, 1e-4f);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace tessera
