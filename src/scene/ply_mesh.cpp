@@ -349,8 +349,7 @@ PlyMesh parse_ply_mesh(const std::string& bytes, const std::string& name) {
     if (&e == vertex) {
       read_vertices(e, in, out, fail);
     } else if (&e == face) {
-      if (out.p.empty()) fail("faces come before the vertices they index");
-      read_faces(e, in, out, vertex->count, fail);
+      read_faces(e, in, out, vertex->count, fail);  // indices are checked against the header's count
     } else {
       for (uint64_t i = 0; i < e.count; ++i)
         for (const PlyProperty& p : e.properties) {

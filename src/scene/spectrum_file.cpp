@@ -1,6 +1,7 @@
 #include "scene/spectrum_file.h"
 
 #include <charconv>
+#include <filesystem>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -42,6 +43,11 @@ std::vector<Float> parse_spectrum_text(const std::string& text, const std::strin
 }
 
 std::vector<Float> read_spectrum_file(const std::string& path) {
+  // Measured spectra are a few kilobytes; anything far larger is not one.
+  constexpr uintmax_t kMaxBytes = uintmax_t(16) << 20;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
+  if (std::filesystem::file_size(path, ec) > kMaxBytes) fail(path, "larger than 16 MiB");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open it");
   std::ostringstream text;

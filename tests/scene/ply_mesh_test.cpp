@@ -262,6 +262,20 @@ TEST(PlyMesh, OtherElementsAndPropertyTypesAreReadPast) {
   EXPECT_EQ(m.indices, (std::vector<uint32_t>{2, 1, 0}));
 }
 
+TEST(PlyMesh, FacesMayComeBeforeVertices) {
+  // RPly (and so pbrt-v4) reads elements in any order.
+  const std::string bytes =
+      "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\nelement vertex 3\n"
+      "property float x\nproperty float y\nproperty float z\nend_header\n3 2 1 0\n0 0 0\n1 0 0\n0 1 0\n";
+  PlyMesh m = parse_ply_mesh(bytes, "m.ply");
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{2, 1, 0}));
+  ASSERT_EQ(m.p.size(), 3u);
+  EXPECT_EQ(m.p[1], Vec3(1.f, 0.f, 0.f));
+  // ...and their indices are still checked against the declared vertices.
+  const std::string bad = std::string(bytes).replace(bytes.find("3 2 1 0"), 7, "3 2 1 3");
+  EXPECT_NE(parse_error(bad).find("vertex index 3 out of range (3 vertices)"), std::string::npos);
+}
+
 TEST(PlyMesh, NonFiniteVertexValuesAreErrors) {
   std::string bytes = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n";

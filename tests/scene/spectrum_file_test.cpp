@@ -66,6 +66,9 @@ TEST(SpectrumFile, MissingOrBadFilesNameTheSceneLine) {
   TempDir dir;
   std::string e = load_error("WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"spds/none.spd\"\n", dir.path());
   EXPECT_NE(e.find("bad.pbrt:2: unknown named spectrum \"spds/none.spd\" (and no spectrum file"), std::string::npos) << e;
+  std::filesystem::create_directories(dir.file("adir.spd"));
+  e = load_error("WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" \"adir.spd\"\n", dir.path());
+  EXPECT_NE(e.find("bad.pbrt:2:"), std::string::npos) << e;
   dir.write("odd.spd", "400 1 500\n");
   e = load_error("WorldBegin\n\nMaterial \"diffuse\" \"spectrum reflectance\" \"odd.spd\"\n", dir.path());
   EXPECT_NE(e.find("bad.pbrt:3: cannot read spectrum file"), std::string::npos) << e;
