@@ -67,25 +67,28 @@ std::optional<Rgb> named_spectrum_rgb(const std::string& name) {
   return std::nullopt;
 }
 
-Rgb blackbody_rgb(Float kelvin) {
-  if (!(kelvin > 0.f)) return Rgb(0.f);
+namespace {
+
+// XYZ of Planck's law at `kelvin` (unnormalised).
+Vec3 blackbody_xyz(Float kelvin) {
   const double c = 299792458., h = 6.62606957e-34, kb = 1.3806488e-23;
-  auto planck = [&](double lambda_nm) {
+  return integrate_xyz([&](double lambda_nm) {
     double l = lambda_nm * 1e-9;
     return (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * kelvin)) - 1));
-  };
-  Vec3 xyz = integrate_xyz(planck);
+  });
+}
+
+}  // namespace
+
+Rgb blackbody_rgb(Float kelvin) {
+  if (!(kelvin > 0.f)) return Rgb(0.f);
+  const Vec3 xyz = blackbody_xyz(kelvin);
   if (!(xyz.y > 0.f)) return Rgb(0.f);
   return glm::max(xyz_to_linear_srgb(xyz / xyz.y), Rgb(0.f));
 }
 
 Vec2 blackbody_xy(Float kelvin) {
-  const double c = 299792458., h = 6.62606957e-34, kb = 1.3806488e-23;
-  auto planck = [&](double lambda_nm) {
-    double l = lambda_nm * 1e-9;
-    return (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * kelvin)) - 1));
-  };
-  const Vec3 xyz = integrate_xyz(planck);
+  const Vec3 xyz = kelvin > 0.f ? blackbody_xyz(kelvin) : Vec3(0.f);
   const Float sum = xyz.x + xyz.y + xyz.z;
   return sum > 0.f ? Vec2(xyz.x / sum, xyz.y / sum) : Vec2(1.f / 3.f);
 }

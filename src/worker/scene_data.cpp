@@ -147,21 +147,19 @@ void SceneData::build_filter() {
   bool negative_lobes = false;
   auto build_axis = [&](Float radius, std::vector<Float>& inverse_cdf, std::vector<Float>& weight) {
     std::vector<Float> table(kBins);
+    weight.resize(kBins);
     double sum_abs = 0, sum = 0;
     for (int i = 0; i < kBins; ++i) {
       Float x = ((i + 0.5f) / kBins * 2.f - 1.f) * radius;
       Float v = pixel_filter_1d(f, x, radius);
       table[i] = std::abs(v);
+      weight[i] = v < 0.f ? -1.f : 1.f;  // the sign, scaled below
       sum_abs += std::abs(v);
       sum += v;
       negative_lobes |= v < 0.f;
     }
     if (!(sum > 0.0)) throw SceneError("pixel filter: its integral is not positive");
-    weight.resize(kBins);
-    for (int i = 0; i < kBins; ++i) {
-      Float x = ((i + 0.5f) / kBins * 2.f - 1.f) * radius;
-      weight[i] = static_cast<Float>((pixel_filter_1d(f, x, radius) < 0.f ? -1.0 : 1.0) * sum_abs / sum);
-    }
+    for (Float& w : weight) w = static_cast<Float>(w * (sum_abs / sum));
     Distribution1D dist(table);
     inverse_cdf.resize(kInverseSize);
     for (int i = 0; i < kInverseSize; ++i) {
