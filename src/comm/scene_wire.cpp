@@ -6,7 +6,8 @@ namespace tessera {
 
 template <class Archive>
 void serialize(Archive& ar, MeshDesc& m) {
-  ar(raw(m.p), raw(m.n), raw(m.uv), raw(m.indices), m.material, m.flip_normals, m.area_light, raw_value(m.alpha), m.where);
+  ar(raw(m.p), raw(m.n), raw(m.uv), raw(m.indices), m.material, m.flip_normals, m.area_light, raw_value(m.alpha), raw_value(m.media),
+     m.where);
 }
 template <class Archive>
 void serialize(Archive& ar, ImageDesc& i) {
@@ -20,6 +21,7 @@ void serialize(Archive& ar, SceneDesc& d) {
   ar(d.sampler, d.camera.exposure_time, d.film.iso, d.film.whitebalance, d.film.sensor, d.film.max_component_value,
      raw_value(d.film.pixel_from_radiance), raw_value(d.film.sensor_from_radiance), raw_value(d.film.pixel_from_sensor));
   ar(d.meshes, raw(d.materials), raw(d.textures), d.images, raw(d.area_lights), raw(d.lights), d.warnings, d.source);
+  ar(raw(d.media), d.camera_medium);
 }
 
 Bytes encode_scene(const SceneDesc& desc) { return encode(desc); }

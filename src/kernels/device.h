@@ -44,6 +44,8 @@ constexpr Float kPi = 3.14159265358979323846f;
 constexpr Float kInvPi = 0.31830988618379067154f;
 constexpr Float kInv2Pi = 0.15915494309189533577f;
 constexpr Float kInv4Pi = 0.07957747154594766788f;
+// The largest float: "no hit" distance of a ray (finite, so 0 * kInfinity is 0).
+constexpr Float kInfinity = 3.402823466e+38f;
 
 // Relaxed atomic add, for order-independent integer accumulators (sums come
 // out bit-identical whatever the thread or block order). Signed values are

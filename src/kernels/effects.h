@@ -20,6 +20,7 @@ enum Effect : uint32_t {
   kEffectInterface = 1u << 9,
   kEffectShadingNormals = 1u << 10,
   kEffectAlpha = 1u << 11,        // alpha cutouts (a ray-query filter, only where present)
+  kEffectMedia = 1u << 12,        // participating media (volumetric path tracing)
 };
 
 // What the integrator template is specialised on: each bit removes work from
@@ -30,7 +31,12 @@ enum Specialisation : uint32_t {
   kSpecAreaLights = 1u << 2,
   kSpecEnvironment = 1u << 3,
   kSpecGuiding = 1u << 4,      // learned guiding (set by the render options, not by the scene)
-  kSpecAll = (1u << 5) - 1,
+  kSpecSurfaceAll = (1u << 5) - 1,
+  // Volumetric path tracing. Media scenes are rare enough that they get the
+  // full surface integrator (every other scene bit set) rather than a
+  // specialisation per combination: two more instantiations, not 32.
+  kSpecMedia = 1u << 5,
+  kSpecAll = (1u << 6) - 1,
 };
 
 TESSERA_HOST_DEVICE inline uint32_t specialisation_for(uint32_t effects) {
@@ -39,6 +45,7 @@ TESSERA_HOST_DEVICE inline uint32_t specialisation_for(uint32_t effects) {
   if (effects & kEffectTextures) s |= kSpecTextures;
   if (effects & kEffectAreaLights) s |= kSpecAreaLights;
   if (effects & kEffectEnvironment) s |= kSpecEnvironment;
+  if (effects & kEffectMedia) s |= kSpecMedia | kSpecNonDiffuse | kSpecTextures | kSpecAreaLights | kSpecEnvironment;
   return s;
 }
 

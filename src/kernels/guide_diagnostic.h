@@ -14,7 +14,7 @@ namespace tessera {
 template <class Tracer>
 TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g, const Tracer& tracer, Ray ray,
                                           int32_t max_depth) {
-  constexpr uint32_t kSpec = kSpecAll & ~kSpecGuiding;
+  constexpr uint32_t kSpec = kSpecSurfaceAll & ~kSpecGuiding;
   Rgb beta(1.f);
   for (int32_t depth = 0;; ++depth) {
     TraceHit hit;

@@ -15,16 +15,9 @@
 #include "rng.h"
 #include "bump.h"
 #include "sampler.h"
+#include "volume_transport.h"
 
 namespace tessera {
-
-struct TraceHit {
-  Float t;
-  uint32_t triangle;
-  Float b1, b2;  // barycentrics of vertices 1 and 2
-};
-
-constexpr Float kInfinity = 3.402823466e+38f;
 
 // Per-path counters; summed over a tile with integer adds (order-independent).
 struct PathCounters {
@@ -37,6 +30,7 @@ struct PathCounters {
   uint64_t guide_updates = 0;      // direction targets accepted by the guide
   uint64_t guided_roulette = 0;    // roulette decisions the guide's prediction took part in
   uint64_t nee_skipped = 0;        // vertices that skipped next-event estimation (GuideView::nee_prob)
+  uint64_t medium_vertices = 0;    // scattering events in participating media
 };
 
 struct PathSettings {
@@ -95,6 +89,12 @@ TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, const Vec3& wo, Fl
 
 // Radiance arriving along the ray; consumes random numbers from rng in a fixed order.
 //
+// With kSpecMedia the path also scatters in participating media (pbrt-v4's
+// volpath for homogeneous media): the ray starts in the camera's medium,
+// changes medium where it crosses a surface that is a medium transition, and
+// each segment through a medium samples a collision (medium.h). Shadow rays
+// accumulate transmittance through "interface" surfaces (volume_transport.h).
+//
 // With kSpecGuiding, directions at vertices without a delta lobe are drawn
 // from a mixture of the BSDF and the learned guide (probability
 // guide.cell_guide_prob(cell)), weighted by the mixture pdf, which also
@@ -115,6 +115,12 @@ template <uint32_t Spec, class Tracer>
 TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray ray, PixelSampler& rng,
                                    const PathSettings& settings, PathCounters& c) {
   constexpr bool kGuide = (Spec & kSpecGuiding) != 0;
+  constexpr bool kMedia = (Spec & kSpecMedia) != 0;
+  int32_t medium = kMedia && s.triangle_media ? s.camera_medium : -1;  // the medium the ray travels in
+  // Luminance of the medium's weight on the segment just traced (its
+  // transmittance, or the collision estimator's weight): learning targets
+  // are the radiance arriving at x, after the medium between.
+  Float segment_tr = 1.f;
   const bool learn = kGuide && settings.learn;
   const GuideView& g = settings.guide;
   const GuideView* guide = kGuide ? &g : nullptr;
@@ -153,6 +159,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   GuideMixSample pend_mix;
   // Sends the pending target (and its mixture statistics) to x's cell.
   auto finish_target = [&](Float target) {
+    target *= segment_tr;
     if (guide_record(g, pend_cell, pend_bin, target)) {
       ++c.guide_updates;
       if (pend_mix.mix_pdf > 0.f) guide_record_mix(g, pend_cell, pend_mix, target);
@@ -162,7 +169,81 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   for (;;) {
     TraceHit hit;
     ++c.rays;
-    if (!tracer.intersect(ray.o, ray.d, kInfinity, &hit)) {
+    const bool found = tracer.intersect(ray.o, ray.d, kInfinity, &hit);
+    if constexpr (kMedia) {
+      if (medium >= 0) {
+        const Medium& m = s.media[medium];
+        const Float t_max = found ? hit.t : kInfinity;
+        if (medium_absorbs_only(m)) {
+          // Exact transmittance: no collision to sample, no path ended by absorption.
+          const Rgb T = transmittance(medium_sigma_t(m), t_max);
+          beta *= T;
+          rr_beta *= T;
+          segment_tr = luminance(T);
+        } else {
+          const Float u_channel = rng.uniform();
+          const Float u_dist = rng.uniform();
+          const MediumSegment seg = sample_medium_segment(m, t_max, u_channel, u_dist);
+          if (depth < settings.max_depth) L += beta * seg.emitted;
+          beta *= seg.weight;
+          rr_beta *= seg.weight;
+          segment_tr = luminance(seg.weight);
+          if (seg.scattered) {
+            if (is_black(beta) || depth++ == settings.max_depth) break;
+            ++c.medium_vertices;
+            const Vec3 p = ray.o + seg.t * ray.d;
+            const Vec3 wo = -ray.d;
+            const Float u_select = rng.uniform();
+            const Vec2 u_light = rng.uniform2();
+            const Vec2 u_phase = rng.uniform2();
+            Float direct_estimate = 0.f;  // unweighted NEE estimate of light scattered here (guide targets)
+            if (settings.nee && s.num_lights > 0) {
+              Float pmf = 0.f;
+              const uint32_t li = select_light(s, guide, -1, u_select, &pmf);
+              LightSample ls;
+              if (pmf > 0.f && sample_light(s, li, p, u_light, &ls)) {
+                const Float phase = henyey_greenstein(glm::dot(wo, ls.wi), m.g);
+                const Float tmax = ls.infinite ? kInfinity : glm::length(ls.p_light - p) * 0.9999f;
+                const Rgb tr = light_visibility<true>(s, tracer, p, ls.wi, tmax, medium, c);
+                const Float light_pdf = pmf * ls.pdf;
+                if (!is_black(tr) && light_pdf > 0.f) {
+                  const Float w = ls.delta ? 1.f : power_heuristic(light_pdf, phase);
+                  L += beta * tr * ls.L * (phase * w / light_pdf);
+                  direct_estimate = luminance(tr * ls.L) * phase / light_pdf;
+                }
+              }
+            }
+            // The guide has no cells in media: a pending target ends here with
+            // the light scattered here directly (multiple scattering is not learned).
+            if (learn && pend_cell >= 0) {
+              finish_target(direct_estimate);
+              pend_cell = -1;
+            }
+            // Henyey-Greenstein sampling is exact: the weight p / pdf is 1.
+            Float phase_pdf = 0.f;
+            const Vec3 wi = sample_henyey_greenstein(wo, m.g, u_phase, &phase_pdf);
+            if (!(phase_pdf > 0.f)) break;
+            prev_scatter_pdf = phase_pdf;
+            prev_cell = -1;
+            prev_p = p;
+            specular_bounce = false;
+            ray.o = p;
+            ray.d = wi;
+            if (depth > 1) {
+              const Float survive = glm::min(1.f, max_component(rr_beta * eta_scale));
+              if (survive < 1.f) {
+                if (rng.uniform() < 1.f - survive) break;
+                beta /= survive;
+                rr_beta /= survive;
+              }
+            }
+            continue;
+          }
+        }
+        if (is_black(beta)) break;
+      }
+    }
+    if (!found) {
       Rgb Le_total(0.f);
       if constexpr ((Spec & kSpecEnvironment) != 0) {
         for (uint32_t k = 0; k < s.num_infinite_lights; ++k) {
@@ -211,6 +292,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       // Interface: continue through without counting a bounce (pbrt's SkipIntersection).
       ++c.interface_skips;
       if (++interface_skips > 256) break;
+      if constexpr (kMedia) medium = medium_after(s, hit.triangle, h.ng, ray.d, medium);
       ray.o = offset_ray_origin(h, ray.d);
       continue;
     }
@@ -284,7 +366,6 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           Vec3 o = offset_ray_origin(h, ls.wi);
           Float tmax = kInfinity;
           if (!ls.infinite) tmax = glm::length(ls.p_light - o) * 0.9999f;
-          ++c.shadow_rays;
           Float light_pdf = pmf * ls.pdf;
           // The guide's density of the light direction, for the MIS weight: its
           // alias entry is fetched while the shadow ray is traced.
@@ -293,7 +374,10 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             light_dir_entry = g.bin_entry(cell, guide_bin_of(g, ls.wi));
             TESSERA_PREFETCH(light_dir_entry);
           }
-          if (light_pdf > 0.f && !tracer.occluded(o, ls.wi, tmax)) {
+          const Rgb tr = light_pdf > 0.f ? light_visibility<kMedia>(s, tracer, o, ls.wi, tmax,
+                                                                    kMedia ? medium_after(s, hit.triangle, h.ng, ls.wi, medium) : -1, c)
+                                         : Rgb(0.f);
+          if (!is_black(tr)) {
             Float w = 1.f;
             if (!ls.delta) {
               Float scatter_pdf = eval_pdf<Spec>(bsdf, wo_l, wi_l);
@@ -301,8 +385,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
                 scatter_pdf = guide_p * g.entry_pdf(*light_dir_entry) + (1.f - guide_p) * scatter_pdf;
               w = power_heuristic(light_pdf, scatter_pdf);
             }
-            L += beta * f * ls.L * (w / light_pdf);
-            learned = luminance(f * ls.L) / ls.pdf;
+            L += beta * f * tr * ls.L * (w / light_pdf);
+            learned = luminance(f * tr * ls.L) / ls.pdf;
           }
         }
       }
@@ -393,6 +477,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     ray.o = offset_ray_origin(h, wi);
     ray.d = wi;
     prev_p = h.p;
+    if constexpr (kMedia) medium = medium_after(s, hit.triangle, h.ng, wi, medium);
 
     // Russian roulette after the second bounce: pbrt-v4's rule, on throughput
     // corrected for radiance scaling at refractive boundaries; where the guide

@@ -5,6 +5,7 @@
 #include "distribution.h"
 #include "light.h"
 #include "material.h"
+#include "medium.h"
 
 namespace tessera {
 
@@ -76,6 +77,11 @@ struct SceneView {
   uint32_t num_infinite_lights = 0;
   const Distribution2DView* env_distributions = nullptr;  // per light index, valid for image infinite lights
 
+  // Participating media; null and 0 when the scene has none.
+  const Medium* media = nullptr;
+  uint32_t num_media = 0;
+  const MediumInterface* triangle_media = nullptr;  // per triangle
+  int32_t camera_medium = -1;                       // -1: vacuum
 
   CameraView camera;
   FilterView filter;

@@ -6,6 +6,13 @@
 
 namespace tessera {
 
+// What a closest-hit ray query reports.
+struct TraceHit {
+  Float t;
+  uint32_t triangle;
+  Float b1, b2;  // barycentrics of vertices 1 and 2
+};
+
 struct SurfaceHit {
   Vec3 p;      // position, interpolated from the vertices (more precise than o + t d)
   Vec3 p_error;  // conservative bound on |p - exact| per axis (pbrt-v4's triangle bound)

@@ -18,7 +18,8 @@
 namespace tessera {
 
 uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options, bool guiding) {
-  uint32_t spec = options.force_full_specialisation ? (kSpecAll & ~kSpecGuiding) : specialisation_for(scene.effects());
+  uint32_t spec = specialisation_for(scene.effects());
+  if (options.force_full_specialisation) spec = (kSpecSurfaceAll & ~kSpecGuiding) | (spec & kSpecMedia);
   return guiding ? spec | kSpecGuiding : spec;
 }
 

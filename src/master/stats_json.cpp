@@ -69,6 +69,7 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
   j.add("samples_per_second", paths / secs);
   j.add("rays_per_second", rays / secs);
   j.add("mean_path_length", paths > 0 ? c.path.vertices / paths : 0.0);
+  j.add("medium_vertices", c.path.medium_vertices);  // scattering events in media (0 without media)
   j.add("zero_contribution_fraction", paths > 0 ? c.zero_radiance / paths : 0.0);
   j.add("nonfinite_samples_rejected", c.rejected_nonfinite);
   j.add("negative_samples_clamped", c.rejected_negative);

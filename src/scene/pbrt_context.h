@@ -16,6 +16,7 @@ struct NamedObjects {
   std::map<std::string, int32_t> materials;
   std::map<std::string, int32_t> float_textures;
   std::map<std::string, int32_t> spectrum_textures;
+  std::map<std::string, int32_t> media;  // -1: a medium that is not simulated
   std::map<std::string, int32_t> images;  // key: resolved path + "|" + encoding (+ "|grey")
 };
 

@@ -11,6 +11,7 @@
 #include "scene/pbrt_film.h"
 #include "scene/pbrt_lights.h"
 #include "scene/pbrt_materials.h"
+#include "scene/pbrt_media.h"
 #include "scene/pbrt_paths.h"
 #include "scene/pbrt_shapes.h"
 #include "scene/pbrt_textures.h"
@@ -353,8 +354,35 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
   } else if (d == "TransformTimes") {
     read_numbers(tokens, pos, 2, at);
     warn("TransformTimes (motion blur) is not supported; ignored");
-  } else if (d == "ColorSpace" || d == "Option" || d == "Attribute" || d == "MakeNamedMedium" ||
-             d == "MediumInterface" || d == "Accelerator") {
+  } else if (d == "MakeNamedMedium") {
+    std::string name = read_string(tokens, pos, at);
+    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_);
+    std::string type = ps.get_string("type", "");
+    if (type.empty()) fail(at, "MakeNamedMedium \"" + name + "\" needs \"string type\"");
+    if (names_.media.count(name)) warn("named medium \"" + name + "\" redefined");
+    if (std::optional<Medium> m = make_medium(type, ps, context(at, including_dir))) {
+      if (scene_.media.size() >= static_cast<size_t>(INT16_MAX)) fail(at, "too many media (at most 32767)");
+      scene_.media.push_back(*m);
+      names_.media[name] = static_cast<int32_t>(scene_.media.size() - 1);
+    } else {
+      names_.media[name] = -1;
+    }
+    ps.report_unused(warnings);
+  } else if (d == "MediumInterface") {
+    // One name: the same medium on both sides; two: inside, then outside.
+    const std::string inside = read_string(tokens, pos, at);
+    std::string outside = inside;
+    if (pos < tokens.size() && tokens[pos].kind == TokenKind::String) outside = tokens[pos++].text;
+    auto medium_index = [&](const std::string& name) -> int16_t {
+      if (name.empty()) return -1;
+      auto it = names_.media.find(name);
+      if (it == names_.media.end())
+        fail(at, "unknown medium \"" + name + "\" (MakeNamedMedium must come before its use)");
+      return static_cast<int16_t>(it->second);
+    };
+    state_.media.inside = medium_index(inside);
+    state_.media.outside = medium_index(outside);
+  } else if (d == "ColorSpace" || d == "Option" || d == "Attribute" || d == "Accelerator") {
     warn("'" + d + "' is not supported; ignored");
     skip_arguments(tokens, pos);
   } else {
@@ -379,6 +407,7 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
     fail(at, "the shutter never opens (shutterclose equals shutteropen): the image would be black");
   scene_.camera.exposure_time = close - open;
   scene_.camera.where = at.where();
+  scene_.camera_medium = state_.media.outside;  // pbrt-v4: the camera sits in the current outside medium
   coordinate_systems_["camera"] = scene_.camera.world_from_camera;
   scene_.camera.lens_radius = params.get_float("lensradius", 0.f);
   scene_.camera.focal_distance = params.get_float("focaldistance", 1e6f);
@@ -407,6 +436,7 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
   }
   mesh->material = state_.material;
   mesh->area_light = state_.area_light;
+  mesh->media = state_.media;
   mesh->alpha = float_slot(params, "alpha", 1.f, context(at, including_dir));
   if (mesh->alpha.texture < 0 && !(mesh->alpha.value.x >= 0.f && mesh->alpha.value.x <= 1.f))
     fail(at, "shape \"alpha\" must be in [0, 1]");

@@ -1,5 +1,5 @@
 // Walks pbrt-v4 directives, keeping pbrt's graphics state (transform,
-// orientation, material, area light; AttributeBegin/End stack; named
+// orientation, material, area light, media; AttributeBegin/End stack; named
 // coordinate systems; object instances) and filling a SceneDesc.
 #pragma once
 
@@ -29,6 +29,7 @@ class PbrtParser {
     bool reverse_orientation = false;
     int32_t material = 0;
     int32_t area_light = -1;
+    MediumInterface media;  // MediumInterface "inside" "outside" (-1: vacuum)
   };
   struct StackEntry {
     char kind;  // 'a' AttributeBegin, 't' TransformBegin, 'o' ObjectBegin

@@ -9,6 +9,7 @@
 
 #include "kernels/light.h"
 #include "kernels/material.h"
+#include "kernels/medium.h"
 #include "kernels/sampler.h"
 
 namespace tessera {
@@ -32,6 +33,8 @@ struct MeshDesc {
   // pbrt-v4 "alpha": a float constant or float texture; hits where it is
   // below 1 are ignored with probability 1 - alpha. Constant 1 = opaque.
   TextureSlot alpha{-1, Rgb(1.f)};
+  // Media inside and outside (indices into SceneDesc::media, -1: vacuum).
+  MediumInterface media;
   std::string where;            // "file:line" of the Shape directive, for messages
 };
 
@@ -102,6 +105,8 @@ struct SceneDesc {
   std::vector<ImageDesc> images;
   std::vector<AreaLightDesc> area_lights;
   std::vector<Light> lights;        // point, spot, distant, infinite (area lights come from meshes)
+  std::vector<Medium> media;        // MakeNamedMedium, in order of definition
+  int32_t camera_medium = -1;       // the medium the camera sits in (pbrt-v4: the outside medium at Camera)
   std::vector<std::string> warnings;  // "file:line: message", in order of appearance
   std::string source;               // file name, or "<builtin:cornell-box>"
 };

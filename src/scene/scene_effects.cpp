@@ -60,7 +60,9 @@ uint32_t compute_effects(const SceneDesc& scene) {
     if (m.area_light >= 0) e |= kEffectAreaLights;
     if (!m.n.empty()) e |= kEffectShadingNormals;
     if (m.alpha.texture >= 0 || m.alpha.value.x < 1.f) e |= kEffectAlpha;
+    if (m.media.inside >= 0 || m.media.outside >= 0) e |= kEffectMedia;
   }
+  if (scene.camera_medium >= 0) e |= kEffectMedia;
   for (const Light& l : scene.lights) {
     if (l.type == LightType::Infinite) e |= kEffectEnvironment;
     else if (l.type != LightType::Area) e |= kEffectDeltaLights;
@@ -70,7 +72,8 @@ uint32_t compute_effects(const SceneDesc& scene) {
 
 std::string describe_effects(uint32_t e) {
   static const char* names[] = {"diffuse", "glossy", "specular", "transmission", "textures", "area-lights",
-                                "delta-lights", "environment", "mix", "interface", "shading-normals", "alpha-cutouts"};
+                                "delta-lights", "environment", "mix", "interface", "shading-normals", "alpha-cutouts",
+                                "media"};
   std::string out;
   for (uint32_t i = 0; i < sizeof(names) / sizeof(names[0]); ++i) {
     if (e & (1u << i)) {
@@ -83,9 +86,9 @@ std::string describe_effects(uint32_t e) {
 
 std::string describe_specialisation(uint32_t s) {
   if (s == kSpecAll) return "full";
-  static const char* names[] = {"non-diffuse-bsdfs", "textures", "area-lights", "environment", "guiding"};
+  static const char* names[] = {"non-diffuse-bsdfs", "textures", "area-lights", "environment", "guiding", "media"};
   std::string out;
-  for (uint32_t i = 0; i < 5; ++i) {
+  for (uint32_t i = 0; i < 6; ++i) {
     if (s & (1u << i)) {
       if (!out.empty()) out += "+";
       out += names[i];

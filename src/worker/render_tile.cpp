@@ -43,9 +43,16 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
 
 using TileFn = TileCounters (*)(const SceneView&, const EmbreeTracer&, const TileSettings&, const TileJob&, TilePixels);
 
+// Media scenes run the full surface integrator (see kSpecMedia): every
+// index with the media bit maps to one of two instantiations.
+constexpr uint32_t instantiated_spec(uint32_t s) {
+  if (!(s & kSpecMedia)) return s;
+  return kSpecMedia | (kSpecSurfaceAll & ~kSpecGuiding) | (s & kSpecGuiding);
+}
+
 template <size_t... I>
 constexpr std::array<TileFn, sizeof...(I)> make_table(std::index_sequence<I...>) {
-  return {&render_tile_spec<static_cast<uint32_t>(I)>...};
+  return {&render_tile_spec<instantiated_spec(static_cast<uint32_t>(I))>...};
 }
 
 // One instantiation per specialisation; chosen once per tile.

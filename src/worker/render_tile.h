@@ -72,6 +72,7 @@ struct TileCounters {
     path.guide_updates += o.path.guide_updates;
     path.guided_roulette += o.path.guided_roulette;
     path.nee_skipped += o.path.nee_skipped;
+    path.medium_vertices += o.path.medium_vertices;
     samples += o.samples;
     zero_radiance += o.zero_radiance;
     rejected_nonfinite += o.rejected_nonfinite;

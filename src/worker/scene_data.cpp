@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "kernels/effects.h"
 #include "kernels/equal_area.h"
 #include "kernels/vecmath.h"
 #include "scene/scene_effects.h"
@@ -27,6 +28,8 @@ SceneData::SceneData(SceneDesc desc) : desc_(std::move(desc)) {
 void SceneData::flatten_meshes() {
   // Per-triangle alpha only for scenes with cutouts.
   for (const MeshDesc& m : desc_.meshes) has_alpha_ |= m.alpha.texture >= 0 || m.alpha.value.x < 1.f;
+  // Per-triangle media only for scenes that have any (the camera's included).
+  has_media_ = (effects_ & kEffectMedia) != 0;
   for (const MeshDesc& m : desc_.meshes) {
     const uint32_t base = static_cast<uint32_t>(positions_.size());
     const bool has_n = !m.n.empty(), has_uv = !m.uv.empty();
@@ -65,6 +68,7 @@ void SceneData::flatten_meshes() {
       }
       triangles_.push_back(ti);
       if (has_alpha_) triangle_alpha_.push_back(m.alpha);
+      if (has_media_) triangle_media_.push_back(m.media);
     }
   }
 }
@@ -198,6 +202,12 @@ void SceneData::build_view() {
   v.num_infinite_lights = static_cast<uint32_t>(infinite_lights_.size());
   v.env_distributions = env_views_.data();
   v.camera = camera_;
+  if (has_media_) {
+    v.media = desc_.media.data();
+    v.num_media = static_cast<uint32_t>(desc_.media.size());
+    v.triangle_media = triangle_media_.data();
+    v.camera_medium = desc_.camera_medium;
+  }
   v.filter.inverse_cdf_x = filter_inverse_cdf_x_.data();
   v.filter.inverse_cdf_y = filter_inverse_cdf_y_.data();
   v.filter.n = static_cast<uint32_t>(filter_inverse_cdf_x_.size());
@@ -244,6 +254,11 @@ uint64_t SceneData::fingerprint() const {
   f.add(&materials, sizeof materials);
   // Cutouts change what the guide sees (only scenes with them add bytes).
   if (has_alpha_) f.add_vector(triangle_alpha_);
+  if (has_media_) {
+    f.add_vector(triangle_media_);
+    f.add_vector(desc_.media);
+    f.add(&desc_.camera_medium, sizeof desc_.camera_medium);
+  }
   return f.h;
 }
 

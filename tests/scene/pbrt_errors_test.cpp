@@ -123,7 +123,7 @@ TEST(PbrtErrors, InfiniteLightArguments) {
 }
 
 TEST(PbrtErrors, UnknownDirectiveOnlyWarns) {
-  SceneDesc s = load_pbrt_string("WorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nFrobnicate [ 1 2 ] \"x\"\n" +
+  SceneDesc s = load_pbrt_string("WorldBegin\nColorSpace \"aces2065-1\"\nFrobnicate [ 1 2 ] \"x\"\n" +
                                      std::string(test::kTriangle),
                                  "ok.pbrt", ".");
   ASSERT_EQ(s.warnings.size(), 2u);

@@ -1,0 +1,67 @@
+// Shadow rays through media (the volumetric integrator's next-event
+// estimation): surfaces with the "interface" material only bound media, so
+// a shadow ray passes them, switching medium where they are transitions, and
+// accumulates each medium's transmittance; any other surface blocks it.
+#pragma once
+
+#include "material.h"
+#include "medium.h"
+#include "scene_view.h"
+#include "surface.h"
+
+namespace tessera {
+
+// Transmittance from o to o + t_max d (d unit length, t_max = kInfinity for
+// infinite lights) starting in `medium`; 0 when a surface blocks. Each ray
+// query counts as a shadow ray.
+template <class Tracer, class Counters>
+TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& tracer, Vec3 o, const Vec3& d,
+                                             Float t_max, int32_t medium, Counters& c) {
+  Rgb tr(1.f);
+  const bool infinite = !(t_max < kInfinity);
+  const Vec3 target = o + t_max * d;
+  // A shadow ray crossing more boundaries than this is treated as blocked.
+  for (int32_t crossing = 0; crossing < 256; ++crossing) {
+    TraceHit hit;
+    ++c.shadow_rays;
+    if (!tracer.intersect(o, d, t_max, &hit)) {
+      if (medium >= 0) tr *= transmittance(medium_sigma_t(s.media[medium]), t_max);
+      return tr;
+    }
+    if (s.materials[s.triangles[hit.triangle].material].type != MaterialType::Interface) return Rgb(0.f);
+    if (medium >= 0) tr *= transmittance(medium_sigma_t(s.media[medium]), hit.t);
+    if (is_black(tr)) return tr;
+    const SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2);
+    const MediumInterface mi = s.triangle_media[hit.triangle];
+    if (is_transition(mi)) medium = medium_towards(mi, h.ng, d);
+    o = offset_ray_origin(h, d);
+    if (!infinite) {
+      t_max = glm::dot(target - o, d);
+      if (!(t_max > 0.f)) return tr;
+    }
+  }
+  return Rgb(0.f);
+}
+
+// The medium a ray leaving triangle tri in direction w travels in: the
+// surface's medium on that side where it is a transition, else `current`.
+TESSERA_HOST_DEVICE inline int32_t medium_after(const SceneView& s, uint32_t tri, const Vec3& ng, const Vec3& w,
+                                                int32_t current) {
+  if (!s.triangle_media) return current;
+  const MediumInterface mi = s.triangle_media[tri];
+  return is_transition(mi) ? medium_towards(mi, ng, w) : current;
+}
+
+// What reaches o from o + t_max d: 1 or 0 from one occlusion query, or, with
+// media, the transmittance through them.
+template <bool kMedia, class Tracer, class Counters>
+TESSERA_HOST_DEVICE Rgb light_visibility(const SceneView& s, const Tracer& tracer, const Vec3& o, const Vec3& d,
+                                         Float t_max, int32_t medium, Counters& c) {
+  if constexpr (kMedia) {
+    if (s.triangle_media) return shadow_transmittance(s, tracer, o, d, t_max, medium, c);
+  }
+  ++c.shadow_rays;
+  return tracer.occluded(o, d, t_max) ? Rgb(0.f) : Rgb(1.f);
+}
+
+}  // namespace tessera

@@ -1,0 +1,99 @@
+// MakeNamedMedium and MediumInterface as pbrt-v4 reads them.
+#include <gtest/gtest.h>
+
+#include "scene/pbrt_loader.h"
+#include "scene/pbrt_media.h"
+
+namespace tessera {
+namespace {
+
+const char* kHead = R"(
+MakeNamedMedium "fog" "string type" "homogeneous" "float scale" 2 "rgb sigma_a" [ 0.1 0.2 0.3 ] "rgb sigma_s" [ 1 2 3 ] "float g" 0.4
+MediumInterface "" "fog"
+LookAt 0 0 -5  0 0 0  0 1 0
+Camera "perspective"
+WorldBegin
+)";
+
+const char* kTriangle = "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 2 ]\n";
+
+TEST(PbrtMedia, HomogeneousParametersAndTheCameraMedium) {
+  SceneDesc d = load_pbrt_string(std::string(kHead) + kTriangle, "<t>", ".");
+  ASSERT_EQ(d.media.size(), 1u);
+  EXPECT_EQ(d.media[0].sigma_a, Rgb(0.2f, 0.4f, 0.6f));  // scale folded in
+  EXPECT_EQ(d.media[0].sigma_s, Rgb(2.f, 4.f, 6.f));
+  EXPECT_FLOAT_EQ(d.media[0].g, 0.4f);
+  EXPECT_EQ(d.camera_medium, 0);  // the outside medium when Camera appears
+  // The interface set before WorldBegin still holds for shapes (pbrt-v4 keeps it).
+  EXPECT_EQ(d.meshes[0].media.inside, -1);
+  EXPECT_EQ(d.meshes[0].media.outside, 0);
+}
+
+TEST(PbrtMedia, InterfacesFollowAttributeBlocksAndOneNameMeansBothSides) {
+  SceneDesc d = load_pbrt_string(std::string(kHead) + "AttributeBegin\nMediumInterface \"fog\"\n" + kTriangle +
+                                     "AttributeEnd\n" + kTriangle,
+                                 "<t>", ".");
+  ASSERT_EQ(d.meshes.size(), 2u);
+  EXPECT_EQ(d.meshes[0].media.inside, 0);
+  EXPECT_EQ(d.meshes[0].media.outside, 0);
+  EXPECT_FALSE(is_transition(d.meshes[0].media));
+  EXPECT_EQ(d.meshes[1].media.inside, -1);
+  EXPECT_EQ(d.meshes[1].media.outside, 0);
+}
+
+TEST(PbrtMedia, DefaultsAndPresetsArepbrtV4s) {
+  SceneDesc d = load_pbrt_string(R"(
+MakeNamedMedium "a" "string type" "homogeneous"
+MakeNamedMedium "milk" "string type" "homogeneous" "string preset" "Wholemilk" "float scale" 10
+LookAt 0 0 -5  0 0 0  0 1 0
+Camera "perspective"
+WorldBegin
+)" + std::string(kTriangle), "<t>", ".");
+  ASSERT_EQ(d.media.size(), 2u);
+  EXPECT_EQ(d.media[0].sigma_a, Rgb(1.f));
+  EXPECT_EQ(d.media[0].sigma_s, Rgb(1.f));
+  EXPECT_EQ(d.media[0].g, 0.f);
+  EXPECT_EQ(d.camera_medium, -1);
+  Rgb a, s;
+  ASSERT_TRUE(medium_preset("Wholemilk", &a, &s));
+  EXPECT_EQ(d.media[1].sigma_a, a * 10.f);
+  EXPECT_EQ(d.media[1].sigma_s, s * 10.f);
+}
+
+TEST(PbrtMedia, GridMediaWarnAndEncloseVacuum) {
+  SceneDesc d = load_pbrt_string(R"(
+MakeNamedMedium "smoke" "string type" "uniformgrid" "integer nx" 1 "integer ny" 1 "integer nz" 1 "float density" [ 1 ]
+LookAt 0 0 -5  0 0 0  0 1 0
+Camera "perspective"
+WorldBegin
+MediumInterface "smoke" ""
+)" + std::string(kTriangle), "<t>", ".");
+  EXPECT_TRUE(d.media.empty());
+  EXPECT_EQ(d.meshes[0].media.inside, -1);
+  bool warned = false;
+  for (const std::string& w : d.warnings) warned |= w.find("uniformgrid") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+void expect_error(const std::string& text, const std::string& needle) {
+  try {
+    load_pbrt_string(text, "scene.pbrt", ".");
+    ADD_FAILURE() << "no error for: " << text;
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("scene.pbrt:", 0), 0u) << e.what();
+  }
+}
+
+TEST(PbrtMedia, BadMediaAreOneLineErrors) {
+  const std::string world = "WorldBegin\n" + std::string(kTriangle);
+  expect_error("MediumInterface \"nowhere\" \"\"\n" + world, "unknown medium \"nowhere\"");
+  expect_error("MakeNamedMedium \"m\" \"float scale\" 1\n" + world, "needs \"string type\"");
+  expect_error("MakeNamedMedium \"m\" \"string type\" \"plasma\"\n" + world, "unknown medium type \"plasma\"");
+  expect_error("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ -1 0 0 ]\n" + world,
+               "must be finite and not negative");
+  expect_error("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float scale\" -2\n" + world, "scale");
+}
+
+}  // namespace
+}  // namespace tessera
