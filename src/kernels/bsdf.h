@@ -8,7 +8,7 @@
 
 namespace tessera {
 
-enum class BsdfType : uint32_t { Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, DiffuseTransmission };
+enum class BsdfType : uint32_t { Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, DiffuseTransmission, CoatedConductor };
 
 // Lobe flags, combinable.
 enum BsdfLobe : uint32_t {
@@ -25,14 +25,15 @@ struct BsdfParams {
   BsdfType type = BsdfType::Diffuse;
   Rgb reflectance{0.5f};  // Diffuse, CoatedDiffuse and DiffuseTransmission albedo, in [0,1]
   Rgb transmittance{0.f}; // DiffuseTransmission, in [0,1]
-  Rgb eta{1.f};           // Conductor: real part of the complex IOR, per channel
-  Rgb k{0.f};             // Conductor: imaginary part
-  Float ior = 1.5f;       // Dielectric / CoatedDiffuse coating: n_inside / n_outside
+  Rgb eta{1.f};           // Conductor, CoatedConductor's base: real part of the complex IOR, per channel
+  Rgb k{0.f};             // ... imaginary part
+  Float ior = 1.5f;       // Dielectric / CoatedDiffuse and CoatedConductor coating: n_inside / n_outside
   Float alpha_x = 0.f;    // GGX (Trowbridge-Reitz) roughness, already remapped;
-  Float alpha_y = 0.f;    // both below kSmoothAlpha means perfectly smooth
+  Float alpha_y = 0.f;    // both below kSmoothAlpha means perfectly smooth (coated BSDFs: the coat's)
+  Float base_alpha_x = 0.f, base_alpha_y = 0.f;  // CoatedConductor: the conductor's GGX roughness
   int32_t bump = -1;      // the material's bump texture (applied by the integrator to the shading normal)
   int32_t normal_map = -1;  // the material's normal map image (likewise)
-  // CoatedDiffuse's layer (pbrt-v4 "thickness", "maxdepth", "nsamples").
+  // The coated BSDFs' layer (pbrt-v4 "thickness", "maxdepth", "nsamples").
   Float thickness = 0.01f;
   uint32_t layer_max_depth = 10;
   uint32_t layer_samples = 1;

@@ -339,6 +339,8 @@ TESSERA_HOST_DEVICE inline bool coated_sample(const BsdfParams& b, const Vec3& w
   return true;
 }
 
+#include "coated_conductor.h"
+
 }  // namespace bsdf_detail
 
 TESSERA_HOST_DEVICE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
@@ -348,6 +350,7 @@ TESSERA_HOST_DEVICE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, co
     case BsdfType::Conductor: return bsdf_detail::conductor_f(b, wo, wi);
     case BsdfType::Dielectric: return bsdf_detail::dielectric_f(b, wo, wi);
     case BsdfType::CoatedDiffuse: return bsdf_detail::coated_f(b, wo, wi);
+    case BsdfType::CoatedConductor: return bsdf_detail::coated_conductor_f(b, wo, wi);
     case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_f(b, wo, wi);
   }
   return Rgb(0.f);
@@ -360,6 +363,7 @@ TESSERA_HOST_DEVICE inline Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, c
     case BsdfType::Conductor: return bsdf_detail::conductor_pdf(b, wo, wi);
     case BsdfType::Dielectric: return bsdf_detail::dielectric_pdf(b, wo, wi);
     case BsdfType::CoatedDiffuse: return bsdf_detail::coated_pdf(b, wo, wi);
+    case BsdfType::CoatedConductor: return bsdf_detail::coated_conductor_pdf(b, wo, wi);
     case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_pdf(b, wo, wi);
   }
   return 0.f;
@@ -376,6 +380,7 @@ TESSERA_HOST_DEVICE inline bool bsdf_sample(const BsdfParams& b, const Vec3& wo,
     case BsdfType::Conductor: ok = bsdf_detail::conductor_sample(b, wo, uc, u, &s); break;
     case BsdfType::Dielectric: ok = bsdf_detail::dielectric_sample(b, wo, uc, u, &s); break;
     case BsdfType::CoatedDiffuse: ok = bsdf_detail::coated_sample(b, wo, uc, u, &s); break;
+    case BsdfType::CoatedConductor: ok = bsdf_detail::coated_conductor_sample(b, wo, uc, u, &s); break;
     case BsdfType::DiffuseTransmission: ok = bsdf_detail::diffuse_transmission_sample(b, wo, uc, u, &s); break;
   }
   // pbrt-v4 BSDF::Sample_f: reject black f, zero pdf and wi in the tangent plane.
@@ -404,6 +409,11 @@ TESSERA_HOST_DEVICE inline uint32_t bsdf_lobes(const BsdfParams& b) {
     case BsdfType::CoatedDiffuse:
       return kLobeReflection | kLobeDiffuse |
              (bsdf_detail::distrib(b).effectively_smooth() ? kLobeSpecular : kLobeGlossy);
+    case BsdfType::CoatedConductor: {
+      const bool coat_smooth = bsdf_detail::distrib(b).effectively_smooth();
+      if (coat_smooth && bsdf_detail::coated_conductor::base_smooth(b)) return kLobeReflection | kLobeSpecular;
+      return kLobeReflection | kLobeGlossy | (coat_smooth ? kLobeSpecular : kLobeNone);
+    }
   }
   return kLobeNone;
 }

@@ -1,7 +1,7 @@
-// pbrt-v4's layered BSDF value (LayeredBxDF::f) for "coateddiffuse": a
-// dielectric interface (smooth or GGX) over a Lambertian base, a thin
-// non-scattering layer between them (transmittance exp(-thickness/|cos|)),
-// two-sided. The value is pbrt-v4's stochastic estimate: a random walk
+// pbrt-v4's layered BSDF value (LayeredBxDF::f) for "coateddiffuse" and
+// "coatedconductor": a dielectric interface (smooth or GGX) over a Lambertian
+// or conductor base, a thin non-scattering layer between them (transmittance
+// exp(-thickness/|cos|)), two-sided. The value is pbrt-v4's stochastic estimate: a random walk
 // between the interfaces with next-event estimation through the exit
 // interface, seeded by the two directions so that f(wo, wi) is a pure
 // function. For a smooth coat its expectation is the layered BSDF; for a
@@ -97,21 +97,71 @@ TESSERA_HOST_DEVICE inline Rng rng_for(const Vec3& wo, const Vec3& wi) {
   return r;
 }
 
+// The base layers the walk below needs: the BSDF value, its density, and a
+// reflection sample (local frame, wo and wi pointing away from the base).
+struct DiffuseBase {
+  Rgb R;
+  TESSERA_HOST_DEVICE bool specular() const { return false; }
+  TESSERA_HOST_DEVICE Rgb f(const Vec3& wo, const Vec3& wi) const {
+    return same_hemisphere(wo, wi) ? R * kInvPi : Rgb(0.f);
+  }
+  TESSERA_HOST_DEVICE Float pdf(const Vec3& wo, const Vec3& wi) const {
+    return same_hemisphere(wo, wi) ? cosine_hemisphere_pdf(abs_cos_theta(wi)) : 0.f;
+  }
+  TESSERA_HOST_DEVICE bool sample(const Vec3& wo, Vec2 u, Vec3* wi, Rgb* f, Float* pdf) const {
+    Vec3 w = sample_cosine_hemisphere(u);
+    if (wo.z < 0.f) w.z = -w.z;
+    *pdf = cosine_hemisphere_pdf(abs_cos_theta(w));
+    if (!(*pdf > 0.f) || w.z == 0.f || is_black(R)) return false;
+    *wi = w;
+    *f = R * kInvPi;
+    return true;
+  }
+};
+
+// pbrt-v4's CoatedConductor base: the conductor's eta and k relative to the
+// coat (divided by the coat's index), its own roughness.
+struct ConductorBase {
+  BsdfParams p;
+  TESSERA_HOST_DEVICE static ConductorBase under_coat(const BsdfParams& coat) {
+    ConductorBase c;
+    c.p = coat;
+    c.p.type = BsdfType::Conductor;
+    c.p.alpha_x = coat.base_alpha_x;
+    c.p.alpha_y = coat.base_alpha_y;
+    c.p.eta = coat.eta / dielectric_eta(coat);
+    c.p.k = coat.k / dielectric_eta(coat);
+    return c;
+  }
+  TESSERA_HOST_DEVICE bool specular() const { return distrib(p).effectively_smooth(); }
+  TESSERA_HOST_DEVICE Rgb f(const Vec3& wo, const Vec3& wi) const { return conductor_f(p, wo, wi); }
+  TESSERA_HOST_DEVICE Float pdf(const Vec3& wo, const Vec3& wi) const { return conductor_pdf(p, wo, wi); }
+  TESSERA_HOST_DEVICE bool sample(const Vec3& wo, Vec2 u, Vec3* wi, Rgb* f, Float* pdf) const {
+    BsdfSample s;
+    if (!conductor_sample(p, wo, 0.f, u, &s) || !(s.pdf > 0.f) || s.wi.z == 0.f) return false;
+    *wi = s.wi;
+    *f = s.f;
+    *pdf = s.pdf;
+    return true;
+  }
+};
+
 }  // namespace layered
 
-// LayeredBxDF<DielectricBxDF, DiffuseBxDF, twoSided = true>::f for reflection
-// (wo and wi in the same hemisphere; transmission through a coated diffuse
-// surface is zero). b.reflectance is the base's albedo.
-TESSERA_HOST_DEVICE inline Rgb coated_diffuse_layered_f(const BsdfParams& b, Vec3 wo, Vec3 wi) {
+// LayeredBxDF<DielectricBxDF, Base, twoSided = true>::f for reflection (wo
+// and wi in the same hemisphere; neither coated BSDF transmits). b is the
+// coat (its roughness, ior, and the layer's thickness, maxdepth, nsamples).
+template <class Base>
+TESSERA_HOST_DEVICE inline Rgb layered_f(const BsdfParams& b, const Base& base, Vec3 wo, Vec3 wi) {
   if (!same_hemisphere(wo, wi)) return Rgb(0.f);
   if (wo.z < 0.f) {  // two-sided
     wo = -wo;
     wi = -wi;
   }
-  const Rgb R = glm::clamp(b.reflectance, Rgb(0.f), Rgb(1.f));
   const Float thickness = glm::max(b.thickness, 1.17549435e-38f);
   const uint32_t n_samples = b.layer_samples > 0 ? b.layer_samples : 1;
   const bool top_specular = dielectric_is_specular(b);
+  const bool base_specular = base.specular();
   // Reflection at the entrance (top) interface: deterministic.
   Rgb f = top_specular ? Rgb(0.f) : Rgb(static_cast<Float>(n_samples) * dielectric_f(b, wo, wi).x);
   Rng rng = layered::rng_for(wo, wi);
@@ -144,31 +194,43 @@ TESSERA_HOST_DEVICE inline Rgb coated_diffuse_layered_f(const BsdfParams& b, Vec
         beta *= bs.f * abs_cos_theta(bs.wi) / bs.pdf;
         w = bs.wi;
       } else {
-        // At the diffuse base: next-event estimation along wis...
-        const Vec3 to_light = -wis.wi;
-        Float wt = 1.f;
-        if (!top_specular) wt = power_heuristic(wis.pdf, diffuse_pdf(b, -w, to_light));
-        if (same_hemisphere(-w, to_light))
-          f += beta * (R * kInvPi) * abs_cos_theta(wis.wi) * wt * layered::transmittance(thickness, wis.wi) *
+        // At the base: next-event estimation along wis (not for a mirror base)...
+        if (!base_specular) {
+          const Vec3 to_light = -wis.wi;
+          Float wt = 1.f;
+          if (!top_specular) wt = power_heuristic(wis.pdf, base.pdf(-w, to_light));
+          f += beta * base.f(-w, to_light) * abs_cos_theta(wis.wi) * wt * layered::transmittance(thickness, wis.wi) *
                (wis.f / wis.pdf);
+        }
         // ...then a new direction from the base.
-        Vec2 u(r(), r());
-        Vec3 wi_base = sample_cosine_hemisphere(u);
-        if (-w.z < 0.f) wi_base.z = -wi_base.z;
-        const Float pdf = cosine_hemisphere_pdf(abs_cos_theta(wi_base));
-        if (!(pdf > 0.f) || wi_base.z == 0.f || is_black(R)) break;
-        beta *= R * kInvPi * abs_cos_theta(wi_base) / pdf;
+        Vec3 wi_base;
+        Rgb f_base;
+        Float pdf = 0.f;
+        if (!base.sample(-w, Vec2(r(), r()), &wi_base, &f_base, &pdf)) break;
+        beta *= f_base * abs_cos_theta(wi_base) / pdf;
         w = wi_base;
         if (!top_specular) {
           // ...and through the rough top along the base's own sample.
           const Float f_exit = dielectric_f(b, -w, wi).x;
           if (f_exit > 0.f) {
-            const Float exit_pdf = layered::interface_transmission_pdf(b, -w, wi);
-            f += beta * layered::transmittance(thickness, w) * f_exit * power_heuristic(pdf, exit_pdf);
+            Float wt = 1.f;
+            if (!base_specular) wt = power_heuristic(pdf, layered::interface_transmission_pdf(b, -w, wi));
+            f += beta * layered::transmittance(thickness, w) * f_exit * wt;
           }
         }
       }
     }
   }
   return finite_or_zero(f / static_cast<Float>(n_samples));
+}
+
+// coateddiffuse: b.reflectance is the base's albedo.
+TESSERA_HOST_DEVICE inline Rgb coated_diffuse_layered_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  return layered_f(b, layered::DiffuseBase{glm::clamp(b.reflectance, Rgb(0.f), Rgb(1.f))}, wo, wi);
+}
+
+// coatedconductor: b.eta / b.k are the conductor's (relative to the outside),
+// b.base_alpha_* its roughness.
+TESSERA_HOST_DEVICE inline Rgb coated_conductor_layered_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  return layered_f(b, layered::ConductorBase::under_coat(b), wo, wi);
 }

@@ -31,7 +31,9 @@ struct ImageView {
   const Rgb* texels = nullptr;
 };
 
-enum class MaterialType : uint32_t { Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, Interface, Mix, DiffuseTransmission };
+enum class MaterialType : uint32_t {
+  Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, Interface, Mix, DiffuseTransmission, CoatedConductor
+};
 
 struct Material {
   MaterialType type = MaterialType::Diffuse;
@@ -42,7 +44,8 @@ struct Material {
   Rgb eta{0.2004f, 0.9240f, 1.1022f};       // conductor eta (pbrt default: metal-Cu)
   Rgb k{3.9129f, 2.4528f, 2.1422f};          // conductor k
   Float ior = 1.5f;                          // dielectric eta / coateddiffuse coating eta
-  Float alpha_x = 0.f, alpha_y = 0.f;        // GGX alpha, remapped from roughness by the loader
+  Float alpha_x = 0.f, alpha_y = 0.f;        // GGX alpha, remapped from roughness by the loader (coated: the coat's)
+  Float base_alpha_x = 0.f, base_alpha_y = 0.f;  // coatedconductor: the conductor's GGX alpha
   // Textured roughness (u, v): evaluated at the hit, then remapped
   // (alpha = sqrt(roughness), pbrt-v4) when remap_roughness. Unused when both are constant.
   TextureSlot roughness_u{-1, Rgb(0.f)}, roughness_v{-1, Rgb(0.f)};
@@ -50,7 +53,7 @@ struct Material {
   int32_t bump = -1;                         // "displacement" float texture (bump mapping), -1 = none
   int32_t normal_map = -1;                   // "normalmap" image (linear RGB), -1 = none; bump wins
   bool remap_roughness = true;
-  Float thickness = 0.01f;                   // coateddiffuse layer (pbrt-v4 defaults)
+  Float thickness = 0.01f;                   // coated materials' layer (pbrt-v4 defaults)
   uint32_t layer_max_depth = 10, layer_samples = 1;
   int32_t mix[2] = {-1, -1};                 // Mix: material indices
   TextureSlot amount{ -1, Rgb(0.5f) };      // Mix: probability of choosing mix[1] (value.x)

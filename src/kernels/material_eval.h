@@ -52,7 +52,8 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
   b.ior = m->ior;
   switch (m->type) {
     case MaterialType::Conductor:
-      b.type = BsdfType::Conductor;
+    case MaterialType::CoatedConductor:
+      b.type = m->type == MaterialType::Conductor ? BsdfType::Conductor : BsdfType::CoatedConductor;
       if (m->conductor_from_reflectance) {
         // pbrt-v4: eta = 1 and k chosen so that normal-incidence reflectance is r.
         Rgb r = glm::clamp(refl, Rgb(0.f), Rgb(0.9999f));
@@ -61,6 +62,13 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
       } else {
         b.eta = m->eta;
         b.k = m->k;
+      }
+      if (m->type == MaterialType::CoatedConductor) {
+        b.base_alpha_x = m->base_alpha_x;
+        b.base_alpha_y = m->base_alpha_y;
+        b.thickness = m->thickness;
+        b.layer_max_depth = m->layer_max_depth;
+        b.layer_samples = m->layer_samples;
       }
       break;
     case MaterialType::Dielectric:

@@ -68,6 +68,23 @@ void read_conductor(Material& m, const ParamSet& params, const DirectiveContext&
   read_roughness(m, params, ctx, prefix);
 }
 
+// The layer of the coated materials: thickness, the random walk's depth and
+// sample count; its scattering medium ("albedo", "g") is not simulated.
+void read_layer(Material& m, const ParamSet& params, const DirectiveContext& ctx, const std::string& type) {
+  m.thickness = constant_float(params, "thickness", 0.01f, ctx);
+  const int max_depth = params.get_int("maxdepth", 10), samples = params.get_int("nsamples", 1);
+  if (!(m.thickness >= 0.f)) ctx.fail(type + " \"thickness\" must not be negative");
+  if (max_depth < 1 || max_depth > 1000) ctx.fail(type + " \"maxdepth\" must be in 1..1000");
+  if (samples < 1 || samples > 1000) ctx.fail(type + " \"nsamples\" must be in 1..1000");
+  m.layer_max_depth = static_cast<uint32_t>(max_depth);
+  m.layer_samples = static_cast<uint32_t>(samples);
+  params.find_any("g");
+  const Param* albedo = params.find_any("albedo");
+  if (albedo && !(albedo->numbers.size() == 3 && albedo->numbers[0] == 0 && albedo->numbers[1] == 0 &&
+                  albedo->numbers[2] == 0) && !(albedo->numbers.size() == 1 && albedo->numbers[0] == 0))
+    ctx.warn(type + " \"albedo\" (a scattering layer) is not supported; the layer only absorbs by its thickness");
+}
+
 }  // namespace
 
 Float roughness_to_alpha(Float roughness) { return std::sqrt(std::max(roughness, 0.f)); }
@@ -89,23 +106,25 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
     m.reflectance = spectrum_slot(params, "reflectance", Rgb(0.5f), ctx);
     m.ior = read_ior(params, "eta", 1.5f, ctx);
     read_roughness(m, params, ctx);
-    m.thickness = constant_float(params, "thickness", 0.01f, ctx);
-    const int max_depth = params.get_int("maxdepth", 10), samples = params.get_int("nsamples", 1);
-    if (!(m.thickness >= 0.f)) ctx.fail("coateddiffuse \"thickness\" must not be negative");
-    if (max_depth < 1 || max_depth > 1000) ctx.fail("coateddiffuse \"maxdepth\" must be in 1..1000");
-    if (samples < 1 || samples > 1000) ctx.fail("coateddiffuse \"nsamples\" must be in 1..1000");
-    m.layer_max_depth = static_cast<uint32_t>(max_depth);
-    m.layer_samples = static_cast<uint32_t>(samples);
-    if (params.find_any("albedo") || params.find_any("g"))
-      ctx.warn("coateddiffuse medium \"albedo\"/\"g\" are not supported; ignored");
+    read_layer(m, params, ctx, type);
   } else if (type == "coatedconductor") {
-    ctx.warn("coatedconductor is approximated by its conductor layer");
+    // The conductor first (its roughness becomes the base's), then the coat.
     read_conductor(m, params, ctx, "conductor.");
     if (m.conductor_from_reflectance == false && params.find_any("reflectance")) {
       m.conductor_from_reflectance = true;
       m.reflectance = spectrum_slot(params, "reflectance", Rgb(1.f), ctx);
     }
-    params.mark_all_used();  // interface.* etc.: approximated away, not unknown
+    if (m.textured_roughness) {
+      ctx.warn("a textured \"conductor.roughness\" is not supported; the conductor is smooth");
+      m.textured_roughness = false;
+      m.alpha_x = m.alpha_y = 0.f;
+    }
+    m.type = MaterialType::CoatedConductor;
+    m.base_alpha_x = m.alpha_x;
+    m.base_alpha_y = m.alpha_y;
+    m.ior = read_ior(params, "interface.eta", 1.5f, ctx);
+    read_roughness(m, params, ctx, "interface.");
+    read_layer(m, params, ctx, type);
   } else if (type == "interface" || type == "none" || type == "") {
     m.type = MaterialType::Interface;
   } else if (type == "mix") {

@@ -23,6 +23,11 @@ void add_material_effects(const SceneDesc& scene, int32_t index, uint32_t& e, in
       e |= kEffectDiffuse;
       if (slot_textured(m.reflectance)) e |= kEffectTextures;
       break;
+    case MaterialType::CoatedConductor:
+      e |= smooth ? kEffectSpecular : kEffectGlossy;
+      if (m.base_alpha_x >= 1e-3f || m.base_alpha_y >= 1e-3f) e |= kEffectGlossy;
+      if (m.conductor_from_reflectance && slot_textured(m.reflectance)) e |= kEffectTextures;
+      break;
     case MaterialType::Conductor:
       e |= smooth ? kEffectSpecular : kEffectGlossy;
       if (m.conductor_from_reflectance && slot_textured(m.reflectance)) e |= kEffectTextures;

@@ -66,6 +66,17 @@ BsdfParams coated(Float a, Rgb r = Rgb(0.7f, 0.45f, 0.2f), Float ior = 1.5f) {
   return b;
 }
 
+// Gold under a clear coat (the corpus's coatedconductor: interface roughness
+// 0.02, conductor roughness 0.002, remapped: alpha 0.141 and 0.045).
+BsdfParams coated_conductor(Float coat_alpha, Float base_alpha, Rgb eta = Rgb(0.143f, 0.374f, 1.442f),
+                            Rgb k = Rgb(3.983f, 2.385f, 1.603f)) {
+  BsdfParams b = conductor(coat_alpha, coat_alpha, eta, k);
+  b.type = BsdfType::CoatedConductor;
+  b.ior = 1.5f;
+  b.base_alpha_x = b.base_alpha_y = base_alpha;
+  return b;
+}
+
 Vec3 spherical(double theta, double phi) {
   return Vec3(Float(std::sin(theta) * std::cos(phi)), Float(std::sin(theta) * std::sin(phi)), Float(std::cos(theta)));
 }
@@ -266,6 +277,15 @@ TEST(BsdfChi2, CoatedDiffuse) {
 
 // The test has teeth: a pdf 10% off in roughness, or a diffuse pdf that ignores
 // the specular-lobe probability, is rejected.
+TEST(BsdfChi2, CoatedConductor) {
+  // The proposal's density, every roughness combination with a non-delta part.
+  for (double t : kWoThetas) {
+    expect_chi2("coated conductor rough/rough", coated_conductor(0.141f, 0.045f), spherical(t, 0.2), 31);
+    expect_chi2("coated conductor smooth/rough", coated_conductor(0.f, 0.2f), spherical(t, 0.2), 32);
+    expect_chi2("coated conductor rough/smooth", coated_conductor(0.3f, 0.f), spherical(t, 0.2), 33);
+  }
+}
+
 TEST(BsdfChi2, DetectsWrongPdf) {
   Vec3 wo = spherical(0.85, 0.7);
   EXPECT_LT(chi2_test(conductor(0.3f, 0.3f), conductor(0.33f, 0.33f), wo, 8).pvalue, 1e-6);
@@ -323,7 +343,12 @@ TEST(BsdfEnergy, AlbedoAtMostOne) {
                              coated(0.2f),
                              coated(0.5f, Rgb(1.f)),
                              coated(0.05f, Rgb(1.f)),
-                             coated(0.f, Rgb(1.f), 2.0f)};
+                             coated(0.f, Rgb(1.f), 2.0f),
+                             coated_conductor(0.141f, 0.045f),
+                             coated_conductor(0.f, 0.2f),
+                             coated_conductor(0.3f, 0.f),
+                             coated_conductor(0.f, 0.f),
+                             coated_conductor(0.5f, 0.5f, Rgb(1.f), Rgb(1000.f))};
   const double thetas[] = {0.05, 0.6, 1.1, 1.45, 1.55};
   for (const BsdfParams& b : cfgs) {
     for (double t : thetas) {
@@ -392,6 +417,21 @@ TEST(BsdfEnergy, WhiteFurnaces) {
     a = albedo(conductor(0.02f, 0.02f, Rgb(1.f), Rgb(1000.f)), wo, 50000, 5, &se);
     EXPECT_NEAR(a.x, 1.0, t < 1.3 ? 0.01 : 0.1);
   }
+  // A white conductor under a clear coat (no layer absorption) is a mirror
+  // with a smooth coat, exactly (the interreflection series sums to 1)...
+  for (double t : {0.1, 0.7, 1.2}) {
+    BsdfParams c = coated_conductor(0.f, 0.f, Rgb(1.f), Rgb(1000.f));
+    c.thickness = 0.f;
+    Rgb se;
+    const Rgb a = albedo(c, spherical(t, 1.0), 1000, 6, &se);
+    EXPECT_NEAR(a.x, 1.0, 1e-3) << "theta " << t;
+    // ...and loses little with a slightly rough base under a long walk, which
+    // the layered estimate (not the series) computes.
+    c.base_alpha_x = c.base_alpha_y = 0.02f;
+    c.layer_max_depth = 1000;
+    const Rgb rough = albedo(c, spherical(t, 1.0), 100000, 7, &se);
+    EXPECT_NEAR(rough.x, 1.0, 0.02 + 4 * se.x) << "theta " << t;
+  }
   // Diffuse with albedo R: exactly R.
   Rgb se;
   Rgb a = albedo(diffuse(Rgb(0.25f, 0.5f, 0.75f)), spherical(0.5, 0), 10000, 9, &se);
@@ -430,9 +470,10 @@ TEST(BsdfReciprocity, Reflection) {
 // is only nearly reciprocal: a few per cent.)
 TEST(BsdfReciprocity, CoatedLayerInExpectation) {
   Rng rng = Rng::for_sample(24, 0, 0);
-  for (Float alpha : {0.f}) {
-    BsdfParams b = coated(alpha);
-    b.layer_samples = 50000;
+  for (int base : {0, 1}) {
+    const Float alpha = 0.f;
+    BsdfParams b = base == 0 ? coated(alpha) : coated_conductor(alpha, 0.2f);
+    b.layer_samples = base == 0 ? 50000 : 400000;
     for (int i = 0; i < 4; ++i) {
       Vec3 wo = sample_uniform_sphere(rng.uniform2()), wi = sample_uniform_sphere(rng.uniform2());
       wo.z = std::abs(wo.z) + 0.2f;
@@ -475,7 +516,8 @@ TEST(BsdfConsistency, SampleMatchesEvalAndPdf) {
   const BsdfParams cfgs[] = {diffuse(Rgb(0.4f)),     conductor(0.05f, 0.05f), conductor(0.3f, 0.3f),
                              conductor(0.1f, 0.4f),  dielectric(0.1f),        dielectric(0.5f),
                              dielectric(0.3f, 1.1f), coated(0.2f),            coated(0.f),
-                             coated(0.6f, Rgb(0.9f), 1.8f), diffuse_transmission(Rgb(0.3f), Rgb(0.6f))};
+                             coated(0.6f, Rgb(0.9f), 1.8f), diffuse_transmission(Rgb(0.3f), Rgb(0.6f)),
+                             coated_conductor(0.141f, 0.045f), coated_conductor(0.f, 0.2f)};
   Rng rng = Rng::for_sample(23, 0, 0);
   for (const BsdfParams& b : cfgs) {
     int checked = 0, bad = 0;
@@ -526,6 +568,9 @@ TEST(BsdfConsistency, LobeFlags) {
   EXPECT_EQ(bsdf_lobes(dielectric(0.2f, 1.f)), kLobeTransmission | kLobeSpecular);
   EXPECT_EQ(bsdf_lobes(coated(0.f)), kLobeReflection | kLobeDiffuse | kLobeSpecular);
   EXPECT_EQ(bsdf_lobes(coated(0.2f)), kLobeReflection | kLobeDiffuse | kLobeGlossy);
+  EXPECT_EQ(bsdf_lobes(coated_conductor(0.f, 0.f)), kLobeReflection | kLobeSpecular);
+  EXPECT_EQ(bsdf_lobes(coated_conductor(0.f, 0.1f)), kLobeReflection | kLobeSpecular | kLobeGlossy);
+  EXPECT_EQ(bsdf_lobes(coated_conductor(0.1f, 0.f)), kLobeReflection | kLobeGlossy);
   // Specular configurations: eval and pdf are zero.
   Vec3 wo = spherical(0.5, 0.1), wi(-wo.x, -wo.y, wo.z);
   EXPECT_TRUE(is_black(bsdf_eval(conductor(0.f, 0.f), wo, wi)));
@@ -587,7 +632,11 @@ TEST(BsdfRobustness, NoNanOrInf) {
                              coated(1.f, Rgb(1.f)),
                              coated(0.f, Rgb(0.f), 1.f),
                              coated(0.2f, Rgb(1.f), 1.f),
-                             coated(0.2f, Rgb(0.5f), 0.8f)};
+                             coated(0.2f, Rgb(0.5f), 0.8f),
+                             coated_conductor(0.f, 0.f),
+                             coated_conductor(1e-3f, 1e-3f),
+                             coated_conductor(0.141f, 0.045f, Rgb(1.f), Rgb(0.f)),
+                             coated_conductor(1.f, 1.f)};
   Rng rng = Rng::for_sample(24, 0, 0);
   auto random_dir = [&](int mode) {
     Vec3 w = sample_uniform_sphere(rng.uniform2());
