@@ -69,13 +69,28 @@ TEST(PbrtMaterials, DielectricCoatedInterfaceMix) {
   EXPECT_TRUE(s.warnings.empty());
 }
 
-TEST(PbrtMaterials, ApproximatedMaterialsWarn) {
+TEST(PbrtMaterials, CoatedConductorKeepsItsCoatAndItsConductor) {
   SceneDesc s = load_world(std::string("Material \"coatedconductor\" \"spectrum conductor.eta\" \"metal-Ag-eta\" "
-                                       "\"spectrum conductor.k\" \"metal-Ag-k\" \"float interface.roughness\" 0.1\n") + kTriangle +
-                           "Material \"diffusetransmission\"\n" + kTriangle);
-  EXPECT_EQ(s.materials[s.meshes[0].material].type, MaterialType::Conductor);
-  EXPECT_VEC3_NEAR(s.materials[s.meshes[0].material].eta, Vec3(0.155f, 0.117f, 0.138f), 1e-3f);
-  EXPECT_EQ(s.warnings.size(), 1u);  // coatedconductor only
+                                       "\"spectrum conductor.k\" \"metal-Ag-k\" \"float interface.roughness\" 0.04 "
+                                       "\"float conductor.roughness\" 0.01 \"float interface.eta\" 1.7 "
+                                       "\"float thickness\" 0.2\n") + kTriangle +
+                           "Material \"coatedconductor\" \"rgb albedo\" [ 0.5 0.5 0.5 ]\n" + kTriangle);
+  const Material& m = s.materials[s.meshes[0].material];
+  EXPECT_EQ(m.type, MaterialType::CoatedConductor);
+  EXPECT_VEC3_NEAR(m.eta, Vec3(0.155f, 0.117f, 0.138f), 1e-3f);
+  EXPECT_FLOAT_EQ(m.alpha_x, 0.2f);        // the coat's, remapped
+  EXPECT_FLOAT_EQ(m.base_alpha_x, 0.1f);   // the conductor's, remapped
+  EXPECT_FLOAT_EQ(m.ior, 1.7f);
+  EXPECT_FLOAT_EQ(m.thickness, 0.2f);
+  // pbrt-v4's defaults: copper under a smooth coat of index 1.5.
+  const Material& d = s.materials[s.meshes[1].material];
+  EXPECT_EQ(d.type, MaterialType::CoatedConductor);
+  EXPECT_FLOAT_EQ(d.ior, 1.5f);
+  EXPECT_EQ(d.alpha_x, 0.f);
+  EXPECT_EQ(d.base_alpha_x, 0.f);
+  // Only the scattering layer (albedo) is approximated, and said so.
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("albedo"), std::string::npos) << s.warnings[0];
 }
 
 TEST(PbrtMaterials, DiffuseTransmission) {
