@@ -17,6 +17,22 @@ variance layer predicts; independent errors add, so this is the error against
 the converged image, and the ratios use it), zero-contribution fraction, mean
 path length, time per sample.
 
+Scenes are shipped scene names or paths to any pbrt-v4 file (`--res` then
+renders every image of the run at that size); the method `auto` is what a
+user gets by default (`--guide auto`: the effects set decides, and the
+learned mixture weight, roulette and NEE probability keep a guide that does
+not pay out of the way). For the "guiding never costs" check:
+
+    scripts/bench_guiding.py --methods none auto --scenes ../shared/public-scenes/cornell-box/cornell-box.pbrt ... \
+        --res 160x120 --no-reference --time 4 --repeats 3
+
+`--no-reference` judges each render by its own variance layer (the relMSE
+it estimates, which for independent samples is unbiased for the error of
+an unbiased render) instead of against a reference: no reference to pay
+for, but fireflies a render did not draw are missed. Renders then use
+independent samples (`--sampler independent`), whose variance estimate is
+not inflated as stratified points' is.
+
 The reference of each scene is an unguided render of --ref-spp samples per
 pixel, made and cached by scripts/reference.py (its command and time are
 recorded beside it), so re-runs only pay for it once. Results: out/bench-guiding/results.json and a
@@ -63,18 +79,29 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench-guiding"))
     ap.add_argument("--results", default="results.json", help="file name of the results, in --out")
     ap.add_argument("--guide-args", default="", help="extra options for the guided methods, e.g. '--guide-budget 4'")
+    ap.add_argument("--res", default="", help="WxH for every render of the run, references included")
+    ap.add_argument("--no-reference", action="store_true",
+                    help="judge renders by their own estimated relMSE (independent samples) instead of a reference")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     threads = ["--threads", str(a.threads)] if a.threads else []
 
     results = {"guide_args": a.guide_args, "time_budget_s": a.time, "repeats": a.repeats, "threads": a.threads or os.cpu_count(),
                "ref_spp": a.ref_spp, "scenes": {}}
-    for scene in a.scenes:
-        path = os.path.join(ROOT, "scenes", scene + ".pbrt")
-        ref, meta = ref_cache.reference(path, spp=a.ref_spp, tessera=a.tessera, threads=a.threads,
-                                        log=lambda m: print(f"[{scene}] {m}", flush=True))
-        entry = {"reference": {"spp": meta["spp"], "seconds": meta["seconds"], "noise": meta["estimated_relmse"]},
-                 "methods": {}}
+    res = ["--res", a.res] if a.res else []
+    for scene_arg in a.scenes:
+        if scene_arg.endswith(".pbrt"):
+            path = os.path.abspath(scene_arg)
+            scene = os.path.splitext(os.path.basename(path))[0]
+        else:
+            path = os.path.join(ROOT, "scenes", scene_arg + ".pbrt")
+            scene = scene_arg
+        entry = {"methods": {}}
+        if not a.no_reference:
+            ref, meta = ref_cache.reference(path, spp=a.ref_spp, tessera=a.tessera, threads=a.threads, extra_args=res,
+                                            log=lambda m: print(f"[{scene}] {m}", flush=True))
+            entry["reference"] = {"spp": meta["spp"], "seconds": meta["seconds"], "noise": meta["estimated_relmse"]}
+        sampler = ["--sampler", "independent"] if a.no_reference else []
         for method in a.methods:
             rows = []
             for rep in range(a.repeats):
@@ -83,9 +110,12 @@ def main():
                 extra = a.guide_args.split() if method != "none" else []
                 method_args = METHOD_ARGS.get(method, ["--guide", method])
                 run([a.tessera, "render", path, "-q", "--no-preview", *method_args, "--time", str(a.time),
-                     "--seed", str(rep + 1), "--stats", st, "-o", img, *threads, *extra])
+                     "--seed", str(rep + 1), "--stats", st, "-o", img, *threads, *extra, *res, *sampler])
                 s = json.load(open(st))
-                c = compare(a.tessera, img, ref)
+                if a.no_reference:
+                    c = {"relmse": s["estimated_relmse"], "reference_estimated_relmse": 0.0}
+                else:
+                    c = compare(a.tessera, img, ref)
                 pixels = s["width"] * s["height"]
                 # The reference's own noise adds to every measured relMSE (independent errors add);
                 # subtracting its estimate leaves the error against the converged image.
@@ -134,6 +164,17 @@ def main():
             e["ratio_time_per_sample_throughput_roulette"] = t["ns_per_sample"] / max(m["none"]["ns_per_sample"], 1e-30)
             print(f"{'':12s}  with throughput roulette: {e['ratio_relmse_throughput_roulette_vs_none']:8.3f}"
                   f"   time/sample {e['ratio_time_per_sample_throughput_roulette']:6.2f}")
+    # The default (--guide auto) against plain path tracing: guiding must never cost.
+    rows = [(scene, e) for scene, e in results["scenes"].items() if "auto" in e["methods"] and "none" in e["methods"]]
+    if rows:
+        print("\nscene                    relMSE auto/none (raw)   verdict (auto must not be worse than none)")
+        for scene, e in rows:
+            m = e["methods"]
+            ratio = m["auto"]["relmse_vs_truth"] / max(m["none"]["relmse_vs_truth"], 1e-30)
+            raw = m["auto"]["relmse"] / max(m["none"]["relmse"], 1e-30)
+            e["ratio_relmse_auto_vs_none"] = ratio
+            e["ratio_relmse_auto_vs_none_raw"] = raw
+            print(f"{scene:24s} {ratio:8.3f} ({raw:.3f})        {'ok' if ratio <= 1.0 else 'WORSE'}")
     with open(os.path.join(a.out, a.results), "w") as f:
         json.dump(results, f, indent=2)
     print(f"\nwrote {os.path.join(a.out, a.results)}")

@@ -32,6 +32,9 @@ int run_info(const std::string& path) {
   std::printf("lights:         %u (%u emissive triangles", v.num_lights, area);
   for (auto& [k, n] : light_kinds) std::printf(", %d %s", n, k.c_str());
   std::printf(")\n");
+  if (!scene.desc().media.empty() || scene.desc().camera_medium >= 0)
+    std::printf("media:          %zu homogeneous%s\n", scene.desc().media.size(),
+                scene.desc().camera_medium >= 0 ? ", the camera in one" : "");
   const Bounds& b = scene.bounds();
   if (scene.num_triangles() > 0)
     std::printf("bounds:         (%g, %g, %g) - (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);

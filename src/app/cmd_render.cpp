@@ -134,6 +134,8 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   if (scene_bytes) *scene_bytes = encode_scene(desc);
   m.scene = std::make_unique<SceneData>(std::move(desc));
   m.guide = make_guide(a.guide, *m.scene, &m.guide_why);
+  // The default must not cost: a trial decides whether the guide pays.
+  m.opt.guide_trial = m.guide && a.guide.mode == "auto";
   m.options_fingerprint = render_options_fingerprint(m.opt, m.scene->view().camera.width, m.scene->view().camera.height,
                                                      m.guide ? (m.guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable") : "none") ^
                           m.scene->film_fingerprint();
@@ -253,6 +255,14 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
                  static_cast<unsigned long long>(g.cells), g.bytes / 1048576.0, static_cast<unsigned long long>(g.updates),
                  static_cast<unsigned long long>(g.rejected_nonfinite + g.rejected_large),
                  g.budget_reached ? ", memory budget reached" : "");
+    const GuideTrial& t = r.stats.guide_trial;
+    if (t.state == GuideTrialState::Kept || t.state == GuideTrialState::SwitchedOff)
+      std::fprintf(stderr,
+                   "tessera: --guide auto trial (%llu guided and %llu unguided samples): relative variance x cost "
+                   "per sample %.3g guided, %.3g unguided: guiding %s\n",
+                   static_cast<unsigned long long>(t.samples[1]), static_cast<unsigned long long>(t.samples[0]),
+                   t.inefficiency[1], t.inefficiency[0],
+                   t.state == GuideTrialState::Kept ? "kept" : "switched off for the rest of the render");
     if (r.stats.ranks > 1 && r.stats.guide_syncs > 0)
       std::fprintf(stderr, "tessera: guide sync: %u all-reductions of %.2f MB, %.3fs (%.1f%% of the render)\n",
                    r.stats.guide_syncs, r.stats.guide_sync_bytes / 1048576.0, r.stats.guide_sync_seconds,

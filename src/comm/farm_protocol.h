@@ -3,7 +3,9 @@
 //   setup     master -> all (broadcast): the parsed scene and the guide
 //             cache every rank starts from, or the error that stops them.
 //   Hello     worker -> master: how many threads it renders with.
-//   PassStart master -> worker: a pass begins (sample range is in the jobs).
+//   PassStart master -> worker: a pass begins (sample range is in the jobs),
+//             with the integrator specialisation it runs (--guide auto's
+//             trial renders some passes unguided).
 //   Request   worker -> master: the tiles it finished (pixel accumulators
 //             and counters) and a request for `capacity` more. A worker
 //             keeps kRequestsInFlight requests open so it never waits idle
@@ -15,8 +17,9 @@
 //   Stop      master -> worker: the render is over.
 //   Error     worker -> master: a worker failed (the master reports it and
 //             ends the job).
-// After a pass, every rank all-reduces the guide's accumulators (--guide-sync
-// pass) and folds them: identical sums, identical fields on every rank.
+// After a guided pass, every rank all-reduces the guide's accumulators
+// (--guide-sync pass) and folds them: identical sums, identical fields on
+// every rank. After an unguided pass, none does.
 #pragma once
 
 #include <string>
@@ -82,6 +85,15 @@ struct FarmError {
   template <class Archive>
   void serialize(Archive& ar) {
     ar(message);
+  }
+};
+
+struct FarmPassStart {
+  uint32_t specialisation = 0;
+  bool guided_roulette = false;
+  template <class Archive>
+  void serialize(Archive& ar) {
+    ar(specialisation, guided_roulette);
   }
 };
 

@@ -10,7 +10,9 @@ namespace tessera {
 namespace {
 
 constexpr char kMagic[] = "tessera-checkpoint";
-constexpr uint32_t kVersion = 3;  // 2: per-pass error estimates; 3: next-event skip counter, guide cache v2
+// 2: per-pass error estimates; 3: next-event skip counter, guide cache v2; 4: medium
+// vertex counter, --guide auto's trial
+constexpr uint32_t kVersion = 4;
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.
 uint64_t fnv1a(const std::string& s) {
@@ -29,6 +31,7 @@ struct CheckpointBody {
     ar(s.spp, s.passes, s.seconds, raw_value(s.counters), raw(s.pass_stats), s.guide_fold_seconds, s.guide_sync_seconds,
        s.guide_syncs);
     ar(s.estimated_rel_mse, s.pass_end_seconds);
+    ar(raw_value(s.guide_trial));
     ar(c->guide);
   }
 };
@@ -40,6 +43,7 @@ uint64_t render_options_fingerprint(const RenderOptions& o, int32_t width, int32
   s << width << 'x' << height << ' ' << o.seed << ' ' << o.max_depth << ' ' << o.nee << ' ' << o.max_pass_spp << ' '
     << o.guide_learn.all_spp << ' ' << o.guide_learn.every << ' ' << o.guide_roulette << ' ' << guide_mode << ' '
     << o.force_full_specialisation;
+  if (o.guide_trial) s << " trial";
   if (o.guide_roulette_window != kGuidedRouletteWindow) s << " window " << o.guide_roulette_window;
   // Checkpoints from before the taper learned every K-th sample throughout.
   if (o.guide_learn.taper) s << " taper";

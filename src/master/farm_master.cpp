@@ -48,7 +48,8 @@ FarmMaster::FarmMaster(Transport& transport, const EmbreeScene& embree, const Sc
 void FarmMaster::render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film,
                              TileCounters* counters, const std::function<void(uint64_t)>& on_tile_done) {
   const int32_t workers = transport_.size() - 1;
-  for (int32_t r = 1; r <= workers; ++r) transport_.send(r, kTagPassStart, encode(FarmEmpty{}));
+  const FarmPassStart start{settings.specialisation, settings.path.guided_roulette};
+  for (int32_t r = 1; r <= workers; ++r) transport_.send(r, kTagPassStart, encode(start));
 
   // One queue of tiles for the workers and the master's own threads. There
   // is no communication thread: between tiles, whichever rendering thread

@@ -112,6 +112,8 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
 
   stats.target_error = opt.target_error;
   if (guide) stats.guide_mode = guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable";
+  if (guide && opt.guide_trial && stats.guide_trial.state == GuideTrialState::Off)
+    stats.guide_trial.state = GuideTrialState::Pending;
   if (!stats.pass_stats.empty()) progress.set_error(stats.estimated_rel_mse, opt.target_error);
 
   uint32_t spp_done = stats.spp;
@@ -133,16 +135,34 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
     if (opt.spp > 0) pass_spp = std::min(pass_spp, opt.spp - spp_done);
     const double pass_start = elapsed();
     const TileCounters before = stats.counters;
-    if (guide) settings.path.guide = guide->view();
+    // Guided unless this is an unguided trial pass or the trial switched guiding off.
+    const TrialPass trial_pass = guide_trial_next_pass(stats.guide_trial, spp_done);
+    const bool guided = guide && trial_pass != TrialPass::Unguided &&
+                        stats.guide_trial.state != GuideTrialState::SwitchedOff;
+    TileSettings pass_settings = settings;
+    if (guided) {
+      pass_settings.path.guide = guide->view();
+    } else {
+      pass_settings.specialisation &= ~kSpecGuiding;
+      pass_settings.path.guided_roulette = false;
+    }
+    std::vector<PixelAccum> film_before;
+    if (trial_pass != TrialPass::None) film_before = result.film.pixels;
     std::vector<TileJob> jobs = tiles;
     for (TileJob& job : jobs) {
       job.sample_begin = spp_done;
       job.sample_end = spp_done + pass_spp;
     }
-    executor->render_pass(settings, jobs, result.film, &stats.counters, [&](uint64_t samples) {
+    executor->render_pass(pass_settings, jobs, result.film, &stats.counters, [&](uint64_t samples) {
       progress.advance(samples_done.fetch_add(samples) + samples, spp_done);
     });
-    if (guide) {
+    if (trial_pass != TrialPass::None) {
+      const TileCounters& now = stats.counters;
+      guide_trial_record(stats.guide_trial, trial_pass == TrialPass::Guided, result.film, film_before,
+                         now.samples - before.samples,
+                         now.path.rays + now.path.shadow_rays - before.path.rays - before.path.shadow_rays);
+    }
+    if (guided) {
       const double fold_start = elapsed();
       executor->reduce_guide(*guide);
       guide->fold();

@@ -11,6 +11,7 @@
 
 #include "guidecache/guide_field.h"
 #include "master/film.h"
+#include "master/guide_trial.h"
 #include "worker/embree_backend.h"
 #include "worker/render_tile.h"
 #include "worker/scene_data.h"
@@ -32,6 +33,9 @@ struct RenderOptions {
   bool guide_roulette = true;   // guide-driven Russian roulette (guided renders)
   float guide_roulette_window = kGuidedRouletteWindow;  // its window (PathSettings::guided_roulette_window)
   bool force_full_specialisation = false;  // benchmark switch: ignore the effects set
+  // --guide auto: guided and unguided passes are compared once the guide has
+  // learned, and the render goes on with the cheaper (master/guide_trial.h).
+  bool guide_trial = false;
   bool progress = true;
 };
 
@@ -72,6 +76,7 @@ struct RenderStats {
   GuideLearnSchedule guide_learn;  // the learning schedule the render ran with
   bool guide_roulette = false;     // whether guide-driven roulette was on
   float guide_roulette_window = 0.f;  // and its window
+  GuideTrial guide_trial;          // --guide auto's comparison of guided and unguided passes
 };
 
 struct RenderResult {

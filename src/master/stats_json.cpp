@@ -104,6 +104,13 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
     j.add("guide_mean_mix", s.guide.mean_mix);
     j.add("guide_mix_samples_out_of_range", s.guide.mix_out_of_range);
     j.add_string("guide_nee", s.guide.learned_nee ? "learned" : "always");
+    // --guide auto's trial: none | pending (not reached) | kept | switched-off
+    static const char* trial_states[] = {"none", "pending", "kept", "switched-off"};
+    j.add_string("guide_trial", trial_states[static_cast<uint32_t>(s.guide_trial.state) & 3u]);
+    if (s.guide_trial.state == GuideTrialState::Kept || s.guide_trial.state == GuideTrialState::SwitchedOff) {
+      j.add("guide_trial_guided_inefficiency", s.guide_trial.inefficiency[1]);
+      j.add("guide_trial_unguided_inefficiency", s.guide_trial.inefficiency[0]);
+    }
     j.add("nee_skipped_fraction",
           c.path.vertices > 0 ? double(c.path.nee_skipped) / double(c.path.vertices) : 0.0);
     j.add("guided_sample_fraction",

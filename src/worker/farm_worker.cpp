@@ -60,9 +60,13 @@ void run_farm_worker(Transport& t, const SceneView& view, const EmbreeScene& emb
       Message m = t.receive(0);
       if (m.tag == kTagStop) return;
       if (m.tag != kTagPassStart) throw std::runtime_error("unexpected message from the master");
-      if (guide) settings.path.guide = guide->view();
+      const FarmPassStart start = decode<FarmPassStart>(m.bytes);
+      settings.specialisation = start.specialisation;
+      settings.path.guided_roulette = start.guided_roulette;
+      const bool guided = guide && (start.specialisation & kSpecGuiding) != 0;
+      if (guided) settings.path.guide = guide->view();
       render_pass_tiles(t, view, tracer, settings, arena, capacity);
-      if (guide) {
+      if (guided) {
         if (sync_guide) t.allreduce_sum(guide->accumulators());
         guide->fold();
       }

@@ -103,6 +103,25 @@ TEST(FarmProtocol, SharedGuideGivesTheLocalImageAndFieldOnEveryRank) {
   }
 }
 
+// --guide auto's trial renders some passes unguided (and may switch guiding
+// off): the workers follow the master's specialisation pass by pass, and
+// fold only after guided passes, so the farm still gives the local image.
+TEST(FarmProtocol, GuideTrialGivesTheLocalImageAndDecisionForAnyRankCount) {
+  FarmScene fs(door_ajar());
+  fs.opt.spp = kGuideTrialStartSpp + 2 * kGuideTrialPassesPerMethod * 8 + 8;
+  fs.opt.guide_trial = true;
+  auto local_guide = fs.make_guide();
+  RenderResult local = render(fs.scene, fs.embree, fs.opt, local_guide.get());
+  ASSERT_NE(local.stats.guide_trial.state, GuideTrialState::Pending);
+  for (int32_t ranks : {2, 3}) {
+    FarmRun farm = render_farm(fs, ranks, true, true);
+    EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
+    expect_same_counters(farm.result.stats.counters, local.stats.counters);
+    EXPECT_EQ(farm.result.stats.guide_trial.state, local.stats.guide_trial.state);
+    for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(*farm.guides[r] == *local_guide) << "rank " << r;
+  }
+}
+
 TEST(FarmProtocol, GuideSyncOffLetsEachRankLearnAlone) {
   FarmScene fs(door_ajar());
   FarmRun shared = render_farm(fs, 3, true, true);
