@@ -93,6 +93,9 @@ def main():
         if scene_arg.endswith(".pbrt"):
             path = os.path.abspath(scene_arg)
             scene = os.path.splitext(os.path.basename(path))[0]
+            parent = os.path.basename(os.path.dirname(path))
+            if parent != scene:  # cornell-box/volumetric-caustic and volumetric-caustic/volumetric-caustic
+                scene = f"{parent}-{scene}"
         else:
             path = os.path.join(ROOT, "scenes", scene_arg + ".pbrt")
             scene = scene_arg

@@ -14,6 +14,10 @@ void serialize(Archive& ar, ImageDesc& i) {
   ar(i.width, i.height, raw(i.texels), i.path);
 }
 template <class Archive>
+void serialize(Archive& ar, GridDesc& g) {
+  ar(raw_value(g.medium_from_world), raw_value(g.p0), raw_value(g.p1), g.nx, g.ny, g.nz, raw(g.density), g.max_density);
+}
+template <class Archive>
 void serialize(Archive& ar, SceneDesc& d) {
   ar(raw_value(d.camera.world_from_camera), d.camera.fov_degrees, d.camera.lens_radius, d.camera.focal_distance,
      d.camera.where);
@@ -21,7 +25,7 @@ void serialize(Archive& ar, SceneDesc& d) {
   ar(d.sampler, d.camera.exposure_time, d.film.iso, d.film.whitebalance, d.film.sensor, d.film.max_component_value,
      raw_value(d.film.pixel_from_radiance), raw_value(d.film.sensor_from_radiance), raw_value(d.film.pixel_from_sensor));
   ar(d.meshes, raw(d.materials), raw(d.textures), d.images, raw(d.area_lights), raw(d.lights), d.warnings, d.source);
-  ar(raw(d.media), d.camera_medium);
+  ar(raw(d.media), d.camera_medium, d.grids);
 }
 
 Bytes encode_scene(const SceneDesc& desc) { return encode(desc); }

@@ -175,15 +175,15 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         const Medium& m = s.media[medium];
         const Float t_max = found ? hit.t : kInfinity;
         if (medium_absorbs_only(m)) {
-          // Exact transmittance: no collision to sample, no path ended by absorption.
-          const Rgb T = transmittance(medium_sigma_t(m), t_max);
+          // Its transmittance: no collision to sample, no path ended by absorption.
+          const Rgb T = medium_transmittance(s, medium, ray.o, ray.d, t_max);
           beta *= T;
           rr_beta *= T;
           segment_tr = luminance(T);
         } else {
           const Float u_channel = rng.uniform();
           const Float u_dist = rng.uniform();
-          const MediumSegment seg = sample_medium_segment(m, t_max, u_channel, u_dist);
+          const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist);
           if (depth < settings.max_depth) L += beta * seg.emitted;
           beta *= seg.weight;
           rr_beta *= seg.weight;

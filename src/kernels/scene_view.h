@@ -5,6 +5,7 @@
 #include "distribution.h"
 #include "light.h"
 #include "material.h"
+#include "grid_medium.h"
 #include "medium.h"
 
 namespace tessera {
@@ -82,6 +83,7 @@ struct SceneView {
   uint32_t num_media = 0;
   const MediumInterface* triangle_media = nullptr;  // per triangle
   int32_t camera_medium = -1;                       // -1: vacuum
+  const DensityGridView* grids = nullptr;           // of the grid media
 
   CameraView camera;
   FilterView filter;

@@ -11,6 +11,22 @@
 
 namespace tessera {
 
+// Transmittance of `medium` along o + t d, t in [0, t_max]: exact for a
+// homogeneous medium, a ratio-tracking estimate for a grid.
+TESSERA_HOST_DEVICE inline Rgb medium_transmittance(const SceneView& s, int32_t medium, const Vec3& o, const Vec3& d,
+                                                    Float t_max) {
+  const Medium& m = s.media[medium];
+  if (m.grid >= 0) return grid_transmittance(m, s.grids[m.grid], o, d, t_max);
+  return transmittance(medium_sigma_t(m), t_max);
+}
+
+// One collision sample on a segment through `m` (medium.h, grid_medium.h).
+TESSERA_HOST_DEVICE inline MediumSegment sample_medium(const SceneView& s, const Medium& m, const Vec3& o, const Vec3& d,
+                                                       Float t_max, Float u_channel, Float u_dist) {
+  if (m.grid >= 0) return sample_grid_segment(m, s.grids[m.grid], o, d, t_max, u_dist);
+  return sample_medium_segment(m, t_max, u_channel, u_dist);
+}
+
 // Transmittance from o to o + t_max d (d unit length, t_max = kInfinity for
 // infinite lights) starting in `medium`; 0 when a surface blocks. Each ray
 // query counts as a shadow ray.
@@ -25,11 +41,11 @@ TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& t
     TraceHit hit;
     ++c.shadow_rays;
     if (!tracer.intersect(o, d, t_max, &hit)) {
-      if (medium >= 0) tr *= transmittance(medium_sigma_t(s.media[medium]), t_max);
+      if (medium >= 0) tr *= medium_transmittance(s, medium, o, d, t_max);
       return tr;
     }
     if (s.materials[s.triangles[hit.triangle].material].type != MaterialType::Interface) return Rgb(0.f);
-    if (medium >= 0) tr *= transmittance(medium_sigma_t(s.media[medium]), hit.t);
+    if (medium >= 0) tr *= medium_transmittance(s, medium, o, d, hit.t);
     if (is_black(tr)) return tr;
     const SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2);
     const MediumInterface mi = s.triangle_media[hit.triangle];

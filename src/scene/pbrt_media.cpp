@@ -71,6 +71,34 @@ bool valid_coefficient(const Rgb& c) {
   return true;
 }
 
+// pbrt-v4's GridMedium: "density" (nx * ny * nz floats, x fastest) over
+// the box p0..p1 of the medium's space.
+int32_t read_grid(const ParamSet& params, const Mat4& world_from_medium, const DirectiveContext& ctx) {
+  GridDesc g;
+  g.density = params.get_floats("density");
+  if (g.density.empty()) ctx.fail("uniformgrid medium needs \"float density\" values");
+  g.nx = params.get_int("nx", 1);
+  g.ny = params.get_int("ny", 1);
+  g.nz = params.get_int("nz", 1);
+  if (g.nx < 1 || g.ny < 1 || g.nz < 1) ctx.fail("uniformgrid \"nx\", \"ny\" and \"nz\" must be positive");
+  const uint64_t n = static_cast<uint64_t>(g.nx) * static_cast<uint64_t>(g.ny) * static_cast<uint64_t>(g.nz);
+  if (n != g.density.size())
+    ctx.fail("uniformgrid has " + std::to_string(g.density.size()) + " density values; nx*ny*nz = " + std::to_string(n));
+  for (Float d : g.density) {
+    if (!(d >= 0.f) || !std::isfinite(d)) ctx.fail("uniformgrid densities must be finite and not negative");
+    g.max_density = std::max(g.max_density, d);
+  }
+  g.p0 = params.get_point3("p0").value_or(Vec3(0.f));
+  g.p1 = params.get_point3("p1").value_or(Vec3(1.f));
+  if (!(g.p1.x > g.p0.x && g.p1.y > g.p0.y && g.p1.z > g.p0.z)) ctx.fail("uniformgrid needs p0 < p1 on every axis");
+  if (glm::determinant(world_from_medium) == 0.f) ctx.fail("the medium's transform is singular");
+  g.medium_from_world = glm::inverse(world_from_medium);
+  if (params.find_any("temperature") || params.get_floats("Lescale").size() > 1)
+    ctx.warn("uniformgrid emission grids (\"temperature\", per-voxel \"Lescale\") are not supported; Le is uniform");
+  ctx.scene.grids.push_back(std::move(g));
+  return static_cast<int32_t>(ctx.scene.grids.size() - 1);
+}
+
 }  // namespace
 
 bool medium_preset(const std::string& name, Rgb* sigma_a, Rgb* sigma_s) {
@@ -84,9 +112,10 @@ bool medium_preset(const std::string& name, Rgb* sigma_a, Rgb* sigma_s) {
   return false;
 }
 
-std::optional<Medium> make_medium(const std::string& type, const ParamSet& params, const DirectiveContext& ctx) {
-  if (type != "homogeneous") {
-    if (type == "uniformgrid" || type == "rgbgrid" || type == "cloud" || type == "nanovdb") {
+std::optional<Medium> make_medium(const std::string& type, const ParamSet& params, const Mat4& world_from_medium,
+                                  const DirectiveContext& ctx) {
+  if (type != "homogeneous" && type != "uniformgrid") {
+    if (type == "rgbgrid" || type == "cloud" || type == "nanovdb") {
       ctx.warn("medium \"" + type + "\" is not simulated; shapes bounding it enclose vacuum");
       params.mark_all_used();
       return std::nullopt;
@@ -114,11 +143,14 @@ std::optional<Medium> make_medium(const std::string& type, const ParamSet& param
   m.sigma_s = sigma_s * scale;
   if (!valid_coefficient(m.sigma_a) || !valid_coefficient(m.sigma_s))
     ctx.fail("medium sigma_a and sigma_s must be finite and not negative");
-  m.Le = params.get_rgb("Le").value_or(Rgb(0.f)) * params.get_float("Lescale", 1.f);
+  // One "Lescale" scales Le (a per-voxel grid of them is not supported: read_grid warns).
+  const std::vector<Float> le_scale = params.get_floats("Lescale");
+  m.Le = params.get_rgb("Le").value_or(Rgb(0.f)) * (le_scale.size() == 1 ? le_scale[0] : 1.f);
   if (!valid_coefficient(m.Le)) ctx.fail("medium \"Le\" must be finite and not negative");
   m.g = params.get_float("g", 0.f);
   if (!std::isfinite(m.g)) ctx.fail("medium \"g\" must be finite");
   m.g = std::clamp(m.g, -0.99f, 0.99f);  // pbrt-v4 clamps too: |g| = 1 is a delta
+  if (type == "uniformgrid") m.grid = read_grid(params, world_from_medium, ctx);
   return m;
 }
 

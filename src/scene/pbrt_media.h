@@ -1,5 +1,6 @@
 // pbrt-v4 MakeNamedMedium: "homogeneous" media (sigma_a, sigma_s, scale, g,
-// Le, Lescale, and pbrt's measured "preset" names).
+// Le, Lescale, and pbrt's measured "preset" names) and "uniformgrid" ones
+// (the same, scaled by a density grid over a box).
 #pragma once
 
 #include <optional>
@@ -9,9 +10,11 @@
 
 namespace tessera {
 
-// nullopt (with a warning) for the grid media (uniformgrid, rgbgrid, cloud,
-// nanovdb), which are not simulated: shapes bounding them then enclose vacuum.
-std::optional<Medium> make_medium(const std::string& type, const ParamSet& params, const DirectiveContext& ctx);
+// A uniformgrid's densities are added to ctx.scene.grids, its box placed by
+// world_from_medium (the CTM). nullopt (with a warning) for rgbgrid, cloud
+// and nanovdb, which are not simulated: shapes bounding them enclose vacuum.
+std::optional<Medium> make_medium(const std::string& type, const ParamSet& params, const Mat4& world_from_medium,
+                                  const DirectiveContext& ctx);
 
 // A preset's scattering and absorption coefficients in mm^-1, as pbrt-v4's
 // GetMediumScatteringProperties gives them; false for an unknown name.

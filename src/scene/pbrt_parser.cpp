@@ -360,7 +360,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     std::string type = ps.get_string("type", "");
     if (type.empty()) fail(at, "MakeNamedMedium \"" + name + "\" needs \"string type\"");
     if (names_.media.count(name)) warn("named medium \"" + name + "\" redefined");
-    if (std::optional<Medium> m = make_medium(type, ps, context(at, including_dir))) {
+    if (std::optional<Medium> m = make_medium(type, ps, ctm, context(at, including_dir))) {
       if (scene_.media.size() >= static_cast<size_t>(INT16_MAX)) fail(at, "too many media (at most 32767)");
       scene_.media.push_back(*m);
       names_.media[name] = static_cast<int32_t>(scene_.media.size() - 1);

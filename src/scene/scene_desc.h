@@ -49,6 +49,15 @@ struct ImageDesc {
   std::string path;
 };
 
+// A uniformgrid medium's densities (Medium::grid indexes these).
+struct GridDesc {
+  Mat4 medium_from_world{1.f};  // inverse of the CTM at MakeNamedMedium
+  Vec3 p0{0.f}, p1{1.f};
+  int32_t nx = 1, ny = 1, nz = 1;
+  std::vector<Float> density;  // nx * ny * nz, x fastest
+  Float max_density = 0.f;
+};
+
 struct CameraDesc {
   Mat4 world_from_camera{1.f};  // pbrt camera space: x right, y up, z forward (left-handed)
   Float fov_degrees = 90.f;     // pbrt-v4: angle spanned by the shorter image axis
@@ -106,6 +115,7 @@ struct SceneDesc {
   std::vector<AreaLightDesc> area_lights;
   std::vector<Light> lights;        // point, spot, distant, infinite (area lights come from meshes)
   std::vector<Medium> media;        // MakeNamedMedium, in order of definition
+  std::vector<GridDesc> grids;      // of the uniformgrid media
   int32_t camera_medium = -1;       // the medium the camera sits in (pbrt-v4: the outside medium at Camera)
   std::vector<std::string> warnings;  // "file:line: message", in order of appearance
   std::string source;               // file name, or "<builtin:cornell-box>"

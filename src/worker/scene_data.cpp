@@ -207,6 +207,20 @@ void SceneData::build_view() {
     v.num_media = static_cast<uint32_t>(desc_.media.size());
     v.triangle_media = triangle_media_.data();
     v.camera_medium = desc_.camera_medium;
+    for (const GridDesc& g : desc_.grids) {
+      DensityGridView gv;
+      gv.medium_from_world = Mat3(g.medium_from_world);
+      gv.medium_from_world_offset = Vec3(g.medium_from_world[3]);
+      gv.p0 = g.p0;
+      gv.p1 = g.p1;
+      gv.nx = g.nx;
+      gv.ny = g.ny;
+      gv.nz = g.nz;
+      gv.density = g.density.data();
+      gv.max_density = g.max_density;
+      grid_views_.push_back(gv);
+    }
+    v.grids = grid_views_.data();
   }
   v.filter.inverse_cdf_x = filter_inverse_cdf_x_.data();
   v.filter.inverse_cdf_y = filter_inverse_cdf_y_.data();
@@ -258,6 +272,7 @@ uint64_t SceneData::fingerprint() const {
     f.add_vector(triangle_media_);
     f.add_vector(desc_.media);
     f.add(&desc_.camera_medium, sizeof desc_.camera_medium);
+    for (const GridDesc& g : desc_.grids) f.add_vector(g.density);
   }
   return f.h;
 }

@@ -65,6 +65,7 @@ class SceneData {
   std::vector<TextureSlot> triangle_alpha_;  // per triangle
   bool has_alpha_ = false;                   // any triangle not opaque
   std::vector<MediumInterface> triangle_media_;  // per triangle, only for scenes with media
+  std::vector<DensityGridView> grid_views_;
   bool has_media_ = false;
   std::vector<Float> filter_inverse_cdf_x_, filter_inverse_cdf_y_;
   std::vector<Float> filter_weight_x_, filter_weight_y_;  // empty unless the filter has negative lobes

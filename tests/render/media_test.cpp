@@ -142,6 +142,46 @@ TEST(Media, GuidedScatteringFurnaceIsOneInEveryChannel) {
   EXPECT_EQ(r.stats.guide.rejected_nonfinite, 0u);
 }
 
+// The same media as density grids (pbrt-v4's "uniformgrid"): a 4^3 grid of
+// density 2, constant where the scene is (between the outer voxel centres),
+// with half the coefficients, gives the same images through delta and ratio
+// tracking.
+TEST(Media, GridMediaMatchTheirHomogeneousEquivalents) {
+  std::string densities;
+  for (int i = 0; i < 64; ++i) densities += "2 ";
+  // Absorption through the slab (ratio tracking on camera and shadow rays).
+  const std::string grid_absorber =
+      "MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"integer nx\" 4 \"integer ny\" 4 \"integer nz\" 4 "
+      "\"float density\" [ " + densities + "] \"point3 p0\" [ -200 -200 -10 ] \"point3 p1\" [ 200 200 20 ] "
+      "\"rgb sigma_a\" [ 0.05 0.1 0.2 ] \"rgb sigma_s\" [ 0 0 0 ]\n";
+  const std::string scene = header(256, 1) + "WorldBegin\n" +
+                            "LightSource \"distant\" \"point3 from\" [ 0 0 0 ] \"point3 to\" [ 0 0 1 ] \"rgb L\" [ 3 3 3 ]\n" +
+                            slab(grid_absorber) +
+                            "Material \"diffuse\" \"rgb reflectance\" [ 1 1 1 ]\n"
+                            "Shape \"trianglemesh\" \"point3 P\" [ -100 -100 10  100 -100 10  100 100 10  -100 100 10 ] "
+                            "\"integer indices\" [ 0 2 1 0 3 2 ]\n";
+  const Rgb m = mean_rgb(testing::render_text(scene));
+  const double d = 3.0, E = 3.0;
+  // Ratio tracking is a stochastic estimate (65536 camera and shadow rays).
+  for (int c = 0; c < 3; ++c) {
+    const double expected = E / M_PI * std::exp(-2 * 2 * (c == 0 ? 0.05 : c == 1 ? 0.1 : 0.2) * d);
+    EXPECT_NEAR(m[c], expected, 0.02 * expected) << "channel " << c;
+  }
+  // The scattering furnace, chromatic, forward-scattering: still 1 everywhere.
+  std::string furnace = header(1024, 100000, 40.0) + "WorldBegin\n" + "LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n" +
+                        "MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"integer nx\" 4 \"integer ny\" 4 "
+                        "\"integer nz\" 4 \"float density\" [ " + densities + "] \"point3 p0\" [ -4 -4 0 ] "
+                        "\"point3 p1\" [ 4 4 9 ] \"rgb sigma_a\" [ 0 0 0 ] \"rgb sigma_s\" [ 0.2 0.25 0.3 ] \"float g\" 0.6\n"
+                        "AttributeBegin\nMaterial \"interface\"\nMediumInterface \"m\" \"\"\n" +
+                        box(Vec3(-1.5, -1.5, 3), Vec3(1.5, 1.5, 6)) + "AttributeEnd\n";
+  GuidedScene s(load_pbrt_string(furnace, "<grid furnace>", "."));
+  RenderResult r = s.run(nullptr);
+  const ChannelStats f = channel_stats(r.film);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(f.mean[c], 1.0, 0.01) << "channel " << c;
+  testing::expect_precise(f, 0.003, "grid furnace");
+  EXPECT_GT(r.stats.counters.path.medium_vertices, r.stats.counters.samples);
+}
+
 TEST(Media, SameSeedGivesTheSameImageForAnyThreadCount) {
   GuidedScene s(scattering_furnace(4));
   RenderOptions one, three;

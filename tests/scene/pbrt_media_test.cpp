@@ -60,19 +60,34 @@ WorldBegin
   EXPECT_EQ(d.media[1].sigma_s, s * 10.f);
 }
 
-TEST(PbrtMedia, GridMediaWarnAndEncloseVacuum) {
+TEST(PbrtMedia, UniformGridKeepsItsDensitiesBoxAndTransform) {
   SceneDesc d = load_pbrt_string(R"(
-MakeNamedMedium "smoke" "string type" "uniformgrid" "integer nx" 1 "integer ny" 1 "integer nz" 1 "float density" [ 1 ]
 LookAt 0 0 -5  0 0 0  0 1 0
 Camera "perspective"
 WorldBegin
+AttributeBegin
+Translate 10 0 0
+MakeNamedMedium "smoke" "string type" "uniformgrid" "integer nx" 2 "integer ny" 1 "integer nz" 1
+  "float density" [ 0.5 3 ] "point3 p0" [ -1 -1 -1 ] "point3 p1" [ 1 1 1 ] "rgb sigma_s" [ 2 2 2 ]
+AttributeEnd
 MediumInterface "smoke" ""
+MakeNamedMedium "wisps" "string type" "cloud"
 )" + std::string(kTriangle), "<t>", ".");
-  EXPECT_TRUE(d.media.empty());
-  EXPECT_EQ(d.meshes[0].media.inside, -1);
+  ASSERT_EQ(d.media.size(), 1u);
+  ASSERT_EQ(d.grids.size(), 1u);
+  EXPECT_EQ(d.media[0].grid, 0);
+  EXPECT_EQ(d.media[0].sigma_s, Rgb(2.f));
+  const GridDesc& g = d.grids[0];
+  EXPECT_EQ(g.nx, 2);
+  EXPECT_EQ(g.density, (std::vector<Float>{0.5f, 3.f}));
+  EXPECT_FLOAT_EQ(g.max_density, 3.f);
+  EXPECT_EQ(g.p0, Vec3(-1.f));
+  // The box sits where the CTM put it: world (10, 0, 0) is the medium's origin.
+  EXPECT_EQ(Vec3(g.medium_from_world * Vec4(10.f, 0.f, 0.f, 1.f)), Vec3(0.f));
+  EXPECT_EQ(d.meshes[0].media.inside, 0);
   bool warned = false;
-  for (const std::string& w : d.warnings) warned |= w.find("uniformgrid") != std::string::npos;
-  EXPECT_TRUE(warned);
+  for (const std::string& w : d.warnings) warned |= w.find("cloud") != std::string::npos;
+  EXPECT_TRUE(warned);  // cloud, rgbgrid and nanovdb media are not simulated
 }
 
 void expect_error(const std::string& text, const std::string& needle) {
@@ -93,6 +108,13 @@ TEST(PbrtMedia, BadMediaAreOneLineErrors) {
   expect_error("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ -1 0 0 ]\n" + world,
                "must be finite and not negative");
   expect_error("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float scale\" -2\n" + world, "scale");
+  expect_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [ 1 ]\n" + world,
+               "1 density values; nx*ny*nz = 2");
+  expect_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\"\n" + world, "needs \"float density\"");
+  expect_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [ -1 ]\n" + world,
+               "densities must be finite");
+  expect_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [ 1 ] "
+               "\"point3 p0\" [ 1 1 1 ] \"point3 p1\" [ 0 2 2 ]\n" + world, "p0 < p1");
 }
 
 }  // namespace
