@@ -32,8 +32,9 @@ enum Specialisation : uint32_t {
   kSpecEnvironment = 1u << 3,
   kSpecGuiding = 1u << 4,      // learned guiding (set by the render options, not by the scene)
   kSpecSurfaceAll = (1u << 5) - 1,
-  // Volumetric path tracing. Media scenes are rare enough that they get the
-  // full surface integrator (every other scene bit set) rather than a
+  // Volumetric path tracing: media, and shadow rays that pass "interface"
+  // surfaces (pbrt-v4's volpath). Such scenes are rare enough that they get
+  // the full surface integrator (every other scene bit set) rather than a
   // specialisation per combination: two more instantiations, not 32.
   kSpecMedia = 1u << 5,
   kSpecAll = (1u << 6) - 1,
@@ -45,7 +46,8 @@ TESSERA_HOST_DEVICE inline uint32_t specialisation_for(uint32_t effects) {
   if (effects & kEffectTextures) s |= kSpecTextures;
   if (effects & kEffectAreaLights) s |= kSpecAreaLights;
   if (effects & kEffectEnvironment) s |= kSpecEnvironment;
-  if (effects & kEffectMedia) s |= kSpecMedia | kSpecNonDiffuse | kSpecTextures | kSpecAreaLights | kSpecEnvironment;
+  if (effects & (kEffectMedia | kEffectInterface))
+    s |= kSpecMedia | kSpecNonDiffuse | kSpecTextures | kSpecAreaLights | kSpecEnvironment;
   return s;
 }
 

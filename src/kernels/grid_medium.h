@@ -94,11 +94,11 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
   if (!(majorant > 0.f) || !grid_clip(g, o, d, t_max, &r)) return seg;
   Rng rng = tracking_rng(u, o, d);
   Rgb w(1.f);
-  Float t = r.t0;
+  double t = r.t0;  // double: free paths far smaller than t still advance it
   for (int32_t step = 0; step < (1 << 20); ++step) {
     t += -glm::log(1.f - rng.uniform()) / majorant;
     if (!(t < r.t1)) break;
-    const Float dens = grid_density(g, r.o + t * r.d);
+    const Float dens = grid_density(g, r.o + static_cast<Float>(t) * r.d);
     const Rgb sigma_a = dens * m.sigma_a, sigma_s = dens * m.sigma_s;
     const Rgb sigma_n = Rgb(majorant) - sigma_a - sigma_s;
     seg.emitted += w * sigma_a * m.Le / majorant;
@@ -107,7 +107,7 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
     const Float e = rng.uniform();
     if (e < p_s) {
       seg.scattered = true;
-      seg.t = t;
+      seg.t = static_cast<Float>(t);
       seg.weight = w * sigma_s / (majorant * p_s);
       return seg;
     }
@@ -116,7 +116,7 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
       continue;
     }
     seg.scattered = true;  // absorbed: the path ends here
-    seg.t = t;
+    seg.t = static_cast<Float>(t);
     seg.weight = Rgb(0.f);
     return seg;
   }
@@ -132,11 +132,11 @@ TESSERA_HOST_DEVICE inline Rgb grid_transmittance(const Medium& m, const Density
   if (!(majorant > 0.f) || !grid_clip(g, o, d, t_max, &r)) return Rgb(1.f);
   Rng rng = tracking_rng(0.5f, o, d);
   Rgb tr(1.f);
-  Float t = r.t0;
+  double t = r.t0;
   for (int32_t step = 0; step < (1 << 20); ++step) {
     t += -glm::log(1.f - rng.uniform()) / majorant;
     if (!(t < r.t1)) break;
-    const Float dens = grid_density(g, r.o + t * r.d);
+    const Float dens = grid_density(g, r.o + static_cast<Float>(t) * r.d);
     tr *= glm::max(Rgb(0.f), Rgb(1.f) - dens * medium_sigma_t(m) / majorant);
     // Russian roulette once little is left (unbiased: survivors are scaled up).
     const Float left = max_component(tr);

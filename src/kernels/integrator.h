@@ -116,7 +116,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
                                    const PathSettings& settings, PathCounters& c) {
   constexpr bool kGuide = (Spec & kSpecGuiding) != 0;
   constexpr bool kMedia = (Spec & kSpecMedia) != 0;
-  int32_t medium = kMedia && s.triangle_media ? s.camera_medium : -1;  // the medium the ray travels in
+  int32_t medium = kMedia ? s.camera_medium : -1;  // the medium the ray travels in (-1: vacuum)
   // Luminance of the medium's weight on the segment just traced (its
   // transmittance, or the collision estimator's weight): learning targets
   // are the radiance arriving at x, after the medium between.
@@ -169,6 +169,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   for (;;) {
     TraceHit hit;
     ++c.rays;
+    segment_tr = 1.f;
     const bool found = tracer.intersect(ray.o, ray.d, kInfinity, &hit);
     if constexpr (kMedia) {
       if (medium >= 0) {

@@ -17,6 +17,24 @@ TESSERA_HOST_DEVICE inline Float mix_hash_float(const Vec3& p, const Vec3& wo, i
   return static_cast<Float>(h >> 40) * 0x1p-24f;
 }
 
+// The material a hit sees: a mix resolved to one of its components (a pure
+// function of the hit and wo, so camera paths and shadow rays agree).
+template <uint32_t Spec>
+TESSERA_HOST_DEVICE inline const Material* resolve_material(const SceneView& s, int32_t material, const SurfaceHit& h,
+                                                            const Vec3& wo) {
+  const Material* m = &s.materials[material];
+  for (int guard = 0; m->type == MaterialType::Mix && guard < 16; ++guard) {
+    Float amount = (Spec & kSpecTextures) ? eval_slot(s, m->amount, h.uv).x : m->amount.value.x;
+    int32_t pick;
+    if (amount <= 0.f) pick = m->mix[0];  // pbrt-v4 MixMaterial::ChooseMaterial
+    else if (amount >= 1.f) pick = m->mix[1];
+    else pick = amount < mix_hash_float(h.p, wo, m->mix[0], m->mix[1]) ? m->mix[0] : m->mix[1];
+    m = &s.materials[pick];
+  }
+  // The loader rejects cycles, so only absurdly deep nesting can remain a Mix.
+  return m->type == MaterialType::Mix ? &s.materials[0] : m;
+}
+
 // Returns false for an "interface" material: the surface only bounds a medium
 // and the ray continues through it.
 template <uint32_t Spec>
@@ -24,16 +42,7 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
                                              BsdfParams* out) {
   const Material* m = &s.materials[material];
   if constexpr ((Spec & kSpecNonDiffuse) != 0) {
-    for (int guard = 0; m->type == MaterialType::Mix && guard < 16; ++guard) {
-      Float amount = (Spec & kSpecTextures) ? eval_slot(s, m->amount, h.uv).x : m->amount.value.x;
-      int32_t pick;
-      if (amount <= 0.f) pick = m->mix[0];  // pbrt-v4 MixMaterial::ChooseMaterial
-      else if (amount >= 1.f) pick = m->mix[1];
-      else pick = amount < mix_hash_float(h.p, wo, m->mix[0], m->mix[1]) ? m->mix[0] : m->mix[1];
-      m = &s.materials[pick];
-    }
-    // The loader rejects cycles, so only absurdly deep nesting can remain a Mix.
-    if (m->type == MaterialType::Mix) m = &s.materials[0];
+    m = resolve_material<Spec>(s, material, h, wo);
     if (m->type == MaterialType::Interface) return false;
   }
   Rgb refl = (Spec & kSpecTextures) ? eval_slot(s, m->reflectance, h.uv) : m->reflectance.value;

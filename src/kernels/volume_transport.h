@@ -4,12 +4,21 @@
 // accumulates each medium's transmittance; any other surface blocks it.
 #pragma once
 
-#include "material.h"
+#include "material_eval.h"
 #include "medium.h"
 #include "scene_view.h"
 #include "surface.h"
 
 namespace tessera {
+
+// The medium a ray leaving triangle tri in direction w travels in: the
+// surface's medium on that side where it is a transition, else `current`.
+TESSERA_HOST_DEVICE inline int32_t medium_after(const SceneView& s, uint32_t tri, const Vec3& ng, const Vec3& w,
+                                                int32_t current) {
+  if (!s.triangle_media) return current;
+  const MediumInterface mi = s.triangle_media[tri];
+  return is_transition(mi) ? medium_towards(mi, ng, w) : current;
+}
 
 // Transmittance of `medium` along o + t d, t in [0, t_max]: exact for a
 // homogeneous medium, a ratio-tracking estimate for a grid.
@@ -28,8 +37,9 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_medium(const SceneView& s, const
 }
 
 // Transmittance from o to o + t_max d (d unit length, t_max = kInfinity for
-// infinite lights) starting in `medium`; 0 when a surface blocks. Each ray
-// query counts as a shadow ray.
+// infinite lights) starting in `medium` (-1: vacuum); 0 when a surface
+// blocks. A mix is resolved as a camera path arriving along d would resolve
+// it. Each ray query counts as a shadow ray.
 template <class Tracer, class Counters>
 TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& tracer, Vec3 o, const Vec3& d,
                                              Float t_max, int32_t medium, Counters& c) {
@@ -44,12 +54,12 @@ TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& t
       if (medium >= 0) tr *= medium_transmittance(s, medium, o, d, t_max);
       return tr;
     }
-    if (s.materials[s.triangles[hit.triangle].material].type != MaterialType::Interface) return Rgb(0.f);
+    const SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2);
+    if (resolve_material<kSpecAll>(s, s.triangles[hit.triangle].material, h, -d)->type != MaterialType::Interface)
+      return Rgb(0.f);
     if (medium >= 0) tr *= medium_transmittance(s, medium, o, d, hit.t);
     if (is_black(tr)) return tr;
-    const SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2);
-    const MediumInterface mi = s.triangle_media[hit.triangle];
-    if (is_transition(mi)) medium = medium_towards(mi, h.ng, d);
+    medium = medium_after(s, hit.triangle, h.ng, d, medium);
     o = offset_ray_origin(h, d);
     if (!infinite) {
       t_max = glm::dot(target - o, d);
@@ -59,25 +69,20 @@ TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& t
   return Rgb(0.f);
 }
 
-// The medium a ray leaving triangle tri in direction w travels in: the
-// surface's medium on that side where it is a transition, else `current`.
-TESSERA_HOST_DEVICE inline int32_t medium_after(const SceneView& s, uint32_t tri, const Vec3& ng, const Vec3& w,
-                                                int32_t current) {
-  if (!s.triangle_media) return current;
-  const MediumInterface mi = s.triangle_media[tri];
-  return is_transition(mi) ? medium_towards(mi, ng, w) : current;
-}
-
-// What reaches o from o + t_max d: 1 or 0 from one occlusion query, or, with
-// media, the transmittance through them.
+// What reaches o from o + t_max d: 1 or 0 from one occlusion query, or, in
+// the volumetric specialisation (media or interface surfaces), the
+// transmittance through media and interfaces.
 template <bool kMedia, class Tracer, class Counters>
 TESSERA_HOST_DEVICE Rgb light_visibility(const SceneView& s, const Tracer& tracer, const Vec3& o, const Vec3& d,
                                          Float t_max, int32_t medium, Counters& c) {
   if constexpr (kMedia) {
-    if (s.triangle_media) return shadow_transmittance(s, tracer, o, d, t_max, medium, c);
+    return shadow_transmittance(s, tracer, o, d, t_max, medium, c);
+  } else {
+    (void)s;
+    (void)medium;
+    ++c.shadow_rays;
+    return tracer.occluded(o, d, t_max) ? Rgb(0.f) : Rgb(1.f);
   }
-  ++c.shadow_rays;
-  return tracer.occluded(o, d, t_max) ? Rgb(0.f) : Rgb(1.f);
 }
 
 }  // namespace tessera

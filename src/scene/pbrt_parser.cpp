@@ -436,6 +436,11 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
   }
   mesh->material = state_.material;
   mesh->area_light = state_.area_light;
+  if (mesh->area_light >= 0 && scene_.materials[state_.material].type == MaterialType::Interface) {
+    // pbrt-v4 (CreateLights) ignores them too: such shapes only bound media.
+    scene_.warnings.push_back(at.where() + ": an area light on a shape with the \"interface\" material is ignored");
+    mesh->area_light = -1;
+  }
   mesh->media = state_.media;
   mesh->alpha = float_slot(params, "alpha", 1.f, context(at, including_dir));
   if (mesh->alpha.texture < 0 && !(mesh->alpha.value.x >= 0.f && mesh->alpha.value.x <= 1.f))

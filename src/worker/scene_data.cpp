@@ -272,7 +272,14 @@ uint64_t SceneData::fingerprint() const {
     f.add_vector(triangle_media_);
     f.add_vector(desc_.media);
     f.add(&desc_.camera_medium, sizeof desc_.camera_medium);
-    for (const GridDesc& g : desc_.grids) f.add_vector(g.density);
+    for (const GridDesc& g : desc_.grids) {
+      f.add_vector(g.density);
+      f.add(&g.medium_from_world, sizeof g.medium_from_world);
+      f.add(&g.p0, sizeof g.p0);
+      f.add(&g.p1, sizeof g.p1);
+      const int32_t dims[3] = {g.nx, g.ny, g.nz};
+      f.add(dims, sizeof dims);
+    }
   }
   return f.h;
 }

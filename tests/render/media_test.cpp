@@ -182,6 +182,30 @@ TEST(Media, GridMediaMatchTheirHomogeneousEquivalents) {
   EXPECT_GT(r.stats.counters.path.medium_vertices, r.stats.counters.samples);
 }
 
+// pbrt-v4's volpath lets shadow rays pass "interface" surfaces (also
+// without media, and through a mix that resolves to one): a white wall lit
+// head-on through such sheets keeps E / pi.
+TEST(Media, ShadowRaysPassInterfaceSurfacesWithOrWithoutMedia) {
+  auto wall_through = [](const std::string& sheet_material) {
+    const std::string scene = header(4, 1) + "WorldBegin\n" +
+                              "LightSource \"distant\" \"point3 from\" [ 0 0 0 ] \"point3 to\" [ 0 0 1 ] \"rgb L\" [ 3 3 3 ]\n" +
+                              "MakeNamedMaterial \"black\" \"string type\" \"diffuse\" \"rgb reflectance\" [ 0 0 0 ]\n"
+                              "MakeNamedMaterial \"clear\" \"string type\" \"interface\"\n"
+                              "AttributeBegin\n" + sheet_material + "\n" +
+                              "Shape \"trianglemesh\" \"point3 P\" [ -100 -100 5  100 -100 5  100 100 5  -100 100 5 ] "
+                              "\"integer indices\" [ 0 2 1 0 3 2 ]\nAttributeEnd\n"
+                              "Material \"diffuse\" \"rgb reflectance\" [ 1 1 1 ]\n"
+                              "Shape \"trianglemesh\" \"point3 P\" [ -100 -100 10  100 -100 10  100 100 10  -100 100 10 ] "
+                              "\"integer indices\" [ 0 2 1 0 3 2 ]\n";
+    SceneDesc d = load_pbrt_string(scene, "<sheet>", ".");
+    return mean_rgb(testing::render_desc(std::move(d), RenderOptions{}));
+  };
+  EXPECT_NEAR(wall_through("NamedMaterial \"clear\"").x, 3.0 / M_PI, 1e-4);
+  EXPECT_NEAR(wall_through("Material \"mix\" \"string materials\" [ \"black\" \"clear\" ] \"float amount\" 1").x,
+              3.0 / M_PI, 1e-4);
+  EXPECT_NEAR(wall_through("NamedMaterial \"black\"").x, 0.0, 1e-6);  // an opaque sheet blocks
+}
+
 TEST(Media, SameSeedGivesTheSameImageForAnyThreadCount) {
   GuidedScene s(scattering_furnace(4));
   RenderOptions one, three;

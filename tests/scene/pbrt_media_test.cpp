@@ -90,6 +90,16 @@ MakeNamedMedium "wisps" "string type" "cloud"
   EXPECT_TRUE(warned);  // cloud, rgbgrid and nanovdb media are not simulated
 }
 
+TEST(PbrtMedia, AreaLightsOnInterfaceShapesAreIgnoredAsInPbrtV4) {
+  SceneDesc d = load_pbrt_string(std::string(kHead) + "AttributeBegin\nMaterial \"interface\"\n"
+                                 "AreaLightSource \"diffuse\" \"rgb L\" [ 1 1 1 ]\n" + kTriangle + "AttributeEnd\n" + kTriangle,
+                                 "<t>", ".");
+  EXPECT_EQ(d.meshes[0].area_light, -1);
+  bool warned = false;
+  for (const std::string& w : d.warnings) warned |= w.find("area light on a shape with the \"interface\"") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
 void expect_error(const std::string& text, const std::string& needle) {
   try {
     load_pbrt_string(text, "scene.pbrt", ".");
