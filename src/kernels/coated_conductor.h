@@ -11,7 +11,9 @@
 // walk can reach. A smooth coat's mirror reflection is a delta with its exact
 // weight F(cos_o) (pbrt's layered f() excludes it too); a smooth coat over a
 // smooth conductor is a single delta whose weight is the closed form of the
-// interreflection series. Two-sided; reflection only.
+// interreflection series (the limit of pbrt-v4's walk, which stops after
+// "maxdepth" bounces: a little brighter at grazing angles). Two-sided;
+// reflection only.
 //
 // Included by bsdf_impl.h inside namespace tessera::bsdf_detail, after layered.h.
 #pragma once

@@ -84,6 +84,9 @@ struct SceneView {
   const MediumInterface* triangle_media = nullptr;  // per triangle
   int32_t camera_medium = -1;                       // -1: vacuum
   const DensityGridView* grids = nullptr;           // of the grid media
+  // Whether any material is "interface": only then can a shadow ray pass a
+  // surface (else the first hit blocks it and one occlusion query decides).
+  bool has_interfaces = false;
 
   CameraView camera;
   FilterView filter;

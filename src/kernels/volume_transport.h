@@ -43,6 +43,11 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_medium(const SceneView& s, const
 template <class Tracer, class Counters>
 TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& tracer, Vec3 o, const Vec3& d,
                                              Float t_max, int32_t medium, Counters& c) {
+  if (!s.has_interfaces) {
+    ++c.shadow_rays;
+    if (tracer.occluded(o, d, t_max)) return Rgb(0.f);
+    return medium >= 0 ? medium_transmittance(s, medium, o, d, t_max) : Rgb(1.f);
+  }
   Rgb tr(1.f);
   const bool infinite = !(t_max < kInfinity);
   const Vec3 target = o + t_max * d;

@@ -202,6 +202,7 @@ void SceneData::build_view() {
   v.num_infinite_lights = static_cast<uint32_t>(infinite_lights_.size());
   v.env_distributions = env_views_.data();
   v.camera = camera_;
+  for (const Material& m : desc_.materials) v.has_interfaces |= m.type == MaterialType::Interface;
   if (has_media_) {
     v.media = desc_.media.data();
     v.num_media = static_cast<uint32_t>(desc_.media.size());
