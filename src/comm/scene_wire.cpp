@@ -7,7 +7,7 @@ namespace tessera {
 template <class Archive>
 void serialize(Archive& ar, MeshDesc& m) {
   ar(raw(m.p), raw(m.n), raw(m.uv), raw(m.indices), m.material, m.flip_normals, m.area_light, raw_value(m.alpha), raw_value(m.media),
-     m.where);
+     raw(m.p_end), raw(m.n_end), m.where);
 }
 template <class Archive>
 void serialize(Archive& ar, ImageDesc& i) {
@@ -26,6 +26,7 @@ void serialize(Archive& ar, SceneDesc& d) {
      raw_value(d.film.pixel_from_radiance), raw_value(d.film.sensor_from_radiance), raw_value(d.film.pixel_from_sensor));
   ar(d.meshes, raw(d.materials), raw(d.textures), d.images, raw(d.area_lights), raw(d.lights), d.warnings, d.source);
   ar(raw(d.media), d.camera_medium, d.grids);
+  ar(d.camera.shutter_open, d.camera.shutter_close, d.camera.transform_start_time, d.camera.transform_end_time);
 }
 
 Bytes encode_scene(const SceneDesc& desc) { return encode(desc); }

@@ -10,6 +10,7 @@ namespace tessera {
 
 struct Ray {
   Vec3 o, d;
+  Float time = 0.f;  // where in the transform interval (0 = its start, 1 = its end): moving shapes
 };
 
 // u_lens: a point on the lens (used only when c.lens_radius > 0; pbrt-v4's
@@ -88,7 +89,15 @@ TESSERA_HOST_DEVICE inline CameraSample sample_camera_ray(const SceneView& s, in
   const FilterSample fs = sample_filter(s.filter, sampler.uniform2());
   const Vec2 p_film(x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y);
   const Vec2 u_lens = s.camera.lens_radius > 0.f ? sampler.uniform2() : Vec2(0.f);
-  return CameraSample{generate_camera_ray(s.camera, p_film, u_lens), fs.weight};
+  Ray r = generate_camera_ray(s.camera, p_film, u_lens);
+  // Motion blur: a time in the shutter interval, as a fraction of the
+  // transform interval (pbrt-v4's TransformTimes), drawn only where shapes move.
+  if (s.positions_end) {
+    const Float t = s.camera.shutter_open + sampler.uniform() * (s.camera.shutter_close - s.camera.shutter_open);
+    r.time = glm::clamp((t - s.camera.transform_start_time) /
+                            (s.camera.transform_end_time - s.camera.transform_start_time), 0.f, 1.f);
+  }
+  return CameraSample{r, fs.weight};
 }
 
 }  // namespace tessera

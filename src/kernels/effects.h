@@ -21,6 +21,7 @@ enum Effect : uint32_t {
   kEffectShadingNormals = 1u << 10,
   kEffectAlpha = 1u << 11,        // alpha cutouts (a ray-query filter, only where present)
   kEffectMedia = 1u << 12,        // participating media (volumetric path tracing)
+  kEffectMotionBlur = 1u << 13,   // moving shapes (a time per camera ray)
 };
 
 // What the integrator template is specialised on: each bit removes work from

@@ -1,9 +1,9 @@
 // Unidirectional path tracing with next-event estimation and MIS (power
 // heuristic), Russian roulette, pbrt-v4's depth counting. Templated on the
 // scene's specialisation bits (effects.h) and on the ray-query backend, which
-// provides:
-//   bool intersect(const Vec3& o, const Vec3& d, Float tmax, TraceHit* hit) const;
-//   bool occluded(const Vec3& o, const Vec3& d, Float tmax) const;   // d unit length
+// provides (time: Ray::time, for moving shapes):
+//   bool intersect(const Vec3& o, const Vec3& d, Float tmax, TraceHit* hit, Float time) const;
+//   bool occluded(const Vec3& o, const Vec3& d, Float tmax, Float time) const;   // d unit length
 #pragma once
 
 #include "bsdf.h"
@@ -170,7 +170,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     TraceHit hit;
     ++c.rays;
     segment_tr = 1.f;
-    const bool found = tracer.intersect(ray.o, ray.d, kInfinity, &hit);
+    const bool found = tracer.intersect(ray.o, ray.d, kInfinity, &hit, ray.time);
     if constexpr (kMedia) {
       if (medium >= 0) {
         const Medium& m = s.media[medium];
@@ -205,7 +205,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
               if (pmf > 0.f && sample_light(s, li, p, u_light, &ls)) {
                 const Float phase = henyey_greenstein(glm::dot(wo, ls.wi), m.g);
                 const Float tmax = ls.infinite ? kInfinity : glm::length(ls.p_light - p) * 0.9999f;
-                const Rgb tr = light_visibility<true>(s, tracer, p, ls.wi, tmax, medium, c);
+                const Rgb tr = light_visibility<true>(s, tracer, p, ls.wi, tmax, medium, ray.time, c);
                 const Float light_pdf = pmf * ls.pdf;
                 if (!is_black(tr) && light_pdf > 0.f) {
                   const Float w = ls.delta ? 1.f : power_heuristic(light_pdf, phase);
@@ -266,7 +266,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       break;
     }
     ++c.vertices;
-    SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2);
+    SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, ray.time);
     Vec3 wo = -ray.d;
     const TriangleInfo& info = s.triangles[hit.triangle];
 
@@ -376,7 +376,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             TESSERA_PREFETCH(light_dir_entry);
           }
           const Rgb tr = light_pdf > 0.f ? light_visibility<kMedia>(s, tracer, o, ls.wi, tmax,
-                                                                    kMedia ? medium_after(s, hit.triangle, h.ng, ls.wi, medium) : -1, c)
+                                                                    kMedia ? medium_after(s, hit.triangle, h.ng, ls.wi, medium) : -1,
+                                                                    ray.time, c)
                                          : Rgb(0.f);
           if (!is_black(tr)) {
             Float w = 1.f;

@@ -8,8 +8,8 @@ namespace tessera {
 
 // Ray queries against an empty scene: enough to instantiate the integrator.
 struct NoGeometryTracer {
-  __device__ bool intersect(const Vec3&, const Vec3&, Float, TraceHit*) const { return false; }
-  __device__ bool occluded(const Vec3&, const Vec3&, Float) const { return false; }
+  __device__ bool intersect(const Vec3&, const Vec3&, Float, TraceHit*, Float = 0.f) const { return false; }
+  __device__ bool occluded(const Vec3&, const Vec3&, Float, Float = 0.f) const { return false; }
 };
 
 template <uint32_t Spec>

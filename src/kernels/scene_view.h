@@ -35,6 +35,10 @@ struct CameraView {
   Mat3 pixel_from_radiance{1.f};
   Mat3 sensor_from_radiance{1.f}, pixel_from_sensor{1.f};  // the two halves, where the clamp sits between
   Float max_component_value = INFINITY;
+  // Motion blur: the shutter and pbrt-v4's TransformTimes (moving shapes are
+  // at their start transform at transform_start_time, their end one at transform_end_time).
+  Float shutter_open = 0.f, shutter_close = 1.f;
+  Float transform_start_time = 0.f, transform_end_time = 1.f;
 };
 
 // A separable pixel filter, sampled per axis in proportion to |f| (filter
@@ -56,6 +60,10 @@ struct FilterView {
 struct SceneView {
   const Vec3* positions = nullptr;
   const Vec3* normals = nullptr;
+  // Motion blur: every vertex's position and normal at the end of the
+  // transform interval (static ones repeated); null when nothing moves.
+  const Vec3* positions_end = nullptr;
+  const Vec3* normals_end = nullptr;
   const Vec2* uvs = nullptr;
   const uint32_t* indices = nullptr;  // 3 per triangle
   const TriangleInfo* triangles = nullptr;

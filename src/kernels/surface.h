@@ -30,14 +30,20 @@ TESSERA_HOST_DEVICE inline Vec2 triangle_uv(const SceneView& s, uint32_t tri, Fl
   return (1.f - b1 - b2) * s.uvs[idx[0]] + b1 * s.uvs[idx[1]] + b2 * s.uvs[idx[2]];
 }
 
-// b1, b2: barycentrics of vertices 1 and 2 (Embree's u, v).
-TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& s, uint32_t tri, Float b1, Float b2) {
+// b1, b2: barycentrics of vertices 1 and 2 (Embree's u, v); time: the ray's (Ray::time).
+TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& s, uint32_t tri, Float b1, Float b2,
+                                                               Float time = 0.f) {
   const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
   const TriangleInfo& info = s.triangles[tri];
   Float b0 = 1.f - b1 - b2;
-  const Vec3& p0 = s.positions[idx[0]];
-  const Vec3& p1 = s.positions[idx[1]];
-  const Vec3& p2 = s.positions[idx[2]];
+  Vec3 p0 = s.positions[idx[0]], p1 = s.positions[idx[1]], p2 = s.positions[idx[2]];
+  // A moving triangle at this time: its vertices interpolated linearly, as Embree intersects it.
+  const bool moving = s.positions_end && time > 0.f;
+  if (moving) {
+    p0 = glm::mix(p0, s.positions_end[idx[0]], time);
+    p1 = glm::mix(p1, s.positions_end[idx[1]], time);
+    p2 = glm::mix(p2, s.positions_end[idx[2]], time);
+  }
   SurfaceHit h;
   h.triangle = tri;
   h.p = b0 * p0 + b1 * p1 + b2 * p2;
@@ -45,9 +51,16 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& 
   constexpr Float kGamma7 = 7.f * 0x1p-24f / (1.f - 7.f * 0x1p-24f);
   h.p_error = kGamma7 * (abs3(b0 * p0) + abs3(b1 * p1) + abs3(b2 * p2));
   h.ng = s.face_normals[tri];
+  if (moving) {
+    const Vec3 n = glm::cross(p0 - p2, p1 - p2);
+    const Float len = glm::length(n);
+    if (len > 0.f) h.ng = (info.flags & kTriFlipNormal) ? -n / len : n / len;
+  }
   h.ns = h.ng;
   if (info.flags & kTriHasNormals) {
     Vec3 ns = b0 * s.normals[idx[0]] + b1 * s.normals[idx[1]] + b2 * s.normals[idx[2]];
+    if (moving)
+      ns = glm::mix(ns, b0 * s.normals_end[idx[0]] + b1 * s.normals_end[idx[1]] + b2 * s.normals_end[idx[2]], time);
     Float l = glm::length(ns);
     if (l > 0.f) {
       h.ns = ns / l;

@@ -42,10 +42,10 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_medium(const SceneView& s, const
 // it. Each ray query counts as a shadow ray.
 template <class Tracer, class Counters>
 TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& tracer, Vec3 o, const Vec3& d,
-                                             Float t_max, int32_t medium, Counters& c) {
+                                             Float t_max, int32_t medium, Float time, Counters& c) {
   if (!s.has_interfaces) {
     ++c.shadow_rays;
-    if (tracer.occluded(o, d, t_max)) return Rgb(0.f);
+    if (tracer.occluded(o, d, t_max, time)) return Rgb(0.f);
     return medium >= 0 ? medium_transmittance(s, medium, o, d, t_max) : Rgb(1.f);
   }
   Rgb tr(1.f);
@@ -55,11 +55,11 @@ TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& t
   for (int32_t crossing = 0; crossing < 256; ++crossing) {
     TraceHit hit;
     ++c.shadow_rays;
-    if (!tracer.intersect(o, d, t_max, &hit)) {
+    if (!tracer.intersect(o, d, t_max, &hit, time)) {
       if (medium >= 0) tr *= medium_transmittance(s, medium, o, d, t_max);
       return tr;
     }
-    const SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2);
+    const SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, time);
     if (resolve_material<kSpecAll>(s, s.triangles[hit.triangle].material, h, -d)->type != MaterialType::Interface)
       return Rgb(0.f);
     if (medium >= 0) tr *= medium_transmittance(s, medium, o, d, hit.t);
@@ -79,14 +79,14 @@ TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& t
 // transmittance through media and interfaces.
 template <bool kMedia, class Tracer, class Counters>
 TESSERA_HOST_DEVICE Rgb light_visibility(const SceneView& s, const Tracer& tracer, const Vec3& o, const Vec3& d,
-                                         Float t_max, int32_t medium, Counters& c) {
+                                         Float t_max, int32_t medium, Float time, Counters& c) {
   if constexpr (kMedia) {
-    return shadow_transmittance(s, tracer, o, d, t_max, medium, c);
+    return shadow_transmittance(s, tracer, o, d, t_max, medium, time, c);
   } else {
     (void)s;
     (void)medium;
     ++c.shadow_rays;
-    return tracer.occluded(o, d, t_max) ? Rgb(0.f) : Rgb(1.f);
+    return tracer.occluded(o, d, t_max, time) ? Rgb(0.f) : Rgb(1.f);
   }
 }
 

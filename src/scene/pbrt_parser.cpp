@@ -165,8 +165,11 @@ void PbrtParser::pop(char kind, const Token& at) {
   stack_.pop_back();
   if (e.kind != kind)
     scene_.warnings.push_back(at.where() + ": " + at.text + " closes the block opened at " + e.where);
-  if (kind == 't') {
-    state_.ctm = e.state.ctm;  // TransformEnd restores only the transform
+  if (kind == 't') {  // TransformEnd restores only the transforms
+    state_.ctm = e.state.ctm;
+    state_.ctm_end = e.state.ctm_end;
+    state_.active_start = e.state.active_start;
+    state_.active_end = e.state.active_end;
   } else {
     state_ = e.state;
   }
@@ -180,37 +183,53 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
   if (is_options_directive(d)) require_world(at, false);
   std::vector<std::string>& warnings = scene_.warnings;
   auto warn = [&](const std::string& m) { warnings.push_back(at.where() + ": " + m); };
-  Mat4& ctm = state_.ctm;
+  const Mat4& ctm = state_.ctm;
+  // Transform directives change the active transforms (ActiveTransform): the
+  // start one, the end one, or both.
+  auto post_multiply = [&](const Mat4& m) {
+    if (state_.active_start) state_.ctm = state_.ctm * m;
+    if (state_.active_end) state_.ctm_end = state_.ctm_end * m;
+  };
 
   if (d == "Translate") {
     std::vector<Float> v = read_numbers(tokens, pos, 3, at);
-    ctm = ctm * glm::translate(Mat4(1.f), Vec3(v[0], v[1], v[2]));
+    post_multiply(glm::translate(Mat4(1.f), Vec3(v[0], v[1], v[2])));
   } else if (d == "Scale") {
     std::vector<Float> v = read_numbers(tokens, pos, 3, at);
-    ctm = ctm * glm::scale(Mat4(1.f), Vec3(v[0], v[1], v[2]));
+    post_multiply(glm::scale(Mat4(1.f), Vec3(v[0], v[1], v[2])));
   } else if (d == "Rotate") {
     std::vector<Float> v = read_numbers(tokens, pos, 4, at);
     Vec3 axis(v[1], v[2], v[3]);
     if (glm::length(axis) == 0.f) fail(at, "Rotate axis is zero");
-    ctm = ctm * glm::rotate(Mat4(1.f), v[0] * kPi / 180.f, glm::normalize(axis));
+    post_multiply(glm::rotate(Mat4(1.f), v[0] * kPi / 180.f, glm::normalize(axis)));
   } else if (d == "LookAt") {
     std::vector<Float> v = read_numbers(tokens, pos, 9, at);
-    ctm = ctm * look_at(Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5]), Vec3(v[6], v[7], v[8]), at, warnings);
+    post_multiply(look_at(Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5]), Vec3(v[6], v[7], v[8]), at, warnings));
   } else if (d == "Transform" || d == "ConcatTransform") {
     // pbrt-v4 reads the 16 numbers row-major and transposes: they are the
     // matrix's columns, exactly glm's storage order.
     std::vector<Float> v = read_numbers(tokens, pos, 16, at);
     Mat4 m = glm::make_mat4(v.data());
-    ctm = d == "Transform" ? m : ctm * m;
+    if (d == "ConcatTransform") {
+      post_multiply(m);
+    } else {
+      if (state_.active_start) state_.ctm = m;
+      if (state_.active_end) state_.ctm_end = m;
+    }
   } else if (d == "Identity") {
-    ctm = Mat4(1.f);
+    if (state_.active_start) state_.ctm = Mat4(1.f);
+    if (state_.active_end) state_.ctm_end = Mat4(1.f);
   } else if (d == "CoordinateSystem") {
-    coordinate_systems_[read_string(tokens, pos, at)] = ctm;
+    coordinate_systems_[read_string(tokens, pos, at)] = {state_.ctm, state_.ctm_end};
   } else if (d == "CoordSysTransform") {
     std::string name = read_string(tokens, pos, at);
     auto it = coordinate_systems_.find(name);
-    if (it == coordinate_systems_.end()) warn("unknown coordinate system \"" + name + "\"; ignored");
-    else ctm = it->second;
+    if (it == coordinate_systems_.end()) {
+      warn("unknown coordinate system \"" + name + "\"; ignored");
+    } else {
+      state_.ctm = it->second.first;
+      state_.ctm_end = it->second.second;
+    }
   } else if (d == "ReverseOrientation") {
     state_.reverse_orientation = !state_.reverse_orientation;
   } else if (d == "AttributeBegin") {
@@ -235,8 +254,9 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
   } else if (d == "WorldBegin") {
     if (world_begun_) fail(at, "WorldBegin appears twice");
     world_begun_ = true;
-    ctm = Mat4(1.f);
-    coordinate_systems_["world"] = ctm;
+    state_.ctm = state_.ctm_end = Mat4(1.f);
+    state_.active_start = state_.active_end = true;
+    coordinate_systems_["world"] = {state_.ctm, state_.ctm_end};
   } else if (d == "WorldEnd") {
     warn("WorldEnd is pbrt-v3 syntax; ignored");
   } else if (d == "Camera") {
@@ -342,18 +362,33 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     if (!open_instance_.empty()) fail(at, "ObjectInstance inside ObjectBegin \"" + open_instance_ + "\"");
     auto it = instances_.find(name);
     if (it == instances_.end()) fail(at, "unknown object \"" + name + "\"");
+    const bool moves = state_.ctm_end != state_.ctm;
     for (const MeshDesc& def : it->second) {
       MeshDesc copy = def;
       transform_mesh(copy, ctm);  // definitions are stored in world space of the definition
+      if (moves && copy.area_light < 0) {  // the instance moves: its end is the definition under the end transform
+        MeshDesc end = def;
+        if (end.p_end.empty()) end.p_end = end.p, end.n_end = end.n;
+        transform_mesh(end, state_.ctm_end);
+        copy.p_end = std::move(end.p_end);
+        copy.n_end = std::move(end.n_end);
+      }
       copy.where = at.where();
       scene_.meshes.push_back(std::move(copy));
     }
   } else if (d == "ActiveTransform") {
     const Token& which = next_token(tokens, pos, at, "All, StartTime or EndTime");
-    if (which.text != "All") warn("ActiveTransform " + which.text + " (motion blur) is not supported");
+    if (which.text == "All") state_.active_start = state_.active_end = true;
+    else if (which.text == "StartTime") state_.active_start = true, state_.active_end = false;
+    else if (which.text == "EndTime") state_.active_start = false, state_.active_end = true;
+    else fail(which, "ActiveTransform takes All, StartTime or EndTime, not '" + which.text + "'");
   } else if (d == "TransformTimes") {
-    read_numbers(tokens, pos, 2, at);
-    warn("TransformTimes (motion blur) is not supported; ignored");
+    require_world(at, false);
+    std::vector<Float> v = read_numbers(tokens, pos, 2, at);
+    if (!(v[1] > v[0]) || !std::isfinite(v[0]) || !std::isfinite(v[1]))
+      fail(at, "TransformTimes needs a start time below its end time");
+    scene_.camera.transform_start_time = v[0];
+    scene_.camera.transform_end_time = v[1];
   } else if (d == "MakeNamedMedium") {
     std::string name = read_string(tokens, pos, at);
     ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_);
@@ -406,9 +441,13 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   if (!(close > open) || !std::isfinite(close - open))
     fail(at, "the shutter never opens (shutterclose equals shutteropen): the image would be black");
   scene_.camera.exposure_time = close - open;
+  scene_.camera.shutter_open = open;
+  scene_.camera.shutter_close = close;
   scene_.camera.where = at.where();
   scene_.camera_medium = state_.media.outside;  // pbrt-v4: the camera sits in the current outside medium
-  coordinate_systems_["camera"] = scene_.camera.world_from_camera;
+  coordinate_systems_["camera"] = {scene_.camera.world_from_camera, scene_.camera.world_from_camera};
+  if (state_.ctm_end != state_.ctm)
+    warnings.push_back(at.where() + ": a moving camera (motion blur) is not supported; it stays where it starts");
   scene_.camera.lens_radius = params.get_float("lensradius", 0.f);
   scene_.camera.focal_distance = params.get_float("focaldistance", 1e6f);
   if (!(scene_.camera.lens_radius >= 0.f) || !std::isfinite(scene_.camera.lens_radius))
@@ -442,6 +481,12 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
     mesh->area_light = -1;
   }
   mesh->media = state_.media;
+  if (state_.ctm_end != state_.ctm) {
+    if (mesh->area_light >= 0)
+      scene_.warnings.push_back(at.where() + ": a moving area light is not supported; it stays where it starts");
+    else if (glm::determinant(state_.ctm) != 0.f)
+      add_motion(*mesh, state_.ctm_end * glm::inverse(state_.ctm));
+  }
   mesh->alpha = float_slot(params, "alpha", 1.f, context(at, including_dir));
   if (mesh->alpha.texture < 0 && !(mesh->alpha.value.x >= 0.f && mesh->alpha.value.x <= 1.f))
     fail(at, "shape \"alpha\" must be in [0, 1]");

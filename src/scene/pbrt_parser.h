@@ -25,7 +25,9 @@ class PbrtParser {
 
  private:
   struct GraphicsState {
-    Mat4 ctm{1.f};
+    Mat4 ctm{1.f};      // at the start of the transform interval (TransformTimes)
+    Mat4 ctm_end{1.f};  // at its end: differs for moving shapes (motion blur)
+    bool active_start = true, active_end = true;  // ActiveTransform
     bool reverse_orientation = false;
     int32_t material = 0;
     int32_t area_light = -1;
@@ -51,7 +53,7 @@ class PbrtParser {
   std::string search_dir_;
   GraphicsState state_;
   std::vector<StackEntry> stack_;
-  std::map<std::string, Mat4> coordinate_systems_;
+  std::map<std::string, std::pair<Mat4, Mat4>> coordinate_systems_;  // start and end transforms
   std::map<std::string, std::vector<MeshDesc>> instances_;
   std::string open_instance_;  // non-empty between ObjectBegin and ObjectEnd
   bool world_begun_ = false;

@@ -212,14 +212,34 @@ void check_finite(const MeshDesc& m, const ShapeContext& ctx) {
 bool swaps_handedness(const Mat4& m) { return glm::determinant(Mat3(m)) < 0.f; }
 
 void transform_mesh(MeshDesc& mesh, const Mat4& m) {
-  for (Vec3& p : mesh.p) p = Vec3(m * Vec4(p, 1.f));
   const Mat3 nm = normal_matrix(m);
-  for (Vec3& n : mesh.n) {
-    Vec3 t = nm * n;
-    Float len = glm::length(t);
+  auto points = [&](std::vector<Vec3>& ps) {
+    for (Vec3& p : ps) p = Vec3(m * Vec4(p, 1.f));
+  };
+  auto normals = [&](std::vector<Vec3>& ns) {
+    for (Vec3& n : ns) {
+      Vec3 t = nm * n;
+      Float len = glm::length(t);
+      n = len > 0.f ? t / len : n;
+    }
+  };
+  points(mesh.p);
+  points(mesh.p_end);
+  normals(mesh.n);
+  normals(mesh.n_end);
+  if (swaps_handedness(m)) mesh.flip_normals = !mesh.flip_normals;
+}
+
+void add_motion(MeshDesc& mesh, const Mat4& end_from_start) {
+  mesh.p_end = mesh.p;
+  mesh.n_end = mesh.n;
+  const Mat3 nm = normal_matrix(end_from_start);
+  for (Vec3& p : mesh.p_end) p = Vec3(end_from_start * Vec4(p, 1.f));
+  for (Vec3& n : mesh.n_end) {
+    const Vec3 t = nm * n;
+    const Float len = glm::length(t);
     n = len > 0.f ? t / len : n;
   }
-  if (swaps_handedness(m)) mesh.flip_normals = !mesh.flip_normals;
 }
 
 std::optional<MeshDesc> make_shape_mesh(const std::string& type, const ParamSet& params, const ShapeContext& ctx) {

@@ -33,6 +33,10 @@ std::optional<MeshDesc> make_shape_mesh(const std::string& type, const ParamSet&
 // the inverse transpose, and flip_normals toggled when `m` mirrors.
 void transform_mesh(MeshDesc& mesh, const Mat4& m);
 
+// Motion blur: the mesh's positions and normals at the end of the transform
+// interval, `end_from_start` applied to those at its start.
+void add_motion(MeshDesc& mesh, const Mat4& end_from_start);
+
 bool swaps_handedness(const Mat4& m);
 
 }  // namespace tessera

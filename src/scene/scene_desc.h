@@ -35,6 +35,9 @@ struct MeshDesc {
   TextureSlot alpha{-1, Rgb(1.f)};
   // Media inside and outside (indices into SceneDesc::media, -1: vacuum).
   MediumInterface media;
+  // Motion blur: positions (and normals, when n is given) at the end of the
+  // transform interval; empty for a shape that does not move.
+  std::vector<Vec3> p_end, n_end;
   std::string where;            // "file:line" of the Shape directive, for messages
 };
 
@@ -64,6 +67,8 @@ struct CameraDesc {
   Float exposure_time = 1.f;    // shutterclose - shutteropen (scales the image, as in pbrt-v4)
   Float lens_radius = 0.f;      // thin lens (pbrt-v4 "lensradius"); 0 = pinhole
   Float focal_distance = 1e6f;  // distance of the plane in focus, along the view axis (camera space)
+  Float shutter_open = 0.f, shutter_close = 1.f;
+  Float transform_start_time = 0.f, transform_end_time = 1.f;  // pbrt-v4 TransformTimes
   std::string where;
 };
 

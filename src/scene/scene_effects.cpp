@@ -66,6 +66,7 @@ uint32_t compute_effects(const SceneDesc& scene) {
     if (!m.n.empty()) e |= kEffectShadingNormals;
     if (m.alpha.texture >= 0 || m.alpha.value.x < 1.f) e |= kEffectAlpha;
     if (m.media.inside >= 0 || m.media.outside >= 0) e |= kEffectMedia;
+    if (!m.p_end.empty()) e |= kEffectMotionBlur;
   }
   if (scene.camera_medium >= 0) e |= kEffectMedia;
   for (const Light& l : scene.lights) {
@@ -78,7 +79,7 @@ uint32_t compute_effects(const SceneDesc& scene) {
 std::string describe_effects(uint32_t e) {
   static const char* names[] = {"diffuse", "glossy", "specular", "transmission", "textures", "area-lights",
                                 "delta-lights", "environment", "mix", "interface", "shading-normals", "alpha-cutouts",
-                                "media"};
+                                "media", "motion-blur"};
   std::string out;
   for (uint32_t i = 0; i < sizeof(names) / sizeof(names[0]); ++i) {
     if (e & (1u << i)) {

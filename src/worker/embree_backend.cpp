@@ -52,6 +52,9 @@ void EmbreeScene::build(const SceneData& data) {
   const size_t nv = data.positions().size(), nt = data.num_triangles();
   if (nt > 0) {
     RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    const Vec3* end = data.view().positions_end;
+    // Motion blur: Embree interpolates each vertex between the two time steps by the ray's time.
+    if (end) rtcSetGeometryTimeStepCount(geom, 2);
     // New buffers (not shared) so Embree owns the padding it needs past the end.
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
     auto* ix = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), nt));
@@ -61,6 +64,15 @@ void EmbreeScene::build(const SceneData& data) {
     }
     std::memcpy(v, data.positions().data(), nv * 3 * sizeof(float));
     std::memcpy(ix, data.indices().data(), nt * 3 * sizeof(uint32_t));
+    if (end) {
+      auto* v1 = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 1, RTC_FORMAT_FLOAT3,
+                                                             3 * sizeof(float), nv));
+      if (!v1) {
+        rtcReleaseGeometry(geom);
+        throw std::runtime_error("embree: cannot allocate motion buffers" + (error_.empty() ? "" : ": " + error_));
+      }
+      std::memcpy(v1, end, nv * 3 * sizeof(float));
+    }
     if (data.view().triangle_alpha) {  // only scenes with cutouts pay for the filter
       rtcSetGeometryUserData(geom, const_cast<SceneView*>(&data.view()));
       rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);

@@ -14,7 +14,8 @@ namespace tessera {
 struct EmbreeTracer {
   RTCScene scene = nullptr;
 
-  bool intersect(const Vec3& o, const Vec3& d, Float tmax, TraceHit* hit) const {
+  // time: where in the transform interval, for moving shapes (0..1).
+  bool intersect(const Vec3& o, const Vec3& d, Float tmax, TraceHit* hit, Float time = 0.f) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
@@ -23,7 +24,7 @@ struct EmbreeTracer {
     rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
     rh.ray.tnear = 0.f;
     rh.ray.tfar = tmax;
-    rh.ray.time = 0.f;
+    rh.ray.time = time;
     rh.ray.mask = 0xffffffffu;
     rh.ray.id = 0;
     rh.ray.flags = 0;
@@ -38,7 +39,7 @@ struct EmbreeTracer {
     return true;
   }
 
-  bool occluded(const Vec3& o, const Vec3& d, Float tmax) const {
+  bool occluded(const Vec3& o, const Vec3& d, Float tmax, Float time = 0.f) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
@@ -47,7 +48,7 @@ struct EmbreeTracer {
     r.dir_x = d.x; r.dir_y = d.y; r.dir_z = d.z;
     r.tnear = 0.f;
     r.tfar = tmax;
-    r.time = 0.f;
+    r.time = time;
     r.mask = 0xffffffffu;
     r.id = 0;
     r.flags = 0;

@@ -30,12 +30,23 @@ void SceneData::flatten_meshes() {
   for (const MeshDesc& m : desc_.meshes) has_alpha_ |= m.alpha.texture >= 0 || m.alpha.value.x < 1.f;
   // Per-triangle media only for scenes that have any (the camera's included).
   has_media_ = (effects_ & kEffectMedia) != 0;
+  bool moves = false;
+  for (const MeshDesc& m : desc_.meshes) moves |= !m.p_end.empty();
   for (const MeshDesc& m : desc_.meshes) {
     const uint32_t base = static_cast<uint32_t>(positions_.size());
     const bool has_n = !m.n.empty(), has_uv = !m.uv.empty();
     for (size_t i = 0; i < m.p.size(); ++i) {
       positions_.push_back(m.p[i]);
       normals_.push_back(has_n ? m.n[i] : Vec3(0.f));
+      if (moves) {
+        const bool moving = m.p_end.size() == m.p.size();
+        positions_end_.push_back(moving ? m.p_end[i] : m.p[i]);
+        normals_end_.push_back(has_n ? (moving && m.n_end.size() == m.n.size() ? m.n_end[i] : m.n[i]) : Vec3(0.f));
+        if (moving) {
+          bounds_.lo = glm::min(bounds_.lo, m.p_end[i]);
+          bounds_.hi = glm::max(bounds_.hi, m.p_end[i]);
+        }
+      }
       uvs_.push_back(has_uv ? m.uv[i] : Vec2(0.f));
       bounds_.lo = glm::min(bounds_.lo, m.p[i]);
       bounds_.hi = glm::max(bounds_.hi, m.p[i]);
@@ -140,6 +151,10 @@ void SceneData::build_camera() {
   camera_.lens_radius = desc_.camera.lens_radius;
   camera_.focal_distance = desc_.camera.focal_distance;
   camera_.max_component_value = desc_.film.max_component_value;
+  camera_.shutter_open = desc_.camera.shutter_open;
+  camera_.shutter_close = desc_.camera.shutter_close;
+  camera_.transform_start_time = desc_.camera.transform_start_time;
+  camera_.transform_end_time = desc_.camera.transform_end_time;
 }
 
 void SceneData::build_filter() {
@@ -185,6 +200,10 @@ void SceneData::build_view() {
   SceneView& v = view_;
   v.positions = positions_.data();
   v.normals = normals_.data();
+  if (!positions_end_.empty()) {
+    v.positions_end = positions_end_.data();
+    v.normals_end = normals_end_.data();
+  }
   v.uvs = uvs_.data();
   v.indices = indices_.data();
   v.triangles = triangles_.data();
@@ -256,6 +275,7 @@ uint64_t SceneData::fingerprint() const {
   Fnv1a f;
   f.add_vector(positions_);
   f.add_vector(indices_);
+  if (!positions_end_.empty()) f.add_vector(positions_end_);
   for (const TriangleInfo& t : triangles_) {
     f.add(&t.material, sizeof t.material);
     f.add(&t.light, sizeof t.light);

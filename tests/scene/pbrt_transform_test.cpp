@@ -132,3 +132,40 @@ TEST(PbrtTransform, ObjectInstanceCopiesWithInstanceTransform) {
 
 }  // namespace
 }  // namespace tessera
+
+namespace tessera {
+namespace {
+
+TEST(PbrtMotion, ActiveTransformMovesOnlyTheEndOrStartTransform) {
+  SceneDesc s = test::load_world(std::string("Translate 1 0 0\nActiveTransform EndTime\nTranslate 0 5 0\n"
+                                             "ActiveTransform StartTime\nTranslate 0 0 2\nActiveTransform All\n") +
+                                 test::kTriangle + "AttributeBegin\nActiveTransform StartTime\nAttributeEnd\n" + test::kTriangle);
+  const MeshDesc& m = s.meshes[0];
+  ASSERT_EQ(m.p_end.size(), m.p.size());
+  // Start: (1, 0, 2) + p; end: (1, 5, 0) + p.
+  EXPECT_EQ(m.p[0] - m.p_end[0], Vec3(0.f, -5.f, 2.f));
+  // AttributeEnd restores the active transforms; the second shape still moves.
+  EXPECT_EQ(s.meshes[1].p[0] - s.meshes[1].p_end[0], Vec3(0.f, -5.f, 2.f));
+}
+
+TEST(PbrtMotion, StaticScenesHaveNoEndPositions) {
+  SceneDesc s = test::load_world(std::string("Translate 1 2 3\n") + test::kTriangle);
+  EXPECT_TRUE(s.meshes[0].p_end.empty());
+}
+
+TEST(PbrtMotion, BadMotionDirectivesAreErrors) {
+  auto fails = [](const std::string& text, const std::string& needle) {
+    try {
+      load_pbrt_string(text, "m.pbrt", ".");
+      ADD_FAILURE() << text;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  fails(std::string("WorldBegin\nActiveTransform Sometimes\n") + test::kTriangle, "ActiveTransform takes All");
+  fails(std::string("TransformTimes 1 0\nWorldBegin\n") + test::kTriangle, "start time below its end time");
+  fails(std::string("WorldBegin\nTransformTimes 0 1\n") + test::kTriangle, "not allowed after WorldBegin");
+}
+
+}  // namespace
+}  // namespace tessera
