@@ -93,23 +93,51 @@ Vec2 blackbody_xy(Float kelvin) {
   return sum > 0.f ? Vec2(xyz.x / sum, xyz.y / sum) : Vec2(1.f / 3.f);
 }
 
+namespace {
+
+// Piecewise-linear value of (wavelength, value) pairs, constant beyond the ends.
+double value_at(const std::vector<Float>& pairs, double l) {
+  const size_t n = pairs.size() / 2;
+  if (l <= pairs[0]) return pairs[1];
+  for (size_t i = 0; i + 1 < n; ++i) {
+    double l0 = pairs[2 * i], l1 = pairs[2 * i + 2];
+    if (l <= l1) {
+      double t = l1 > l0 ? (l - l0) / (l1 - l0) : 0.;
+      return pairs[2 * i + 1] * (1 - t) + pairs[2 * i + 3] * t;
+    }
+  }
+  return pairs[2 * n - 1];
+}
+
+// RGB of a spectrum given as a function, relative to an equal-energy white.
+template <typename SpectrumFn>
+Rgb spectrum_rgb(SpectrumFn&& f) {
+  const Rgb white = xyz_to_linear_srgb(integrate_xyz([](double) { return 1.; }));
+  return glm::max(xyz_to_linear_srgb(integrate_xyz(f)) / white, Rgb(0.f));
+}
+
+}  // namespace
+
 Rgb sampled_spectrum_rgb(const std::vector<Float>& pairs) {
   if (pairs.size() < 2) return Rgb(0.f);
-  const size_t n = pairs.size() / 2;
-  auto value_at = [&](double l) -> double {
-    if (l <= pairs[0]) return pairs[1];
-    for (size_t i = 0; i + 1 < n; ++i) {
-      double l0 = pairs[2 * i], l1 = pairs[2 * i + 2];
-      if (l <= l1) {
-        double t = l1 > l0 ? (l - l0) / (l1 - l0) : 0.;
-        return pairs[2 * i + 1] * (1 - t) + pairs[2 * i + 3] * t;
-      }
-    }
-    return pairs[2 * n - 1];
-  };
-  Rgb white = xyz_to_linear_srgb(integrate_xyz([](double) { return 1.; }));
-  Rgb rgb = xyz_to_linear_srgb(integrate_xyz(value_at));
-  return glm::max(rgb / white, Rgb(0.f));
+  return spectrum_rgb([&](double l) { return value_at(pairs, l); });
+}
+
+void sampled_conductor_rgb(const std::vector<Float>& eta_pairs, const std::vector<Float>& k_pairs, Float outside_eta,
+                           Rgb* eta, Rgb* k) {
+  *eta = sampled_spectrum_rgb(eta_pairs);
+  *k = sampled_spectrum_rgb(k_pairs);
+  if (eta_pairs.size() < 2 || k_pairs.size() < 2 || !(outside_eta > 0.f)) return;
+  const double o = outside_eta;
+  const Rgb r0 = spectrum_rgb([&](double l) {
+    const double n = value_at(eta_pairs, l) / o, kk = value_at(k_pairs, l) / o;
+    return ((n - 1) * (n - 1) + kk * kk) / ((n + 1) * (n + 1) + kk * kk);
+  });
+  for (int c = 0; c < 3; ++c) {
+    const double n = (*eta)[c] / o, r = std::min<double>(r0[c], 0.9999);
+    const double k2 = (r * (n + 1) * (n + 1) - (n - 1) * (n - 1)) / (1 - r);
+    if (k2 >= 0) (*k)[c] = static_cast<Float>(std::sqrt(k2) * o);
+  }
 }
 
 }  // namespace tessera

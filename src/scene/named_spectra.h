@@ -27,4 +27,13 @@ Vec2 blackbody_xy(Float kelvin);
 // RGB such that a constant spectrum c gives (c, c, c). A rough approximation.
 Rgb sampled_spectrum_rgb(const std::vector<Float>& lambda_value_pairs);
 
+// A conductor given by sampled eta and k spectra, as RGB: eta is each
+// channel's weighted mean (as sampled_spectrum_rgb) and k is chosen so that
+// the channel's normal-incidence reflectance, seen from a medium of index
+// `outside_eta` (a coat's), is that of the spectral Fresnel reflectance
+// ((n-1)^2 + k^2) / ((n+1)^2 + k^2) (n, k relative to it) reduced to RGB.
+// Averaging eta and k separately instead misses the colour of gold by a few per cent.
+void sampled_conductor_rgb(const std::vector<Float>& eta_pairs, const std::vector<Float>& k_pairs, Float outside_eta,
+                           Rgb* eta, Rgb* k);
+
 }  // namespace tessera

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "scene/named_spectra.h"
 #include "scene/pbrt_textures.h"
 
 namespace tessera {
@@ -57,6 +58,16 @@ void read_conductor(Material& m, const ParamSet& params, const DirectiveContext&
   if (params.find_any(prefix + "reflectance")) {
     m.conductor_from_reflectance = true;
     m.reflectance = spectrum_slot(params, prefix + "reflectance", Rgb(1.f), ctx);
+  } else if (const Param* e = params.find_any(prefix + "eta"), *kp = params.find_any(prefix + "k");
+             e && kp && e->type == "spectrum" && kp->type == "spectrum" && !e->file.empty() && !kp->file.empty()) {
+    // Both measured spectra (.spd files): fitted together (named_spectra.h).
+    std::vector<Float> eta_pairs(e->numbers.begin(), e->numbers.end()), k_pairs(kp->numbers.begin(), kp->numbers.end());
+    // Under a coat the conductor is seen from the coat's index (pbrt-v4 divides eta and k by it).
+    const Float outside = prefix == "conductor." ? read_ior(params, "interface.eta", 1.5f, ctx) : 1.f;
+    sampled_conductor_rgb(eta_pairs, k_pairs, outside, &m.eta, &m.k);
+    e->used = kp->used = true;
+    ctx.warn("conductor \"" + prefix + "eta\" and \"" + prefix + "k\" spectra (files '" + e->file + "', '" + kp->file +
+             "') reduced to RGB, matching their normal-incidence reflectance");
   } else {
     // A lone "float eta" is allowed too (grey).
     const Material defaults;

@@ -330,6 +330,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
   } else if (d == "LightSource") {
     std::string type = read_string(tokens, pos, at);
     ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
+    if (state_.ctm_end != state_.ctm) warn("a moving light is not supported; it stays where it starts");
     if (auto light = make_light(type, ps, ctm, context(at, including_dir))) {
       if (!open_instance_.empty()) warn("lights inside ObjectBegin are not instanced; added once");
       scene_.lights.push_back(*light);
@@ -395,6 +396,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     std::string type = ps.get_string("type", "");
     if (type.empty()) fail(at, "MakeNamedMedium \"" + name + "\" needs \"string type\"");
     if (names_.media.count(name)) warn("named medium \"" + name + "\" redefined");
+    if (state_.ctm_end != state_.ctm) warn("a moving medium is not supported; it stays where it starts");
     if (std::optional<Medium> m = make_medium(type, ps, ctm, context(at, including_dir))) {
       if (scene_.media.size() >= static_cast<size_t>(INT16_MAX)) fail(at, "too many media (at most 32767)");
       scene_.media.push_back(*m);
@@ -482,10 +484,23 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
   }
   mesh->media = state_.media;
   if (state_.ctm_end != state_.ctm) {
-    if (mesh->area_light >= 0)
+    if (mesh->area_light >= 0) {
       scene_.warnings.push_back(at.where() + ": a moving area light is not supported; it stays where it starts");
-    else if (glm::determinant(state_.ctm) != 0.f)
-      add_motion(*mesh, state_.ctm_end * glm::inverse(state_.ctm));
+    } else if (glm::determinant(state_.ctm) == 0.f) {
+      scene_.warnings.push_back(at.where() + ": the shape's start transform is singular; it does not move");
+    } else {
+      const Mat4 end_from_start = state_.ctm_end * glm::inverse(state_.ctm);
+      add_motion(*mesh, end_from_start);
+      // Vertices move on straight lines: exact for translation and scale, a
+      // chord instead of pbrt-v4's arc for a rotation.
+      const Mat3 l(end_from_start);
+      Float off = 0.f, diag = 0.f;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) (i == j ? diag : off) += std::abs(l[i][j]);
+      if (off > 0.05f * diag)
+        scene_.warnings.push_back(at.where() + ": a rotating shape's vertices move on straight lines (pbrt-v4 "
+                                  "interpolates the rotation): fast spins are blurred differently");
+    }
   }
   mesh->alpha = float_slot(params, "alpha", 1.f, context(at, including_dir));
   if (mesh->alpha.texture < 0 && !(mesh->alpha.value.x >= 0.f && mesh->alpha.value.x <= 1.f))

@@ -309,7 +309,8 @@ uint64_t SceneData::film_fingerprint() const {
   // pbrt's defaults give 0, so checkpoints of such scenes keep their fingerprint.
   const FilterDesc default_filter;
   const bool defaults = camera_.pixel_from_radiance == Mat3(1.f) && !std::isfinite(camera_.max_component_value) &&
-                        camera_.lens_radius == 0.f && std::memcmp(&desc_.filter, &default_filter, sizeof default_filter) == 0;
+                        camera_.lens_radius == 0.f && std::memcmp(&desc_.filter, &default_filter, sizeof default_filter) == 0 &&
+                        positions_end_.empty();
   if (defaults) return 0;
   Fnv1a f;
   f.add(&camera_.pixel_from_radiance, sizeof camera_.pixel_from_radiance);
@@ -318,6 +319,11 @@ uint64_t SceneData::film_fingerprint() const {
   f.add(&camera_.lens_radius, sizeof camera_.lens_radius);
   f.add(&camera_.focal_distance, sizeof camera_.focal_distance);
   f.add(&desc_.filter, sizeof desc_.filter);
+  if (!positions_end_.empty()) {  // motion blur: when the shutter opens, and the transforms' times
+    const Float times[4] = {camera_.shutter_open, camera_.shutter_close, camera_.transform_start_time,
+                            camera_.transform_end_time};
+    f.add(times, sizeof times);
+  }
   return f.h;
 }
 

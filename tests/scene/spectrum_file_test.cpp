@@ -49,7 +49,8 @@ TEST(SpectrumFile, SceneParametersReadFilesBesideTheScene) {
   EXPECT_VEC3_NEAR(m.eta, Vec3(0.2f), 1e-3f);
   EXPECT_VEC3_NEAR(m.k, Vec3(3.f), 3e-3f);
   bool warned = false;
-  for (const std::string& w : s.warnings) warned |= w.find("(file 'spds/eta.spd'); using an approximate RGB") != std::string::npos;
+  for (const std::string& w : s.warnings)
+    warned |= w.find("(files 'spds/eta.spd', 'spds/k.spd') reduced to RGB") != std::string::npos;
   EXPECT_TRUE(warned);
   // A sloped reflectance reduces to a colour that follows the slope.
   dir.write("red.spd", "400 0.1 700 0.9\n");
