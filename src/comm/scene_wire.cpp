@@ -26,7 +26,8 @@ void serialize(Archive& ar, SceneDesc& d) {
      raw_value(d.film.pixel_from_radiance), raw_value(d.film.sensor_from_radiance), raw_value(d.film.pixel_from_sensor));
   ar(d.meshes, raw(d.materials), raw(d.textures), d.images, raw(d.area_lights), raw(d.lights), d.warnings, d.source);
   ar(raw(d.media), d.camera_medium, d.grids);
-  ar(d.camera.shutter_open, d.camera.shutter_close, d.camera.transform_start_time, d.camera.transform_end_time);
+  ar(d.camera.shutter_open, d.camera.shutter_close, d.camera.transform_start_time, d.camera.transform_end_time,
+     raw_value(d.camera.world_from_camera_end));
 }
 
 Bytes encode_scene(const SceneDesc& desc) { return encode(desc); }

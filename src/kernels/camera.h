@@ -16,21 +16,31 @@ struct Ray {
 // u_lens: a point on the lens (used only when c.lens_radius > 0; pbrt-v4's
 // thin lens: the ray passes through the point of the focal plane that the
 // pinhole ray meets).
-TESSERA_HOST_DEVICE inline Ray generate_camera_ray(const CameraView& c, Vec2 p_film, Vec2 u_lens = Vec2(0.f)) {
+// time: Ray::time; a moving camera (motion blur) is interpolated linearly
+// between its start and end placements.
+TESSERA_HOST_DEVICE inline Ray generate_camera_ray(const CameraView& c, Vec2 p_film, Vec2 u_lens = Vec2(0.f),
+                                                   Float time = 0.f) {
   Float sx = c.screen_min.x + (p_film.x / c.width) * (c.screen_max.x - c.screen_min.x);
   Float sy = c.screen_max.y - (p_film.y / c.height) * (c.screen_max.y - c.screen_min.y);
   Vec3 d_cam(sx * c.tan_half_fov, sy * c.tan_half_fov, 1.f);
+  Mat3 world_from_camera_linear = c.world_from_camera_linear;
+  Vec3 origin = c.origin;
+  if (c.moves && time > 0.f) {
+    world_from_camera_linear += time * (c.world_from_camera_linear_end - c.world_from_camera_linear);
+    origin = glm::mix(origin, c.origin_end, time);
+  }
   Ray r;
-  r.o = c.origin;
+  r.time = time;
+  r.o = origin;
   if (c.lens_radius > 0.f) {
     d_cam = glm::normalize(d_cam);
     const Vec2 lens = c.lens_radius * sample_uniform_disk_concentric(u_lens);
     const Vec3 focus = d_cam * (c.focal_distance / d_cam.z);
     const Vec3 o_cam(lens.x, lens.y, 0.f);
     d_cam = focus - o_cam;
-    r.o = c.origin + c.world_from_camera_linear * o_cam;
+    r.o = origin + world_from_camera_linear * o_cam;
   }
-  r.d = glm::normalize(c.world_from_camera_linear * d_cam);
+  r.d = glm::normalize(world_from_camera_linear * d_cam);
   return r;
 }
 
@@ -89,15 +99,15 @@ TESSERA_HOST_DEVICE inline CameraSample sample_camera_ray(const SceneView& s, in
   const FilterSample fs = sample_filter(s.filter, sampler.uniform2());
   const Vec2 p_film(x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y);
   const Vec2 u_lens = s.camera.lens_radius > 0.f ? sampler.uniform2() : Vec2(0.f);
-  Ray r = generate_camera_ray(s.camera, p_film, u_lens);
   // Motion blur: a time in the shutter interval, as a fraction of the
-  // transform interval (pbrt-v4's TransformTimes), drawn only where shapes move.
-  if (s.positions_end) {
+  // transform interval (pbrt-v4's TransformTimes), drawn only where something moves.
+  Float time = 0.f;
+  if (s.positions_end || s.camera.moves) {
     const Float t = s.camera.shutter_open + sampler.uniform() * (s.camera.shutter_close - s.camera.shutter_open);
-    r.time = glm::clamp((t - s.camera.transform_start_time) /
-                            (s.camera.transform_end_time - s.camera.transform_start_time), 0.f, 1.f);
+    time = glm::clamp((t - s.camera.transform_start_time) /
+                          (s.camera.transform_end_time - s.camera.transform_start_time), 0.f, 1.f);
   }
-  return CameraSample{r, fs.weight};
+  return CameraSample{generate_camera_ray(s.camera, p_film, u_lens, time), fs.weight};
 }
 
 }  // namespace tessera

@@ -39,6 +39,9 @@ struct CameraView {
   // at their start transform at transform_start_time, their end one at transform_end_time).
   Float shutter_open = 0.f, shutter_close = 1.f;
   Float transform_start_time = 0.f, transform_end_time = 1.f;
+  bool moves = false;  // a moving camera: its placement at the end of the transform interval
+  Mat3 world_from_camera_linear_end{1.f};
+  Vec3 origin_end{0.f};
 };
 
 // A separable pixel filter, sampled per axis in proportion to |f| (filter

@@ -433,6 +433,11 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   if (type != "perspective") warnings.push_back(at.where() + ": camera \"" + type + "\" treated as \"perspective\"");
   if (glm::determinant(state_.ctm) == 0.f) fail(at, "camera transform is singular");
   scene_.camera.world_from_camera = glm::inverse(state_.ctm);
+  scene_.camera.world_from_camera_end = scene_.camera.world_from_camera;
+  if (state_.ctm_end != state_.ctm) {
+    if (glm::determinant(state_.ctm_end) == 0.f) fail(at, "camera end transform is singular");
+    scene_.camera.world_from_camera_end = glm::inverse(state_.ctm_end);
+  }
   scene_.camera.fov_degrees = params.get_float("fov", 90.f);
   // pbrt-v4 swaps reversed shutter times and refuses a shutter that never opens.
   Float open = params.get_float("shutteropen", 0.f), close = params.get_float("shutterclose", 1.f);
@@ -447,9 +452,7 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   scene_.camera.shutter_close = close;
   scene_.camera.where = at.where();
   scene_.camera_medium = state_.media.outside;  // pbrt-v4: the camera sits in the current outside medium
-  coordinate_systems_["camera"] = {scene_.camera.world_from_camera, scene_.camera.world_from_camera};
-  if (state_.ctm_end != state_.ctm)
-    warnings.push_back(at.where() + ": a moving camera (motion blur) is not supported; it stays where it starts");
+  coordinate_systems_["camera"] = {scene_.camera.world_from_camera, scene_.camera.world_from_camera_end};
   scene_.camera.lens_radius = params.get_float("lensradius", 0.f);
   scene_.camera.focal_distance = params.get_float("focaldistance", 1e6f);
   if (!(scene_.camera.lens_radius >= 0.f) || !std::isfinite(scene_.camera.lens_radius))

@@ -68,6 +68,7 @@ struct CameraDesc {
   Float lens_radius = 0.f;      // thin lens (pbrt-v4 "lensradius"); 0 = pinhole
   Float focal_distance = 1e6f;  // distance of the plane in focus, along the view axis (camera space)
   Float shutter_open = 0.f, shutter_close = 1.f;
+  Mat4 world_from_camera_end{1.f};  // == world_from_camera unless the camera moves (motion blur)
   Float transform_start_time = 0.f, transform_end_time = 1.f;  // pbrt-v4 TransformTimes
   std::string where;
 };

@@ -69,6 +69,7 @@ uint32_t compute_effects(const SceneDesc& scene) {
     if (!m.p_end.empty()) e |= kEffectMotionBlur;
   }
   if (scene.camera_medium >= 0) e |= kEffectMedia;
+  if (scene.camera.world_from_camera_end != scene.camera.world_from_camera) e |= kEffectMotionBlur;
   for (const Light& l : scene.lights) {
     if (l.type == LightType::Infinite) e |= kEffectEnvironment;
     else if (l.type != LightType::Area) e |= kEffectDeltaLights;

@@ -136,6 +136,9 @@ void SceneData::build_camera() {
   camera_.height = film.yres;
   camera_.world_from_camera_linear = Mat3(desc_.camera.world_from_camera);
   camera_.origin = Vec3(desc_.camera.world_from_camera * Vec4(0.f, 0.f, 0.f, 1.f));
+  camera_.moves = desc_.camera.world_from_camera_end != desc_.camera.world_from_camera;
+  camera_.world_from_camera_linear_end = Mat3(desc_.camera.world_from_camera_end);
+  camera_.origin_end = Vec3(desc_.camera.world_from_camera_end * Vec4(0.f, 0.f, 0.f, 1.f));
   Float aspect = static_cast<Float>(film.xres) / static_cast<Float>(film.yres);
   if (aspect > 1.f) {
     camera_.screen_min = Vec2(-aspect, -1.f);
@@ -310,7 +313,7 @@ uint64_t SceneData::film_fingerprint() const {
   const FilterDesc default_filter;
   const bool defaults = camera_.pixel_from_radiance == Mat3(1.f) && !std::isfinite(camera_.max_component_value) &&
                         camera_.lens_radius == 0.f && std::memcmp(&desc_.filter, &default_filter, sizeof default_filter) == 0 &&
-                        positions_end_.empty();
+                        positions_end_.empty() && !camera_.moves;
   if (defaults) return 0;
   Fnv1a f;
   f.add(&camera_.pixel_from_radiance, sizeof camera_.pixel_from_radiance);
@@ -319,7 +322,9 @@ uint64_t SceneData::film_fingerprint() const {
   f.add(&camera_.lens_radius, sizeof camera_.lens_radius);
   f.add(&camera_.focal_distance, sizeof camera_.focal_distance);
   f.add(&desc_.filter, sizeof desc_.filter);
-  if (!positions_end_.empty()) {  // motion blur: when the shutter opens, and the transforms' times
+  if (!positions_end_.empty() || camera_.moves) {  // motion blur: the shutter, the transforms' times, the camera's end
+    f.add(&camera_.world_from_camera_linear_end, sizeof camera_.world_from_camera_linear_end);
+    f.add(&camera_.origin_end, sizeof camera_.origin_end);
     const Float times[4] = {camera_.shutter_open, camera_.shutter_close, camera_.transform_start_time,
                             camera_.transform_end_time};
     f.add(times, sizeof times);

@@ -11,10 +11,15 @@ namespace tessera {
 namespace {
 
 // A white quad x in [-2, 0] at z = 10, lit head-on; `motion` (after
-// ActiveTransform EndTime) moves its end position. The camera sees x in [-2, 2].
-std::string quad_scene(const std::string& motion, const std::string& camera_params = "") {
+// ActiveTransform EndTime) moves its end position, `camera_motion` the
+// camera's. The camera sees x in [-2, 2].
+std::string quad_scene(const std::string& motion, const std::string& camera_params = "",
+                       const std::string& camera_motion = "") {
   return R"(
 LookAt 0 0 0  0 0 1  0 1 0
+ActiveTransform EndTime
+)" + camera_motion + R"(
+ActiveTransform All
 Camera "perspective" "float fov" [ 22.619865 ] )" + camera_params + R"(
 Film "rgb" "integer xresolution" [ 32 ] "integer yresolution" [ 32 ]
 Sampler "independent" "integer pixelsamples" [ 256 ]
@@ -56,6 +61,16 @@ TEST(MotionBlur, AQuadMovingByItsWidthSpreadsOverBothHalves) {
   // Coverage ramps from 0 to 1 across the left half and back down across the
   // right: each half gets half of the quad's light.
   RenderResult r = testing::render_text(quad_scene("Translate 2 0 0"));
+  const auto [left, right] = halves(r);
+  EXPECT_NEAR(left, 0.5 * kLit * kRows, 0.02 * kLit);
+  EXPECT_NEAR(right, 0.5 * kLit * kRows, 0.02 * kLit);
+  EXPECT_NE(r.stats.effects & kEffectMotionBlur, 0u);
+}
+
+TEST(MotionBlur, ACameraMovingTheOtherWaySeesTheSameBlur) {
+  // The camera ends at x = -2: the quad, still, sweeps across the view as if
+  // it had moved by +2.
+  RenderResult r = testing::render_text(quad_scene("", "", "Translate 2 0 0"));
   const auto [left, right] = halves(r);
   EXPECT_NEAR(left, 0.5 * kLit * kRows, 0.02 * kLit);
   EXPECT_NEAR(right, 0.5 * kLit * kRows, 0.02 * kLit);
