@@ -8,7 +8,9 @@
 
 namespace tessera {
 
-enum class BsdfType : uint32_t { Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, DiffuseTransmission, CoatedConductor };
+enum class BsdfType : uint32_t {
+  Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, DiffuseTransmission, CoatedConductor, ThinDielectric
+};
 
 // Lobe flags, combinable.
 enum BsdfLobe : uint32_t {

@@ -249,6 +249,38 @@ TESSERA_HOST_DEVICE inline bool dielectric_sample(const BsdfParams& b, const Vec
   return true;
 }
 
+// --------------------------------------------------------- ThinDielectric ---
+// pbrt-v4's ThinDielectricBxDF: a sheet of glass (a window) whose two
+// parallel faces reflect R and transmit T at the incidence angle; the light
+// bouncing inside leaves either way, so it reflects R + T^2 R / (1 - R^2) and
+// the rest goes straight through, undeflected (no eta^2 scaling: it leaves
+// into the medium it came from). Both lobes are deltas.
+TESSERA_HOST_DEVICE inline Float thin_dielectric_reflectance(const BsdfParams& b, Float cos_o) {
+  Float R = fr_dielectric(fabsf(cos_o), dielectric_eta(b));
+  const Float T = 1.f - R;
+  if (R < 1.f) R += T * T * R / (1.f - R * R);
+  return R;
+}
+
+TESSERA_HOST_DEVICE inline bool thin_dielectric_sample(const BsdfParams& b, const Vec3& wo, Float uc, BsdfSample* s) {
+  const Float R = thin_dielectric_reflectance(b, wo.z), T = 1.f - R;
+  const Float c = abs_cos_theta(wo);
+  if (!(c > 0.f)) return false;
+  if (uc < R / (R + T)) {
+    s->wi = Vec3(-wo.x, -wo.y, wo.z);
+    s->f = Rgb(R / c);
+    s->pdf = R / (R + T);
+    s->lobe = kLobeReflection | kLobeSpecular;
+  } else {
+    s->wi = -wo;
+    s->f = Rgb(T / c);
+    s->pdf = T / (R + T);
+    s->lobe = kLobeTransmission | kLobeSpecular;
+  }
+  s->eta = 1.f;
+  return s->pdf > 0.f;
+}
+
 // ---------------------------------------------------------- CoatedDiffuse ---
 // pbrt-v4's "coateddiffuse": the value f(wo, wi) is pbrt-v4's own layered
 // estimate (layered.h: a random walk between the dielectric coat and the
@@ -381,6 +413,7 @@ TESSERA_HOST_DEVICE inline bool bsdf_sample(const BsdfParams& b, const Vec3& wo,
     case BsdfType::Dielectric: ok = bsdf_detail::dielectric_sample(b, wo, uc, u, &s); break;
     case BsdfType::CoatedDiffuse: ok = bsdf_detail::coated_sample(b, wo, uc, u, &s); break;
     case BsdfType::CoatedConductor: ok = bsdf_detail::coated_conductor_sample(b, wo, uc, u, &s); break;
+    case BsdfType::ThinDielectric: ok = bsdf_detail::thin_dielectric_sample(b, wo, uc, &s); break;
     case BsdfType::DiffuseTransmission: ok = bsdf_detail::diffuse_transmission_sample(b, wo, uc, u, &s); break;
   }
   // pbrt-v4 BSDF::Sample_f: reject black f, zero pdf and wi in the tangent plane.
@@ -409,6 +442,7 @@ TESSERA_HOST_DEVICE inline uint32_t bsdf_lobes(const BsdfParams& b) {
     case BsdfType::CoatedDiffuse:
       return kLobeReflection | kLobeDiffuse |
              (bsdf_detail::distrib(b).effectively_smooth() ? kLobeSpecular : kLobeGlossy);
+    case BsdfType::ThinDielectric: return kLobeReflection | kLobeTransmission | kLobeSpecular;
     case BsdfType::CoatedConductor: {
       const bool coat_smooth = bsdf_detail::distrib(b).effectively_smooth();
       if (coat_smooth && bsdf_detail::coated_conductor::base_smooth(b)) return kLobeReflection | kLobeSpecular;

@@ -32,7 +32,7 @@ struct ImageView {
 };
 
 enum class MaterialType : uint32_t {
-  Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, Interface, Mix, DiffuseTransmission, CoatedConductor
+  Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, Interface, Mix, DiffuseTransmission, CoatedConductor, ThinDielectric
 };
 
 struct Material {

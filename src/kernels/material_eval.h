@@ -83,6 +83,9 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
     case MaterialType::Dielectric:
       b.type = BsdfType::Dielectric;
       break;
+    case MaterialType::ThinDielectric:
+      b.type = BsdfType::ThinDielectric;
+      break;
     case MaterialType::DiffuseTransmission: {
       b.type = BsdfType::DiffuseTransmission;
       const Rgb t = (Spec & kSpecTextures) ? eval_slot(s, m->transmittance, h.uv) : m->transmittance.value;

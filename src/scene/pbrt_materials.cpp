@@ -107,11 +107,13 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
     m.reflectance = spectrum_slot(params, "reflectance", Rgb(0.5f), ctx);
   } else if (type == "conductor") {
     read_conductor(m, params, ctx, "");
-  } else if (type == "dielectric" || type == "thindielectric") {
-    if (type == "thindielectric") ctx.warn("thindielectric is approximated by dielectric (light refracts)");
+  } else if (type == "dielectric") {
     m.type = MaterialType::Dielectric;
     m.ior = read_ior(params, "eta", 1.5f, ctx);
     read_roughness(m, params, ctx);
+  } else if (type == "thindielectric") {
+    m.type = MaterialType::ThinDielectric;  // pbrt-v4: smooth only
+    m.ior = read_ior(params, "eta", 1.5f, ctx);
   } else if (type == "coateddiffuse") {
     m.type = MaterialType::CoatedDiffuse;
     m.reflectance = spectrum_slot(params, "reflectance", Rgb(0.5f), ctx);

@@ -35,6 +35,9 @@ void add_material_effects(const SceneDesc& scene, int32_t index, uint32_t& e, in
     case MaterialType::Dielectric:
       e |= (smooth ? kEffectSpecular : kEffectGlossy) | kEffectTransmission;
       break;
+    case MaterialType::ThinDielectric:
+      e |= kEffectSpecular | kEffectTransmission;
+      break;
     case MaterialType::CoatedDiffuse:
       e |= kEffectDiffuse | (smooth ? kEffectSpecular : kEffectGlossy);
       if (slot_textured(m.reflectance)) e |= kEffectTextures;

@@ -675,3 +675,41 @@ TEST(BsdfRobustness, NoNanOrInf) {
     }
   }
 }
+
+namespace tessera {
+namespace {
+
+// pbrt-v4's thindielectric: a window. Light reflects R + T^2 R / (1 - R^2)
+// (R, T of one face) and the rest passes straight through; nothing is lost.
+TEST(ThinDielectric, ReflectsTheInterreflectedShareAndPassesTheRestStraightThrough) {
+  BsdfParams b;
+  b.type = BsdfType::ThinDielectric;
+  b.ior = 1.5f;
+  const double R1 = 0.04, expected_r = R1 + (1 - R1) * (1 - R1) * R1 / (1 - R1 * R1);
+  for (double theta : {0.0, 0.7, 1.3}) {
+    const Vec3 wo(Float(std::sin(theta)), 0.f, Float(std::cos(theta)));
+    double reflected = 0, transmitted = 0;
+    Rng rng = Rng::for_sample(5, 6, 7);
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) {
+      BsdfSample s;
+      ASSERT_TRUE(bsdf_sample(b, wo, rng.uniform(), rng.uniform2(), &s));
+      const double w = s.f.x * std::abs(s.wi.z) / s.pdf;
+      if (s.lobe & kLobeReflection) {
+        EXPECT_NEAR(s.wi.x, -wo.x, 1e-6f);
+        reflected += w;
+      } else {
+        EXPECT_NEAR(glm::length(s.wi + wo), 0.f, 1e-6f);  // undeflected
+        transmitted += w;
+      }
+      EXPECT_EQ(s.lobe & kLobeSpecular, kLobeSpecular);
+    }
+    EXPECT_NEAR((reflected + transmitted) / n, 1.0, 1e-5) << theta;  // white furnace
+    if (theta == 0.0) EXPECT_NEAR(reflected / n, expected_r, 0.01);
+  }
+  EXPECT_EQ(bsdf_eval(b, Vec3(0, 0, 1), Vec3(0, 0, -1)), Rgb(0.f));  // deltas only
+  EXPECT_EQ(bsdf_pdf(b, Vec3(0, 0, 1), Vec3(0, 0, -1)), 0.f);
+}
+
+}  // namespace
+}  // namespace tessera
