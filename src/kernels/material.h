@@ -12,7 +12,7 @@ struct TextureSlot {
   Rgb value{0.f};        // constant (float parameters use value.x)
 };
 
-enum class TextureType : uint32_t { Constant = 0, Image, Scale, Checkerboard };
+enum class TextureType : uint32_t { Constant = 0, Image, Scale, Checkerboard, Mix, Bilerp };
 
 // pbrt-v4 "uv" mapping: st = (su * u + du, sv * v + dv).
 struct Texture {
@@ -22,7 +22,9 @@ struct Texture {
   Float su = 1.f, sv = 1.f, du = 0.f, dv = 0.f;
   Float scale = 1.f;         // Image: multiplier (pbrt "scale")
   bool invert = false;       // Image: 1 - value (pbrt "invert")
-  TextureSlot a, b;          // Scale: a * b ("tex" * "scale"); Checkerboard: tex1, tex2
+  TextureSlot a, b;          // Scale: a * b ("tex" * "scale"); Checkerboard, Mix: tex1, tex2
+  TextureSlot amount;        // Mix: (1 - amount) tex1 + amount tex2
+  Rgb corners[4] = {Rgb(0.f), Rgb(1.f), Rgb(0.f), Rgb(1.f)};  // Bilerp: v00, v01, v10, v11 at (s, t) corners
 };
 
 // Linear RGB texels, row 0 is the top row of the file.

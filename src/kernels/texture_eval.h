@@ -63,6 +63,16 @@ TESSERA_HOST_DEVICE inline Rgb eval_texture(const SceneView& s, int32_t tex_inde
       const TextureSlot& pick = (parity % 2 == 0) ? t.a : t.b;
       return pick.texture >= 0 ? eval_texture(s, pick.texture, uv) : pick.value;
     }
+    case TextureType::Mix: {  // pbrt-v4 MixTexture: a component with weight 0 is not evaluated
+      const Float amt = (t.amount.texture >= 0 ? eval_texture(s, t.amount.texture, uv) : t.amount.value).x;
+      Rgb v(0.f);
+      if (amt != 1.f) v += (1.f - amt) * (t.a.texture >= 0 ? eval_texture(s, t.a.texture, uv) : t.a.value);
+      if (amt != 0.f) v += amt * (t.b.texture >= 0 ? eval_texture(s, t.b.texture, uv) : t.b.value);
+      return v;
+    }
+    case TextureType::Bilerp:  // corners v00, v01, v10, v11 at (s, t) = (0,0), (0,1), (1,0), (1,1)
+      return (1.f - st.x) * (1.f - st.y) * t.corners[0] + (1.f - st.x) * st.y * t.corners[1] +
+             st.x * (1.f - st.y) * t.corners[2] + st.x * st.y * t.corners[3];
   }
   return Rgb(0.f);
 }

@@ -121,6 +121,19 @@ void make_named_texture(const std::string& name, const std::string& kind, const 
     t.a = any_slot(params, "tex1", spectrum, Rgb(1.f), ctx);
     t.b = any_slot(params, "tex2", spectrum, Rgb(0.f), ctx);
     read_uv_mapping(t, params, ctx);
+  } else if (texture_class == "mix") {
+    t.type = TextureType::Mix;
+    t.a = any_slot(params, "tex1", spectrum, Rgb(0.f), ctx);
+    t.b = any_slot(params, "tex2", spectrum, Rgb(1.f), ctx);
+    t.amount = float_slot(params, "amount", 0.5f, ctx);
+  } else if (texture_class == "bilerp") {
+    t.type = TextureType::Bilerp;
+    const char* names[4] = {"v00", "v01", "v10", "v11"};
+    const Float defaults[4] = {0.f, 1.f, 0.f, 1.f};
+    for (int i = 0; i < 4; ++i)
+      t.corners[i] = spectrum ? params.get_rgb(names[i]).value_or(Rgb(defaults[i]))
+                              : Rgb(params.get_float(names[i], defaults[i]));
+    read_uv_mapping(t, params, ctx);
   } else {
     ctx.warn("unsupported texture class \"" + texture_class + "\"; using a constant 0.5");
     t.type = TextureType::Constant;

@@ -3,6 +3,7 @@
 
 #include <ImfRgbaFile.h>
 
+#include "scene/displacement.h"
 #include "scene/image_io.h"
 #include "scene/pbrt_materials.h"
 #include "scene_test_helpers.h"
@@ -131,6 +132,24 @@ TEST(PbrtTextures, ConstantScaleCheckerboard) {
   EXPECT_EQ(s.materials[s.meshes[0].material].reflectance.texture, 3);
   // A constant float texture as roughness gives its value (remapped).
   EXPECT_NEAR(s.materials[s.meshes[1].material].alpha_x, std::sqrt(0.5f), 1e-6f);
+}
+
+TEST(PbrtTextures, MixAndBilerpEvaluateAsPbrtV4s) {
+  SceneDesc s = load_world(
+      "Texture \"amt\" \"float\" \"bilerp\" \"float v00\" 0 \"float v01\" 0 \"float v10\" 1 \"float v11\" 1\n"
+      "Texture \"m\" \"float\" \"mix\" \"float tex1\" 2 \"float tex2\" 4 \"texture amount\" \"amt\"\n"
+      "Texture \"d\" \"float\" \"mix\"\n" + std::string(kTriangle));
+  ASSERT_EQ(s.textures.size(), 3u);
+  EXPECT_EQ(s.textures[0].type, TextureType::Bilerp);
+  EXPECT_EQ(s.textures[1].type, TextureType::Mix);
+  const HostTextures t(s);
+  // The amount rises with s (v10 = v11 = 1): tex1 at s = 0, tex2 at s = 1.
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{0, Rgb(0.f)}, Vec2(0.25f, 0.7f)), 0.25f);
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{1, Rgb(0.f)}, Vec2(0.f, 0.3f)), 2.f);
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{1, Rgb(0.f)}, Vec2(0.75f, 0.3f)), 3.5f);
+  // pbrt-v4's defaults: tex1 0, tex2 1, amount 0.5.
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{2, Rgb(0.f)}, Vec2(0.3f, 0.3f)), 0.5f);
+  EXPECT_TRUE(s.warnings.empty());
 }
 
 TEST(PbrtTextures, UnsupportedClassWarnsConstantHalf) {
