@@ -1,5 +1,6 @@
 #include "scene/pbrt_shapes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -178,6 +179,33 @@ MeshDesc sphere_mesh(const ParamSet& params, const ShapeContext& ctx) {
   return m;
 }
 
+constexpr int kCylinderRings = 8, kCylinderSegments = 128;
+
+// pbrt-v4's cylinder: radius, zmin, zmax, phimax; u = phi / phimax, v along z.
+MeshDesc cylinder_mesh(const ParamSet& params, const ShapeContext& ctx) {
+  const Float r = params.get_float("radius", 1.f);
+  const Float zmin = params.get_float("zmin", -1.f), zmax = params.get_float("zmax", 1.f);
+  const Float phimax = glm::radians(std::clamp(params.get_float("phimax", 360.f), 0.f, 360.f));
+  if (!(r > 0.f) || !std::isfinite(r)) fail(ctx, "cylinder radius must be positive");
+  if (!(zmax != zmin) || !std::isfinite(zmin) || !std::isfinite(zmax)) fail(ctx, "cylinder needs zmin != zmax");
+  if (!(phimax > 0.f)) fail(ctx, "cylinder phimax must be positive");
+  const Float z0 = std::min(zmin, zmax), z1 = std::max(zmin, zmax);
+  MeshDesc m;
+  // Rings run from z1 down, so d(ring) x d(phi) points outwards (pbrt-v4's dp/du x dp/dv).
+  for (int i = 0; i <= kCylinderRings; ++i) {
+    const Float z = z1 - (z1 - z0) * i / kCylinderRings;
+    for (int j = 0; j <= kCylinderSegments; ++j) {
+      const Float phi = phimax * j / kCylinderSegments;
+      const Vec3 dir(std::cos(phi), std::sin(phi), 0.f);
+      m.p.emplace_back(r * dir.x, r * dir.y, z);
+      m.n.push_back(dir);
+      m.uv.emplace_back(phi / phimax, (z - z0) / (z1 - z0));
+    }
+  }
+  add_grid_triangles(m, kCylinderRings, kCylinderSegments, false, false);
+  return m;
+}
+
 constexpr int kDiskRings = 4, kDiskSegments = 128;
 
 MeshDesc disk_mesh(const ParamSet& params, const ShapeContext& ctx) {
@@ -258,6 +286,9 @@ std::optional<MeshDesc> make_shape_mesh(const std::string& type, const ParamSet&
     quadric = true;
   } else if (type == "disk") {
     m = disk_mesh(params, ctx);
+    quadric = true;
+  } else if (type == "cylinder") {
+    m = cylinder_mesh(params, ctx);
     quadric = true;
   } else {
     warn(ctx, "unsupported shape \"" + type + "\"; skipped");

@@ -1,4 +1,4 @@
-// Shapes: trianglemesh, bilinearmesh, sphere, disk, plymesh.
+// Shapes: trianglemesh, bilinearmesh, sphere, disk, cylinder, plymesh.
 #include "scene_test_helpers.h"
 
 namespace tessera {
@@ -46,6 +46,25 @@ TEST(PbrtShapes, SphereIsOutwardWithPbrtUvAndArea) {
   double area = test::surface_area(m), exact = 4. * kPi * 4.;
   EXPECT_NEAR(area / exact, 1., 0.01);
   EXPECT_FALSE(m.flip_normals);
+}
+
+TEST(PbrtShapes, CylinderIsOutwardWithPbrtUvAndArea) {
+  SceneDesc s = load_world("Shape \"cylinder\" \"float radius\" 2 \"float zmin\" -1 \"float zmax\" 3\n"
+                           "Shape \"cylinder\" \"float phimax\" 90\n");
+  ASSERT_EQ(s.meshes.size(), 2u);
+  const MeshDesc& m = s.meshes[0];
+  for (size_t t = 0; t < m.indices.size() / 3; ++t) {
+    const Vec3 c = (m.p[m.indices[3 * t]] + m.p[m.indices[3 * t + 1]] + m.p[m.indices[3 * t + 2]]) / 3.f;
+    ASSERT_GT(glm::dot(test::geometric_normal(m, t), Vec3(c.x, c.y, 0.f)), 0.f) << "triangle " << t;
+  }
+  for (size_t v = 0; v < m.p.size(); ++v) {
+    ASSERT_NEAR(m.uv[v].y, (m.p[v].z + 1.f) / 4.f, 1e-5f);  // v along z from zmin
+    ASSERT_NEAR(glm::length(Vec2(m.p[v].x, m.p[v].y)), 2.f, 1e-5f);
+  }
+  EXPECT_NEAR(test::surface_area(m) / (2. * kPi * 2. * 4.), 1., 0.01);
+  // A quarter cylinder: phimax 90 degrees.
+  EXPECT_NEAR(test::surface_area(s.meshes[1]) / (0.5 * kPi * 1. * 2.), 1., 0.01);
+  EXPECT_TRUE(s.warnings.empty());
 }
 
 TEST(PbrtShapes, ReverseOrientationTurnsSphereInward) {
