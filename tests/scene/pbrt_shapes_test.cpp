@@ -108,10 +108,10 @@ TEST(PbrtShapes, BilinearMeshSplitsPatchesKeepingOrientation) {
 }
 
 TEST(PbrtShapes, UnsupportedShapeWarnsAndSkips) {
-  SceneDesc s = load_world(std::string("Shape \"cylinder\" \"float radius\" 1\n") + test::kTriangle);
+  SceneDesc s = load_world(std::string("Shape \"curve\" \"point3 P\" [ 0 0 0 1 0 0 2 0 0 3 0 0 ]\n") + test::kTriangle);
   EXPECT_EQ(s.meshes.size(), 1u);
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("test.pbrt:2: unsupported shape \"cylinder\""), std::string::npos);
+  EXPECT_NE(s.warnings[0].find("test.pbrt:2: unsupported shape \"curve\""), std::string::npos);
 }
 
 const char* kAsciiPly =
