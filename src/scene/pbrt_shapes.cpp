@@ -158,24 +158,30 @@ constexpr int kSphereThetaSteps = 64, kSpherePhiSteps = 128;
 
 MeshDesc sphere_mesh(const ParamSet& params, const ShapeContext& ctx) {
   const Float r = params.get_float("radius", 1.f);
-  const Float zmin = params.get_float("zmin", -r), zmax = params.get_float("zmax", r);
-  const Float phimax = params.get_float("phimax", 360.f);
-  if (zmin > -r || zmax < r || phimax < 360.f) warn(ctx, "partial spheres (zmin/zmax/phimax) are not supported; using a full sphere");
-  if (!(r > 0.f)) fail(ctx, "sphere radius must be positive");
+  if (!(r > 0.f) || !std::isfinite(r)) fail(ctx, "sphere radius must be positive");
+  // pbrt-v4's partial spheres: z clamped to [-r, r], phi up to phimax; v runs
+  // from zmin (0) to zmax (1), u = phi / phimax.
+  const Float z0 = std::clamp(std::min(params.get_float("zmin", -r), params.get_float("zmax", r)), -r, r);
+  const Float z1 = std::clamp(std::max(params.get_float("zmin", -r), params.get_float("zmax", r)), -r, r);
+  const Float phimax = glm::radians(std::clamp(params.get_float("phimax", 360.f), 0.f, 360.f));
+  if (!(z1 > z0) || !(phimax > 0.f)) fail(ctx, "sphere zmin, zmax and phimax leave no surface");
+  const Float theta_top = std::acos(z1 / r), theta_bottom = std::acos(z0 / r);
+  const bool top_pole = z1 >= r, bottom_pole = z0 <= -r;
   MeshDesc m;
-  // Rings run from the +z pole (theta = 0) down, so d(theta) x d(phi) is outward.
+  // Rings run from the top (smallest theta) down, so d(theta) x d(phi) is outward.
   for (int i = 0; i <= kSphereThetaSteps; ++i) {
-    Float theta = kPi * i / kSphereThetaSteps;
+    const Float theta = theta_top + (theta_bottom - theta_top) * i / kSphereThetaSteps;
     for (int j = 0; j <= kSpherePhiSteps; ++j) {
-      Float phi = 2.f * kPi * j / kSpherePhiSteps;
+      const Float phi = phimax * j / kSpherePhiSteps;
       Vec3 dir(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
-      if (i == 0 || i == kSphereThetaSteps) dir = Vec3(0.f, 0.f, i == 0 ? 1.f : -1.f);  // exact poles
+      if ((i == 0 && top_pole) || (i == kSphereThetaSteps && bottom_pole))
+        dir = Vec3(0.f, 0.f, i == 0 ? 1.f : -1.f);  // exact poles
       m.p.push_back(r * dir);
       m.n.push_back(dir);
-      m.uv.emplace_back(phi / (2.f * kPi), 1.f - theta / kPi);
+      m.uv.emplace_back(phi / phimax, (theta - theta_bottom) / (theta_top - theta_bottom));
     }
   }
-  add_grid_triangles(m, kSphereThetaSteps, kSpherePhiSteps, true, true);
+  add_grid_triangles(m, kSphereThetaSteps, kSpherePhiSteps, top_pole, bottom_pole);
   return m;
 }
 

@@ -75,10 +75,19 @@ TEST(PbrtShapes, ReverseOrientationTurnsSphereInward) {
   EXPECT_LT(glm::dot(m.n[200], m.p[200]), 0.f);
 }
 
-TEST(PbrtShapes, PartialSphereWarns) {
-  SceneDesc s = load_world("Shape \"sphere\" \"float zmax\" 0.5\n");
-  ASSERT_FALSE(s.warnings.empty());
-  EXPECT_NE(s.warnings[0].find("test.pbrt:2: partial spheres"), std::string::npos);
+TEST(PbrtShapes, PartialSpheresAreCutAsInPbrtV4) {
+  // The upper hemisphere (zmin 0) of a half turn (phimax 180): a quarter of the area.
+  SceneDesc s = load_world("Shape \"sphere\" \"float zmin\" 0 \"float phimax\" 180\n");
+  ASSERT_EQ(s.meshes.size(), 1u);
+  const MeshDesc& m = s.meshes[0];
+  EXPECT_NEAR(test::surface_area(m) / kPi, 1., 0.01);  // 4 pi r^2 / 4
+  for (size_t v = 0; v < m.p.size(); ++v) {
+    ASSERT_GE(m.p[v].z, -1e-6f);
+    ASSERT_GE(m.p[v].y, -1e-6f);  // phi in [0, pi]
+    // v runs linearly in theta from zmin (0, theta = pi/2) to zmax (1, theta = 0).
+    ASSERT_NEAR(m.uv[v].y, 1.f - std::acos(glm::clamp(m.p[v].z, -1.f, 1.f)) / (0.5f * kPi), 1e-3f);
+  }
+  EXPECT_TRUE(s.warnings.empty());
 }
 
 TEST(PbrtShapes, DiskFacesPlusZWithPbrtUv) {
