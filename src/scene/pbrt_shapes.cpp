@@ -217,16 +217,17 @@ constexpr int kDiskRings = 4, kDiskSegments = 128;
 MeshDesc disk_mesh(const ParamSet& params, const ShapeContext& ctx) {
   const Float h = params.get_float("height", 0.f), radius = params.get_float("radius", 1.f);
   const Float inner = params.get_float("innerradius", 0.f);
-  if (params.get_float("phimax", 360.f) < 360.f) warn(ctx, "partial disks (phimax) are not supported; using a full disk");
+  const Float phimax = glm::radians(std::clamp(params.get_float("phimax", 360.f), 0.f, 360.f));
   if (!(radius > inner) || inner < 0.f) fail(ctx, "disk needs 0 <= innerradius < radius");
+  if (!(phimax > 0.f)) fail(ctx, "disk phimax must be positive");
   MeshDesc m;
   // Rings run outward, so d(r) x d(phi) is +z.
   for (int i = 0; i <= kDiskRings; ++i) {
     Float rr = inner + (radius - inner) * i / kDiskRings;
     for (int j = 0; j <= kDiskSegments; ++j) {
-      Float phi = 2.f * kPi * j / kDiskSegments;
+      Float phi = phimax * j / kDiskSegments;
       m.p.emplace_back(rr * std::cos(phi), rr * std::sin(phi), h);
-      m.uv.emplace_back(phi / (2.f * kPi), (radius - rr) / (radius - inner));
+      m.uv.emplace_back(phi / phimax, (radius - rr) / (radius - inner));
     }
   }
   add_grid_triangles(m, kDiskRings, kDiskSegments, inner == 0.f, false);

@@ -100,6 +100,11 @@ TEST(PbrtShapes, DiskFacesPlusZWithPbrtUv) {
     ASSERT_NEAR(m.uv[v].y, (2.f - r) / 1.f, 1e-5f);
   }
   EXPECT_NEAR(test::surface_area(m) / (kPi * 3.), 1., 0.01);
+  // A quarter disk (phimax 90): a quarter of the area, u = phi / phimax.
+  s = load_world("Shape \"disk\" \"float phimax\" 90\n");
+  EXPECT_NEAR(test::surface_area(s.meshes[0]) / (0.25 * kPi), 1., 0.01);
+  for (const Vec3& p : s.meshes[0].p) ASSERT_TRUE(p.x >= -1e-6f && p.y >= -1e-6f);
+  EXPECT_TRUE(s.warnings.empty());
   // Under a rotation the normal follows.
   s = load_world("Rotate 90 1 0 0\nShape \"disk\"\n");
   EXPECT_VEC3_NEAR(test::geometric_normal(s.meshes[0], 0), Vec3(0, -1, 0), 1e-5f);
