@@ -410,15 +410,21 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     const std::string inside = read_string(tokens, pos, at);
     std::string outside = inside;
     if (pos < tokens.size() && tokens[pos].kind == TokenKind::String) outside = tokens[pos++].text;
-    auto medium_index = [&](const std::string& name) -> int16_t {
+    // pbrt-v4 looks media up by name when the scene is complete, so a medium
+    // may be defined after its use: names are numbered here (as -2 - k) and
+    // resolved in finish().
+    auto medium_ref = [&](const std::string& name) -> int16_t {
       if (name.empty()) return -1;
-      auto it = names_.media.find(name);
-      if (it == names_.media.end())
-        fail(at, "unknown medium \"" + name + "\" (MakeNamedMedium must come before its use)");
-      return static_cast<int16_t>(it->second);
+      auto it = medium_refs_.find(name);
+      if (it == medium_refs_.end()) {
+        if (medium_refs_.size() >= 32000) fail(at, "too many medium names");
+        it = medium_refs_.emplace(name, MediumRef{static_cast<int16_t>(-2 - static_cast<int>(medium_refs_.size())),
+                                                  at.where()}).first;
+      }
+      return it->second.code;
     };
-    state_.media.inside = medium_index(inside);
-    state_.media.outside = medium_index(outside);
+    state_.media.inside = medium_ref(inside);
+    state_.media.outside = medium_ref(outside);
   } else if (d == "ColorSpace" || d == "Option" || d == "Attribute" || d == "Accelerator") {
     warn("'" + d + "' is not supported; ignored");
     skip_arguments(tokens, pos);
@@ -521,6 +527,21 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
   }
 }
 
+void PbrtParser::resolve_media() {
+  std::map<int16_t, int16_t> index;  // code -> medium (-1: not simulated)
+  for (const auto& [name, ref] : medium_refs_) {
+    auto it = names_.media.find(name);
+    if (it == names_.media.end()) throw SceneError(ref.where + ": unknown medium \"" + name + "\" in MediumInterface");
+    index[ref.code] = static_cast<int16_t>(it->second);
+  }
+  auto resolve = [&](int16_t code) -> int16_t { return code <= -2 ? index.at(code) : code; };
+  for (MeshDesc& m : scene_.meshes) {
+    m.media.inside = resolve(m.media.inside);
+    m.media.outside = resolve(m.media.outside);
+  }
+  scene_.camera_medium = resolve(static_cast<int16_t>(scene_.camera_medium));
+}
+
 SceneDesc PbrtParser::finish(const std::string& file_name, int last_line) {
   const std::string where = file_name + ":" + std::to_string(last_line);
   if (!world_begun_) throw SceneError(where + ": missing WorldBegin");
@@ -528,6 +549,7 @@ SceneDesc PbrtParser::finish(const std::string& file_name, int last_line) {
   for (const StackEntry& e : stack_)
     if (e.kind != 'o') scene_.warnings.push_back(e.where + ": block not closed before end of file");
   if (scene_.meshes.empty() && scene_.lights.empty()) throw SceneError(where + ": empty scene (no shapes and no lights)");
+  resolve_media();
   set_film_sensor(scene_.film, scene_.camera.exposure_time);
   return std::move(scene_);
 }

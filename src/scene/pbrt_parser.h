@@ -46,6 +46,7 @@ class PbrtParser {
   void push(char kind, const Token& at);
   void pop(char kind, const Token& at);
   void require_world(const Token& at, bool inside) const;
+  void resolve_media();  // MediumInterface names -> media (pbrt-v4 resolves them at the end too)
   DirectiveContext context(const Token& at, const std::string& including_dir);
 
   SceneDesc scene_;
@@ -56,6 +57,11 @@ class PbrtParser {
   std::map<std::string, std::pair<Mat4, Mat4>> coordinate_systems_;  // start and end transforms
   std::map<std::string, std::vector<MeshDesc>> instances_;
   std::string open_instance_;  // non-empty between ObjectBegin and ObjectEnd
+  struct MediumRef {
+    int16_t code;       // what MeshDesc::media holds until resolve_media(): -2 - k
+    std::string where;  // the first MediumInterface naming it
+  };
+  std::map<std::string, MediumRef> medium_refs_;
   bool world_begun_ = false;
   int include_depth_ = 0;
 };

@@ -90,6 +90,23 @@ MakeNamedMedium "wisps" "string type" "cloud"
   EXPECT_TRUE(warned);  // cloud, rgbgrid and nanovdb media are not simulated
 }
 
+TEST(PbrtMedia, AMediumMayBeDefinedAfterItsUseAsInPbrtV4) {
+  SceneDesc d = load_pbrt_string(std::string(R"(
+MediumInterface "" "late"
+LookAt 0 0 -5  0 0 0  0 1 0
+Camera "perspective"
+WorldBegin
+MakeNamedMedium "early" "string type" "homogeneous"
+MediumInterface "late" "early"
+)") + kTriangle + "MakeNamedMedium \"late\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [ 2 2 2 ]\n",
+                                 "<t>", ".");
+  ASSERT_EQ(d.media.size(), 2u);
+  EXPECT_EQ(d.camera_medium, 1);
+  EXPECT_EQ(d.meshes[0].media.inside, 1);
+  EXPECT_EQ(d.meshes[0].media.outside, 0);
+  EXPECT_EQ(d.media[1].sigma_s, Rgb(2.f));
+}
+
 TEST(PbrtMedia, AreaLightsOnInterfaceShapesAreIgnoredAsInPbrtV4) {
   SceneDesc d = load_pbrt_string(std::string(kHead) + "AttributeBegin\nMaterial \"interface\"\n"
                                  "AreaLightSource \"diffuse\" \"rgb L\" [ 1 1 1 ]\n" + kTriangle + "AttributeEnd\n" + kTriangle,
@@ -113,6 +130,7 @@ void expect_error(const std::string& text, const std::string& needle) {
 TEST(PbrtMedia, BadMediaAreOneLineErrors) {
   const std::string world = "WorldBegin\n" + std::string(kTriangle);
   expect_error("MediumInterface \"nowhere\" \"\"\n" + world, "unknown medium \"nowhere\"");
+  expect_error(std::string("WorldBegin\nMediumInterface \"\" \"nowhere\"\n") + kTriangle, "scene.pbrt:2: unknown medium");
   expect_error("MakeNamedMedium \"m\" \"float scale\" 1\n" + world, "needs \"string type\"");
   expect_error("MakeNamedMedium \"m\" \"string type\" \"plasma\"\n" + world, "unknown medium type \"plasma\"");
   expect_error("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ -1 0 0 ]\n" + world,
