@@ -269,7 +269,11 @@ void add_motion(MeshDesc& mesh, const Mat4& end_from_start) {
   mesh.p_end = mesh.p;
   mesh.n_end = mesh.n;
   const Mat3 nm = normal_matrix(end_from_start);
-  for (Vec3& p : mesh.p_end) p = Vec3(end_from_start * Vec4(p, 1.f));
+  for (Vec3& p : mesh.p_end) {
+    p = Vec3(end_from_start * Vec4(p, 1.f));
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw SceneError(mesh.where + ": non-finite vertex coordinates at the end of the motion (NaN or Inf)");
+  }
   for (Vec3& n : mesh.n_end) {
     const Vec3 t = nm * n;
     const Float len = glm::length(t);

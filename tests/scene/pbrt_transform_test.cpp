@@ -165,6 +165,9 @@ TEST(PbrtMotion, BadMotionDirectivesAreErrors) {
   fails(std::string("WorldBegin\nActiveTransform Sometimes\n") + test::kTriangle, "ActiveTransform takes All");
   fails(std::string("TransformTimes 1 0\nWorldBegin\n") + test::kTriangle, "start time below its end time");
   fails(std::string("WorldBegin\nTransformTimes 0 1\n") + test::kTriangle, "not allowed after WorldBegin");
+  fails(std::string("WorldBegin\nActiveTransform EndTime\nScale 1e30 1e30 1e30\nScale 1e30 1e30 1e30\n") +
+            test::kTriangle,
+        "at the end of the motion");
 }
 
 }  // namespace
