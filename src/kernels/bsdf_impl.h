@@ -383,6 +383,7 @@ TESSERA_HOST_DEVICE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, co
     case BsdfType::Dielectric: return bsdf_detail::dielectric_f(b, wo, wi);
     case BsdfType::CoatedDiffuse: return bsdf_detail::coated_f(b, wo, wi);
     case BsdfType::CoatedConductor: return bsdf_detail::coated_conductor_f(b, wo, wi);
+    case BsdfType::ThinDielectric: return Rgb(0.f);  // deltas only
     case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_f(b, wo, wi);
   }
   return Rgb(0.f);
@@ -396,6 +397,7 @@ TESSERA_HOST_DEVICE inline Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, c
     case BsdfType::Dielectric: return bsdf_detail::dielectric_pdf(b, wo, wi);
     case BsdfType::CoatedDiffuse: return bsdf_detail::coated_pdf(b, wo, wi);
     case BsdfType::CoatedConductor: return bsdf_detail::coated_conductor_pdf(b, wo, wi);
+    case BsdfType::ThinDielectric: return 0.f;
     case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_pdf(b, wo, wi);
   }
   return 0.f;

@@ -705,7 +705,9 @@ TEST(ThinDielectric, ReflectsTheInterreflectedShareAndPassesTheRestStraightThrou
       EXPECT_EQ(s.lobe & kLobeSpecular, kLobeSpecular);
     }
     EXPECT_NEAR((reflected + transmitted) / n, 1.0, 1e-5) << theta;  // white furnace
-    if (theta == 0.0) EXPECT_NEAR(reflected / n, expected_r, 0.01);
+    if (theta == 0.0) {
+      EXPECT_NEAR(reflected / n, expected_r, 0.01);
+    }
   }
   EXPECT_EQ(bsdf_eval(b, Vec3(0, 0, 1), Vec3(0, 0, -1)), Rgb(0.f));  // deltas only
   EXPECT_EQ(bsdf_pdf(b, Vec3(0, 0, 1), Vec3(0, 0, -1)), 0.f);
