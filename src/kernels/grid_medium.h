@@ -83,6 +83,18 @@ TESSERA_HOST_DEVICE inline Rng tracking_rng(Float u, const Vec3& o, const Vec3& 
   return r;
 }
 
+// The next tentative collision along the clipped ray, against the majorant:
+// false once past the box (or after 2^20 of them). t is double so that free
+// paths far smaller than t still advance it.
+TESSERA_HOST_DEVICE inline bool next_tentative_collision(const DensityGridView& g, const GridRay& r, Float majorant,
+                                                         Rng& rng, int32_t& steps, double& t, Float& density) {
+  if (++steps > (1 << 20)) return false;
+  t += -glm::log(1.f - rng.uniform()) / majorant;
+  if (!(t < r.t1)) return false;
+  density = grid_density(g, r.o + static_cast<Float>(t) * r.d);
+  return true;
+}
+
 // Delta tracking along [0, t_max]: a real collision (weight sigma_s / its
 // probability) or the end of the segment; absorption ends the path (weight 0).
 TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, const DensityGridView& g, const Vec3& o,
@@ -94,11 +106,10 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
   if (!(majorant > 0.f) || !grid_clip(g, o, d, t_max, &r)) return seg;
   Rng rng = tracking_rng(u, o, d);
   Rgb w(1.f);
-  double t = r.t0;  // double: free paths far smaller than t still advance it
-  for (int32_t step = 0; step < (1 << 20); ++step) {
-    t += -glm::log(1.f - rng.uniform()) / majorant;
-    if (!(t < r.t1)) break;
-    const Float dens = grid_density(g, r.o + static_cast<Float>(t) * r.d);
+  double t = r.t0;
+  int32_t steps = 0;
+  Float dens = 0.f;
+  while (next_tentative_collision(g, r, majorant, rng, steps, t, dens)) {
     const Rgb sigma_a = dens * m.sigma_a, sigma_s = dens * m.sigma_s;
     const Rgb sigma_n = Rgb(majorant) - sigma_a - sigma_s;
     seg.emitted += w * sigma_a * m.Le / majorant;
@@ -133,10 +144,9 @@ TESSERA_HOST_DEVICE inline Rgb grid_transmittance(const Medium& m, const Density
   Rng rng = tracking_rng(0.5f, o, d);
   Rgb tr(1.f);
   double t = r.t0;
-  for (int32_t step = 0; step < (1 << 20); ++step) {
-    t += -glm::log(1.f - rng.uniform()) / majorant;
-    if (!(t < r.t1)) break;
-    const Float dens = grid_density(g, r.o + static_cast<Float>(t) * r.d);
+  int32_t steps = 0;
+  Float dens = 0.f;
+  while (next_tentative_collision(g, r, majorant, rng, steps, t, dens)) {
     tr *= glm::max(Rgb(0.f), Rgb(1.f) - dens * medium_sigma_t(m) / majorant);
     // Russian roulette once little is left (unbiased: survivors are scaled up).
     const Float left = max_component(tr);

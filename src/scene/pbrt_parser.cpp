@@ -186,10 +186,11 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
   const Mat4& ctm = state_.ctm;
   // Transform directives change the active transforms (ActiveTransform): the
   // start one, the end one, or both.
-  auto post_multiply = [&](const Mat4& m) {
-    if (state_.active_start) state_.ctm = state_.ctm * m;
-    if (state_.active_end) state_.ctm_end = state_.ctm_end * m;
+  auto set_active = [&](const Mat4& start, const Mat4& end) {
+    if (state_.active_start) state_.ctm = start;
+    if (state_.active_end) state_.ctm_end = end;
   };
+  auto post_multiply = [&](const Mat4& m) { set_active(state_.ctm * m, state_.ctm_end * m); };
 
   if (d == "Translate") {
     std::vector<Float> v = read_numbers(tokens, pos, 3, at);
@@ -210,15 +211,10 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     // matrix's columns, exactly glm's storage order.
     std::vector<Float> v = read_numbers(tokens, pos, 16, at);
     Mat4 m = glm::make_mat4(v.data());
-    if (d == "ConcatTransform") {
-      post_multiply(m);
-    } else {
-      if (state_.active_start) state_.ctm = m;
-      if (state_.active_end) state_.ctm_end = m;
-    }
+    if (d == "ConcatTransform") post_multiply(m);
+    else set_active(m, m);
   } else if (d == "Identity") {
-    if (state_.active_start) state_.ctm = Mat4(1.f);
-    if (state_.active_end) state_.ctm_end = Mat4(1.f);
+    set_active(Mat4(1.f), Mat4(1.f));
   } else if (d == "CoordinateSystem") {
     coordinate_systems_[read_string(tokens, pos, at)] = {state_.ctm, state_.ctm_end};
   } else if (d == "CoordSysTransform") {
