@@ -185,6 +185,7 @@ def conform(s, args, corpus):
         cmd += ["--res", s["res"]]
     if args.threads is not None:
         cmd += ["--threads", str(args.threads)]
+    cmd += args.render_arg
     s["command"] = cmd
     status, rc, seconds, _, err = run(cmd, args.timeout)
     s.update(status=status, returncode=rc, seconds=round(seconds, 2))
@@ -253,6 +254,8 @@ def main():
     p.add_argument("--out", default=os.path.join("out", "conformance"), help="renders and stats (default out/conformance)")
     p.add_argument("--json", help="write every result here")
     p.add_argument("--binary", default=os.path.join(ROOT, "build", "tessera"))
+    p.add_argument("--render-arg", action="append", default=[], metavar="ARG",
+                   help="extra argument for every render (repeat: --render-arg=--spectral --render-arg=on)")
     args = p.parse_args()
     if not args.scenes and not args.corpus:
         p.error("give scene files or --corpus DIR")

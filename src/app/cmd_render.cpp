@@ -30,6 +30,7 @@ struct RenderArgs {
   int64_t spp = -1, max_depth = -1, threads = 0, tile = 16;
   int64_t seed = -1;
   std::string sampler;  // "" = the scene's
+  std::string spectral = "off";
   double time = 0.0;
   double target_error = 0.0;
   std::string snapshot_every;
@@ -61,6 +62,7 @@ SceneDesc load_desc(const RenderArgs& a) {
   if (a.seed >= 0) desc.seed = static_cast<uint64_t>(a.seed);
   if (a.sampler == "independent") desc.sampler = SamplerKind::Independent;
   else if (a.sampler == "sobol") desc.sampler = SamplerKind::Sobol;
+  desc.spectral = a.spectral == "on";
   return desc;
 }
 
@@ -204,6 +206,7 @@ ExrMetadata base_metadata(const MasterSetup& m, uint32_t spec) {
   meta.strings["seed"] = std::to_string(m.opt.seed);
   meta.strings["sampler"] = m.opt.sampler == SamplerKind::Sobol ? "sobol" : "independent";
   meta.strings["effects"] = describe_effects(m.scene->effects());
+  meta.strings["transport"] = m.scene->desc().spectral ? "spectral" : "rgb";
   meta.strings["specialisation"] = describe_specialisation(spec);
   meta.strings["software"] = "tessera " TESSERA_VERSION;
   meta.strings["scene"] = m.scene->desc().source;
@@ -404,6 +407,9 @@ CommandRunner add_render_command(CLI::App& app) {
   c->add_option("--sampler", a->sampler,
                 "independent | sobol (Owen-scrambled Sobol points); default: the scene's Sampler (pbrt's default zsobol -> sobol)")
       ->check(CLI::IsMember({"independent", "sobol"}));
+  c->add_option("--spectral", a->spectral,
+                "on: paths carry sampled wavelengths and colours become pbrt-v4's spectra; off: paths carry RGB")
+      ->check(CLI::IsMember({"on", "off"}));
   c->add_option("--threads", a->threads, "Worker threads per process (0 = all cores, shared out among the ranks on a machine)")->check(CLI::Range(0, 4096));
   c->add_option("--tile", a->tile, "Tile size in pixels")->check(CLI::Range(1, 4096));
   c->add_option("--stats", a->stats, "Write render statistics as JSON");

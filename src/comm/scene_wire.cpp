@@ -28,6 +28,7 @@ void serialize(Archive& ar, SceneDesc& d) {
   ar(raw(d.media), d.camera_medium, d.grids);
   ar(d.camera.shutter_open, d.camera.shutter_close, d.camera.transform_start_time, d.camera.transform_end_time,
      raw_value(d.camera.world_from_camera_end));
+  ar(d.spectral, d.spectra);
 }
 
 Bytes encode_scene(const SceneDesc& desc) { return encode(desc); }

@@ -53,6 +53,9 @@ struct BsdfSample {
 };
 
 TESSERA_HOST_DEVICE Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, const Vec3& wi);
+// The value next-event estimation (light samples) multiplies: bsdf_eval but
+// for the coated BSDFs, which follow pbrt-v4's light-sample estimate (layered.h).
+TESSERA_HOST_DEVICE Rgb bsdf_eval_light(const BsdfParams& b, const Vec3& wo, const Vec3& wi);
 TESSERA_HOST_DEVICE Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi);
 // uc picks among lobes, u samples within the lobe. Returns false when no
 // direction could be produced (e.g. a grazing wo or a sample below the horizon).

@@ -325,8 +325,9 @@ TESSERA_HOST_DEVICE inline Float coated_pdf_upper(const BsdfParams& b, const Vec
 
 TESSERA_HOST_DEVICE inline Vec3 flip_to_upper(const Vec3& v, bool flip) { return flip ? Vec3(v.x, v.y, -v.z) : v; }
 
-TESSERA_HOST_DEVICE inline Rgb coated_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
-  return coated_diffuse_layered_f(b, wo, wi);
+TESSERA_HOST_DEVICE inline Rgb coated_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi,
+                                        layered::LayerWeights weights = layered::LayerWeights::Consistent) {
+  return coated_diffuse_layered_f(b, wo, wi, weights);
 }
 TESSERA_HOST_DEVICE inline Float coated_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
   if (!same_hemisphere(wo, wi)) return 0.f;
@@ -387,6 +388,18 @@ TESSERA_HOST_DEVICE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, co
     case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_f(b, wo, wi);
   }
   return Rgb(0.f);
+}
+
+// The value next-event estimation uses: bsdf_eval, except that the coated
+// BSDFs weigh their layer walk as pbrt-v4's LayeredBxDF::f does (layered.h).
+TESSERA_HOST_DEVICE inline Rgb bsdf_eval_light(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  if (wo.z == 0.f || !is_finite(wo) || !is_finite(wi)) return Rgb(0.f);
+  switch (b.type) {
+    case BsdfType::CoatedDiffuse: return bsdf_detail::coated_f(b, wo, wi, bsdf_detail::layered::LayerWeights::Pbrt);
+    case BsdfType::CoatedConductor:
+      return bsdf_detail::coated_conductor_f(b, wo, wi, bsdf_detail::layered::LayerWeights::Pbrt);
+    default: return bsdf_eval(b, wo, wi);
+  }
 }
 
 TESSERA_HOST_DEVICE inline Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {

@@ -83,9 +83,10 @@ TESSERA_HOST_DEVICE inline Rgb mirror_series(const BsdfParams& b, Float cos_o) {
 
 }  // namespace coated_conductor
 
-TESSERA_HOST_DEVICE inline Rgb coated_conductor_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+TESSERA_HOST_DEVICE inline Rgb coated_conductor_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi,
+                                                  layered::LayerWeights weights = layered::LayerWeights::Consistent) {
   if (distrib(b).effectively_smooth() && coated_conductor::base_smooth(b)) return Rgb(0.f);
-  return coated_conductor_layered_f(b, wo, wi);
+  return coated_conductor_layered_f(b, wo, wi, weights);
 }
 
 TESSERA_HOST_DEVICE inline Float coated_conductor_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {

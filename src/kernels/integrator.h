@@ -64,6 +64,12 @@ TESSERA_HOST_DEVICE inline Rgb eval_f(const BsdfParams& b, const Vec3& wo, const
   if constexpr ((Spec & kSpecNonDiffuse) != 0) return bsdf_eval(b, wo, wi);
   else return detail::diffuse_eval(b, wo, wi);
 }
+// For light samples (next-event estimation): see bsdf_eval_light.
+template <uint32_t Spec>
+TESSERA_HOST_DEVICE inline Rgb eval_f_light(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  if constexpr ((Spec & kSpecNonDiffuse) != 0) return bsdf_eval_light(b, wo, wi);
+  else return detail::diffuse_eval(b, wo, wi);
+}
 template <uint32_t Spec>
 TESSERA_HOST_DEVICE inline Float eval_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
   if constexpr ((Spec & kSpecNonDiffuse) != 0) return bsdf_pdf(b, wo, wi);
@@ -113,7 +119,7 @@ TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, const Vec3& wo, Fl
 // light that reaches x over several bounces is still learned.
 template <uint32_t Spec, class Tracer>
 TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray ray, PixelSampler& rng,
-                                   const PathSettings& settings, PathCounters& c) {
+                                   const PathSettings& settings, PathCounters& c, Wavelengths* wl = nullptr) {
   constexpr bool kGuide = (Spec & kSpecGuiding) != 0;
   constexpr bool kMedia = (Spec & kSpecMedia) != 0;
   int32_t medium = kMedia ? s.camera_medium : -1;  // the medium the ray travels in (-1: vacuum)
@@ -173,11 +179,11 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     const bool found = tracer.intersect(ray.o, ray.d, kInfinity, &hit, ray.time);
     if constexpr (kMedia) {
       if (medium >= 0) {
-        const Medium& m = s.media[medium];
+        const Medium m = medium_at(s, medium, wl);
         const Float t_max = found ? hit.t : kInfinity;
         if (medium_absorbs_only(m)) {
           // Its transmittance: no collision to sample, no path ended by absorption.
-          const Rgb T = medium_transmittance(s, medium, ray.o, ray.d, t_max);
+          const Rgb T = medium_transmittance(s, medium, ray.o, ray.d, t_max, wl);
           beta *= T;
           rr_beta *= T;
           segment_tr = luminance(T);
@@ -203,9 +209,10 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
               const uint32_t li = select_light(s, guide, -1, u_select, &pmf);
               LightSample ls;
               if (pmf > 0.f && sample_light(s, li, p, u_light, &ls)) {
+                ls.L = light_emission(s, wl, s.lights[li], ls.L);
                 const Float phase = henyey_greenstein(glm::dot(wo, ls.wi), m.g);
                 const Float tmax = ls.infinite ? kInfinity : glm::length(ls.p_light - p) * 0.9999f;
-                const Rgb tr = light_visibility<true>(s, tracer, p, ls.wi, tmax, medium, ray.time, c);
+                const Rgb tr = light_visibility<true>(s, tracer, p, ls.wi, tmax, medium, ray.time, c, wl);
                 const Float light_pdf = pmf * ls.pdf;
                 if (!is_black(tr) && light_pdf > 0.f) {
                   const Float w = ls.delta ? 1.f : power_heuristic(light_pdf, phase);
@@ -249,7 +256,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       if constexpr ((Spec & kSpecEnvironment) != 0) {
         for (uint32_t k = 0; k < s.num_infinite_lights; ++k) {
           uint32_t li = static_cast<uint32_t>(s.infinite_lights[k]);
-          Rgb Le = environment_radiance(s, s.lights[li], ray.d);
+          const Rgb Le = light_emission(s, wl, s.lights[li], environment_radiance(s, s.lights[li], ray.d));
           Le_total += Le;
           if (depth == 0 || specular_bounce || !settings.nee) {
             L += beta * Le;
@@ -276,20 +283,20 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         const Light& l = s.lights[info.light];
         Float cos_l = glm::dot(h.ng, wo);
         if (l.two_sided || cos_l > 0.f) {
-          Le_hit = l.L;
+          Le_hit = light_emission(s, wl, l, l.L);
           if (depth == 0 || specular_bounce || !settings.nee) {
-            L += beta * l.L;
+            L += beta * Le_hit;
           } else {
             Float light_pdf = light_select_pmf(s, guide, prev_cell, static_cast<uint32_t>(info.light)) *
                               area_light_pdf(l.area, glm::length(h.p - prev_p), cos_l);
-            L += beta * l.L * power_heuristic(prev_scatter_pdf, light_pdf);
+            L += beta * Le_hit * power_heuristic(prev_scatter_pdf, light_pdf);
           }
         }
       }
     }
 
     BsdfParams bsdf;
-    if (!resolve_bsdf<Spec>(s, info.material, h, wo, &bsdf)) {
+    if (!resolve_bsdf<Spec>(s, info.material, h, wo, &bsdf, wl)) {
       // Interface: continue through without counting a bounce (pbrt's SkipIntersection).
       ++c.interface_skips;
       if (++interface_skips > 256) break;
@@ -361,8 +368,9 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       LightSample ls;
       Float learned = 0.f;  // unoccluded contribution of the selected light, for the guide
       if (pmf > 0.f && sample_light(s, li, h.p, u_light, &ls)) {
+        ls.L = light_emission(s, wl, s.lights[li], ls.L);
         Vec3 wi_l = frame.to_local(ls.wi);
-        Rgb f = eval_f<Spec>(bsdf, wo_l, wi_l) * abs_cos_theta(wi_l);
+        Rgb f = eval_f_light<Spec>(bsdf, wo_l, wi_l) * abs_cos_theta(wi_l);
         if (!is_black(f)) {
           Vec3 o = offset_ray_origin(h, ls.wi);
           Float tmax = kInfinity;
@@ -377,7 +385,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           }
           const Rgb tr = light_pdf > 0.f ? light_visibility<kMedia>(s, tracer, o, ls.wi, tmax,
                                                                     kMedia ? medium_after(s, hit.triangle, h.ng, ls.wi, medium) : -1,
-                                                                    ray.time, c)
+                                                                    ray.time, c, wl)
                                          : Rgb(0.f);
           if (!is_black(tr)) {
             Float w = 1.f;

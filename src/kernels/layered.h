@@ -4,16 +4,26 @@
 // exp(-thickness/|cos|)), two-sided. The value is pbrt-v4's stochastic estimate: a random walk
 // between the interfaces with next-event estimation through the exit
 // interface, seeded by the two directions so that f(wo, wi) is a pure
-// function. For a smooth coat its expectation is the layered BSDF; for a
-// rough coat pbrt-v4's MIS weights (which we keep, to match its pictures)
-// compare densities on the two sides of the interface, so the estimate is
-// pbrt-v4's, slightly off the exact layered BSDF and not exactly reciprocal.
+// function. Two weightings of its two next-event strategies at the base:
+//  * LayerWeights::Consistent: by the densities of the same inside direction.
+//    The expectation is the layered BSDF that pbrt-v4's sampling walk
+//    (LayeredBxDF::Sample_f) simulates: energy-conserving, reciprocal.
+//  * LayerWeights::Pbrt: pbrt-v4's f(), which weighs the exit connection by
+//    the density of wi given the inside direction, a different measure. Its
+//    weights sum to more than 1 and it comes out 5-15 % above the walk for
+//    rough coats (above 1 in albedo for a rough coat over silver).
+// pbrt-v4 uses f() for light samples and the walk for BSDF samples, so its
+// pictures mix the two: bsdf_eval_light() (next-event estimation) uses
+// pbrt-v4's weighting and everything else the consistent one, which
+// reproduces pbrt-v4 under both small and large lights.
 //
 // Included by bsdf_impl.h inside namespace tessera::bsdf_detail; uses the
 // dielectric helpers defined there.
 #pragma once
 
 namespace layered {
+
+enum class LayerWeights { Consistent, Pbrt };
 
 // One lobe of the dielectric interface, as pbrt-v4 samples it with
 // BxDFReflTransFlags::Reflection or ::Transmission. `radiance`: transport
@@ -152,7 +162,8 @@ struct ConductorBase {
 // and wi in the same hemisphere; neither coated BSDF transmits). b is the
 // coat (its roughness, ior, and the layer's thickness, maxdepth, nsamples).
 template <class Base>
-TESSERA_HOST_DEVICE inline Rgb layered_f(const BsdfParams& b, const Base& base, Vec3 wo, Vec3 wi) {
+TESSERA_HOST_DEVICE inline Rgb layered_f(const BsdfParams& b, const Base& base, Vec3 wo, Vec3 wi,
+                                         layered::LayerWeights weights) {
   if (!same_hemisphere(wo, wi)) return Rgb(0.f);
   if (wo.z < 0.f) {  // two-sided
     wo = -wo;
@@ -214,7 +225,12 @@ TESSERA_HOST_DEVICE inline Rgb layered_f(const BsdfParams& b, const Base& base, 
           const Float f_exit = dielectric_f(b, -w, wi).x;
           if (f_exit > 0.f) {
             Float wt = 1.f;
-            if (!base_specular) wt = power_heuristic(pdf, layered::interface_transmission_pdf(b, -w, wi));
+            // The other strategy's density of this direction: the virtual
+            // light's sample from wi reaching -w (pbrt-v4: of wi given -w).
+            if (!base_specular)
+              wt = power_heuristic(pdf, weights == layered::LayerWeights::Consistent
+                                            ? layered::interface_transmission_pdf(b, wi, -w)
+                                            : layered::interface_transmission_pdf(b, -w, wi));
             f += beta * layered::transmittance(thickness, w) * f_exit * wt;
           }
         }
@@ -225,12 +241,14 @@ TESSERA_HOST_DEVICE inline Rgb layered_f(const BsdfParams& b, const Base& base, 
 }
 
 // coateddiffuse: b.reflectance is the base's albedo.
-TESSERA_HOST_DEVICE inline Rgb coated_diffuse_layered_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
-  return layered_f(b, layered::DiffuseBase{glm::clamp(b.reflectance, Rgb(0.f), Rgb(1.f))}, wo, wi);
+TESSERA_HOST_DEVICE inline Rgb coated_diffuse_layered_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi,
+                                                        layered::LayerWeights weights = layered::LayerWeights::Consistent) {
+  return layered_f(b, layered::DiffuseBase{glm::clamp(b.reflectance, Rgb(0.f), Rgb(1.f))}, wo, wi, weights);
 }
 
 // coatedconductor: b.eta / b.k are the conductor's (relative to the outside),
 // b.base_alpha_* its roughness.
-TESSERA_HOST_DEVICE inline Rgb coated_conductor_layered_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
-  return layered_f(b, layered::ConductorBase::under_coat(b), wo, wi);
+TESSERA_HOST_DEVICE inline Rgb coated_conductor_layered_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi,
+                                                          layered::LayerWeights weights = layered::LayerWeights::Consistent) {
+  return layered_f(b, layered::ConductorBase::under_coat(b), wo, wi, weights);
 }

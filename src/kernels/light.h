@@ -23,6 +23,10 @@ struct Light {
   int32_t image = -1;          // Infinite: index into the scene's images (equal-area octahedral), -1 = constant L
   Mat3 light_from_world{1.f};  // Infinite: into the light's frame (directions; normalise after)
   Mat3 world_from_light{1.f};  // Infinite: its inverse (set when the scene is built)
+  // A blackbody emitter (pbrt-v4 "blackbody"): in spectral mode it emits
+  // luminance(L) * blackbody_norm * B(lambda) / B(peak) instead of L's spectrum.
+  Float blackbody_kelvin = 0.f;  // 0: L is an RGB (illuminant spectrum)
+  Float blackbody_norm = 0.f;    // 1 / luminance of B / B(peak) (set when the scene is built)
 };
 
 }  // namespace tessera

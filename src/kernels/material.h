@@ -45,6 +45,9 @@ struct Material {
   bool conductor_from_reflectance = false;  // conductor given by "reflectance" instead of eta/k
   Rgb eta{0.2004f, 0.9240f, 1.1022f};       // conductor eta (pbrt default: metal-Cu)
   Rgb k{3.9129f, 2.4528f, 2.1422f};          // conductor k
+  // Conductors given by measured spectra: indices into SceneView::spectra
+  // (used in spectral mode; eta and k above are their RGB fit). -1: none.
+  int32_t eta_spectrum = -1, k_spectrum = -1;
   Float ior = 1.5f;                          // dielectric eta / coateddiffuse coating eta
   Float alpha_x = 0.f, alpha_y = 0.f;        // GGX alpha, remapped from roughness by the loader (coated: the coat's)
   Float base_alpha_x = 0.f, base_alpha_y = 0.f;  // coatedconductor: the conductor's GGX alpha

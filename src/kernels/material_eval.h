@@ -37,9 +37,13 @@ TESSERA_HOST_DEVICE inline const Material* resolve_material(const SceneView& s, 
 
 // Returns false for an "interface" material: the surface only bounds a medium
 // and the ray continues through it.
+//
+// In spectral mode (wl non-null) colours become values at the path's
+// wavelengths: reflectances as albedo spectra, conductors' eta and k as
+// unbounded spectra (spectral.h).
 template <uint32_t Spec>
 TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t material, const SurfaceHit& h, const Vec3& wo,
-                                             BsdfParams* out) {
+                                             BsdfParams* out, Wavelengths* wl = nullptr) {
   const Material* m = &s.materials[material];
   if constexpr ((Spec & kSpecNonDiffuse) != 0) {
     m = resolve_material<Spec>(s, material, h, wo);
@@ -65,12 +69,14 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
       b.type = m->type == MaterialType::Conductor ? BsdfType::Conductor : BsdfType::CoatedConductor;
       if (m->conductor_from_reflectance) {
         // pbrt-v4: eta = 1 and k chosen so that normal-incidence reflectance is r.
-        Rgb r = glm::clamp(refl, Rgb(0.f), Rgb(0.9999f));
+        Rgb r = glm::clamp(spectral_albedo(s.spectral, wl, refl), Rgb(0.f), Rgb(0.9999f));
         b.eta = Rgb(1.f);
         b.k = 2.f * glm::sqrt(r) / glm::sqrt(Rgb(1.f) - r);
       } else {
-        b.eta = m->eta;
-        b.k = m->k;
+        b.eta = wl && m->eta_spectrum >= 0 ? sample_spectrum(s.spectra + m->eta_spectrum * kSpectralSamples, *wl)
+                                           : spectral_unbounded(s.spectral, wl, m->eta);
+        b.k = wl && m->k_spectrum >= 0 ? sample_spectrum(s.spectra + m->k_spectrum * kSpectralSamples, *wl)
+                                       : spectral_unbounded(s.spectral, wl, m->k);
       }
       if (m->type == MaterialType::CoatedConductor) {
         b.base_alpha_x = m->base_alpha_x;
@@ -89,21 +95,21 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
     case MaterialType::DiffuseTransmission: {
       b.type = BsdfType::DiffuseTransmission;
       const Rgb t = (Spec & kSpecTextures) ? eval_slot(s, m->transmittance, h.uv) : m->transmittance.value;
-      b.reflectance = glm::clamp(m->scale * refl, Rgb(0.f), Rgb(1.f));
-      b.transmittance = glm::clamp(m->scale * t, Rgb(0.f), Rgb(1.f));
+      b.reflectance = spectral_albedo(s.spectral, wl, glm::clamp(m->scale * refl, Rgb(0.f), Rgb(1.f)));
+      b.transmittance = spectral_albedo(s.spectral, wl, glm::clamp(m->scale * t, Rgb(0.f), Rgb(1.f)));
       b.ior = 1.f;  // light passes straight through: no refraction, no eta^2 scaling
       break;
     }
     case MaterialType::CoatedDiffuse:
       b.type = BsdfType::CoatedDiffuse;
-      b.reflectance = glm::clamp(refl, Rgb(0.f), Rgb(1.f));
+      b.reflectance = spectral_albedo(s.spectral, wl, refl);
       b.thickness = m->thickness;
       b.layer_max_depth = m->layer_max_depth;
       b.layer_samples = m->layer_samples;
       break;
     default:
       b.type = BsdfType::Diffuse;
-      b.reflectance = glm::clamp(refl, Rgb(0.f), Rgb(1.f));
+      b.reflectance = spectral_albedo(s.spectral, wl, refl);
       break;
   }
   *out = b;

@@ -7,6 +7,7 @@
 #include "material.h"
 #include "grid_medium.h"
 #include "medium.h"
+#include "spectral.h"
 
 namespace tessera {
 
@@ -101,6 +102,36 @@ struct SceneView {
 
   CameraView camera;
   FilterView filter;
+  // Spectral transport (spectral.h); disabled: paths carry RGB.
+  SpectralView spectral;
+  // Measured spectra (conductors' eta and k), kSpectralSamples values each.
+  const Float* spectra = nullptr;
 };
+
+// What light l emits at the path's wavelengths, given its RGB emission rgb
+// (L or an image texel, times any geometric factor): pbrt-v4's illuminant
+// spectrum, or Planck's law for a blackbody. rgb itself in RGB mode.
+TESSERA_HOST_DEVICE inline Rgb light_emission(const SceneView& s, const Wavelengths* wl, const Light& l, Rgb rgb) {
+  if (!wl) return rgb;
+  if (l.blackbody_kelvin > 0.f) {
+    const Float k = luminance(rgb) * l.blackbody_norm;
+    return Rgb(k * blackbody_relative(wl->lambda[0], l.blackbody_kelvin),
+               k * blackbody_relative(wl->lambda[1], l.blackbody_kelvin),
+               k * blackbody_relative(wl->lambda[2], l.blackbody_kelvin));
+  }
+  return spectral_illuminant(s.spectral, wl, rgb);
+}
+
+// The medium as the path sees it: its coefficients at the path's wavelengths
+// in spectral mode (pbrt-v4's unbounded and illuminant spectra), else as given.
+TESSERA_HOST_DEVICE inline Medium medium_at(const SceneView& s, int32_t medium, const Wavelengths* wl) {
+  Medium m = s.media[medium];
+  if (wl) {
+    m.sigma_a = spectral_unbounded(s.spectral, wl, m.sigma_a);
+    m.sigma_s = spectral_unbounded(s.spectral, wl, m.sigma_s);
+    m.Le = spectral_illuminant(s.spectral, wl, m.Le);
+  }
+  return m;
+}
 
 }  // namespace tessera

@@ -23,8 +23,8 @@ TESSERA_HOST_DEVICE inline int32_t medium_after(const SceneView& s, uint32_t tri
 // Transmittance of `medium` along o + t d, t in [0, t_max]: exact for a
 // homogeneous medium, a ratio-tracking estimate for a grid.
 TESSERA_HOST_DEVICE inline Rgb medium_transmittance(const SceneView& s, int32_t medium, const Vec3& o, const Vec3& d,
-                                                    Float t_max) {
-  const Medium& m = s.media[medium];
+                                                    Float t_max, const Wavelengths* wl) {
+  const Medium m = medium_at(s, medium, wl);
   if (m.grid >= 0) return grid_transmittance(m, s.grids[m.grid], o, d, t_max);
   return transmittance(medium_sigma_t(m), t_max);
 }
@@ -42,11 +42,12 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_medium(const SceneView& s, const
 // it. Each ray query counts as a shadow ray.
 template <class Tracer, class Counters>
 TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& tracer, Vec3 o, const Vec3& d,
-                                             Float t_max, int32_t medium, Float time, Counters& c) {
+                                             Float t_max, int32_t medium, Float time, Counters& c,
+                                             const Wavelengths* wl) {
   if (!s.has_interfaces) {
     ++c.shadow_rays;
     if (tracer.occluded(o, d, t_max, time)) return Rgb(0.f);
-    return medium >= 0 ? medium_transmittance(s, medium, o, d, t_max) : Rgb(1.f);
+    return medium >= 0 ? medium_transmittance(s, medium, o, d, t_max, wl) : Rgb(1.f);
   }
   Rgb tr(1.f);
   const bool infinite = !(t_max < kInfinity);
@@ -56,13 +57,13 @@ TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& t
     TraceHit hit;
     ++c.shadow_rays;
     if (!tracer.intersect(o, d, t_max, &hit, time)) {
-      if (medium >= 0) tr *= medium_transmittance(s, medium, o, d, t_max);
+      if (medium >= 0) tr *= medium_transmittance(s, medium, o, d, t_max, wl);
       return tr;
     }
     const SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, time);
     if (resolve_material<kSpecAll>(s, s.triangles[hit.triangle].material, h, -d)->type != MaterialType::Interface)
       return Rgb(0.f);
-    if (medium >= 0) tr *= medium_transmittance(s, medium, o, d, hit.t);
+    if (medium >= 0) tr *= medium_transmittance(s, medium, o, d, hit.t, wl);
     if (is_black(tr)) return tr;
     medium = medium_after(s, hit.triangle, h.ng, d, medium);
     o = offset_ray_origin(h, d);
@@ -79,12 +80,13 @@ TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& t
 // transmittance through media and interfaces.
 template <bool kMedia, class Tracer, class Counters>
 TESSERA_HOST_DEVICE Rgb light_visibility(const SceneView& s, const Tracer& tracer, const Vec3& o, const Vec3& d,
-                                         Float t_max, int32_t medium, Float time, Counters& c) {
+                                         Float t_max, int32_t medium, Float time, Counters& c, const Wavelengths* wl) {
   if constexpr (kMedia) {
-    return shadow_transmittance(s, tracer, o, d, t_max, medium, time, c);
+    return shadow_transmittance(s, tracer, o, d, t_max, medium, time, c, wl);
   } else {
     (void)s;
     (void)medium;
+    (void)wl;
     ++c.shadow_rays;
     return tracer.occluded(o, d, t_max, time) ? Rgb(0.f) : Rgb(1.f);
   }

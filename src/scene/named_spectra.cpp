@@ -1,24 +1,22 @@
 #include "scene/named_spectra.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+
+#include "scene/cie_tables.h"
 
 namespace tessera {
 namespace {
 
-// Multi-lobe Gaussian fit of the CIE 1931 colour matching functions (Wyman,
-// Sloan & Shirley 2013): accurate to a few per cent, and no 471-entry tables.
-double lobe(double lambda, double mu, double sigma_lo, double sigma_hi) {
-  double t = (lambda - mu) / (lambda < mu ? sigma_lo : sigma_hi);
-  return std::exp(-0.5 * t * t);
-}
-
+// The CIE 1931 matching functions at lambda (nm), from the tabulated standard.
 Vec3 cie_xyz(double l) {
-  double x = 1.056 * lobe(l, 599.8, 37.9, 31.0) + 0.362 * lobe(l, 442.0, 16.0, 26.7) -
-             0.065 * lobe(l, 501.1, 20.4, 26.2);
-  double y = 0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1);
-  double z = 1.217 * lobe(l, 437.0, 11.8, 36.0) + 0.681 * lobe(l, 459.0, 26.0, 13.8);
-  return Vec3(static_cast<Float>(x), static_cast<Float>(y), static_cast<Float>(z));
+  const double x = std::clamp((l - kCieLambdaMin) / kCieLambdaStep, 0.0, double(kCieSamples - 1));
+  const int i = std::min(int(x), kCieSamples - 2);
+  const double f = x - i;
+  Vec3 v;
+  for (int c = 0; c < 3; ++c) v[c] = static_cast<Float>((1.0 - f) * kCie1931Xyz[i][c] + f * kCie1931Xyz[i + 1][c]);
+  return v;
 }
 
 Rgb xyz_to_linear_srgb(Vec3 c) {
@@ -117,6 +115,14 @@ Rgb spectrum_rgb(SpectrumFn&& f) {
 }
 
 }  // namespace
+
+std::vector<Float> resample_spectrum(const std::vector<Float>& pairs) {
+  std::vector<Float> out(kSpectralSamples, 0.f);
+  if (pairs.size() < 2) return out;
+  for (int i = 0; i < kSpectralSamples; ++i)
+    out[i] = static_cast<Float>(value_at(pairs, kCieLambdaMin + kCieLambdaStep * i));
+  return out;
+}
 
 Rgb sampled_spectrum_rgb(const std::vector<Float>& pairs) {
   if (pairs.size() < 2) return Rgb(0.f);

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "kernels/device.h"
+#include "kernels/spectral.h"
 
 namespace tessera {
 
@@ -26,6 +26,10 @@ Vec2 blackbody_xy(Float kelvin);
 // A piecewise-linear spectrum given as (wavelength nm, value) pairs, reduced to
 // RGB such that a constant spectrum c gives (c, c, c). A rough approximation.
 Rgb sampled_spectrum_rgb(const std::vector<Float>& lambda_value_pairs);
+
+// A piecewise-linear spectrum given as (wavelength nm, value) pairs, sampled
+// at the spectral tables' wavelengths (kernels/spectral.h), constant beyond its ends.
+std::vector<Float> resample_spectrum(const std::vector<Float>& lambda_value_pairs);
 
 // A conductor given by sampled eta and k spectra, as RGB: eta is each
 // channel's weighted mean (as sampled_spectrum_rgb) and k is chosen so that

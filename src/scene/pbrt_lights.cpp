@@ -17,6 +17,12 @@ Float radians(Float degrees) { return degrees * kPi / 180.f; }
 // conversion to RGB, so the same holds for them.
 Rgb emission(const ParamSet& params, const std::string& name) { return params.get_rgb(name).value_or(Rgb(1.f)); }
 
+// The temperature of a "blackbody" emission parameter, 0 for anything else.
+Float blackbody_kelvin(const ParamSet& params, const std::string& name) {
+  const Param* p = params.find_any(name);
+  return p && p->type == "blackbody" && !p->numbers.empty() ? static_cast<Float>(p->numbers[0]) : 0.f;
+}
+
 }  // namespace
 
 std::optional<Light> make_light(const std::string& type, const ParamSet& params, const Mat4& world_from_light,
@@ -26,6 +32,7 @@ std::optional<Light> make_light(const std::string& type, const ParamSet& params,
   if (type == "point") {
     l.type = LightType::Point;
     l.L = emission(params, "I") * scale;
+    l.blackbody_kelvin = blackbody_kelvin(params, "I");
     // pbrt-v4: power sets the scale so that a white I emits `power`; the RGB
     // colour itself is not taken into account.
     if (Float power = params.get_float("power", -1.f); power > 0.f) l.L *= power / (4.f * kPi);
@@ -33,6 +40,7 @@ std::optional<Light> make_light(const std::string& type, const ParamSet& params,
   } else if (type == "spot") {
     l.type = LightType::Spot;
     l.L = emission(params, "I") * scale;
+    l.blackbody_kelvin = blackbody_kelvin(params, "I");
     const Float cone = params.get_float("coneangle", 30.f), delta = params.get_float("conedeltaangle", 5.f);
     l.cos_falloff_end = std::cos(radians(cone));
     l.cos_falloff_start = std::cos(radians(cone - delta));
@@ -47,6 +55,7 @@ std::optional<Light> make_light(const std::string& type, const ParamSet& params,
   } else if (type == "distant") {
     l.type = LightType::Distant;
     l.L = emission(params, "L") * scale;
+    l.blackbody_kelvin = blackbody_kelvin(params, "L");
     if (Float e = params.get_float("illuminance", -1.f); e > 0.f) l.L *= e;
     Vec3 from = params.get_point3("from").value_or(Vec3(0.f)), to = params.get_point3("to").value_or(Vec3(0.f, 0.f, 1.f));
     if (from == to) ctx.fail("distant light \"from\" and \"to\" coincide");
@@ -65,6 +74,7 @@ std::optional<Light> make_light(const std::string& type, const ParamSet& params,
       l.L = Rgb(scale);
     } else {
       l.L = emission(params, "L") * scale;
+      l.blackbody_kelvin = blackbody_kelvin(params, "L");
     }
     if (params.find_any("illuminance")) ctx.warn("infinite light \"illuminance\" is not supported; ignored");
     if (params.find_any("portal")) ctx.warn("infinite light \"portal\" is not supported; ignored");
@@ -81,6 +91,7 @@ AreaLightDesc make_area_light(const std::string& type, const ParamSet& params, c
   if (type != "diffuse") ctx.warn("area light \"" + type + "\" is not supported; using \"diffuse\"");
   AreaLightDesc a;
   a.L = emission(params, "L") * params.get_float("scale", 1.f);
+  a.blackbody_kelvin = blackbody_kelvin(params, "L");
   a.two_sided = params.get_bool("twosided", false);
   if (params.find_any("filename")) ctx.warn("image area lights (\"filename\") are not supported; using \"L\"");
   if (params.find_any("power")) ctx.warn("area light \"power\" is not supported; ignored");

@@ -59,15 +59,24 @@ void read_conductor(Material& m, const ParamSet& params, const DirectiveContext&
     m.conductor_from_reflectance = true;
     m.reflectance = spectrum_slot(params, prefix + "reflectance", Rgb(1.f), ctx);
   } else if (const Param* e = params.find_any(prefix + "eta"), *kp = params.find_any(prefix + "k");
-             e && kp && e->type == "spectrum" && kp->type == "spectrum" && !e->file.empty() && !kp->file.empty()) {
-    // Both measured spectra (.spd files): fitted together (named_spectra.h).
+             e && kp && e->type == "spectrum" && kp->type == "spectrum" && e->strings.empty() && kp->strings.empty()) {
+    // Both measured spectra (.spd files or inline samples): kept for spectral
+    // transport, and fitted together for RGB (named_spectra.h).
     std::vector<Float> eta_pairs(e->numbers.begin(), e->numbers.end()), k_pairs(kp->numbers.begin(), kp->numbers.end());
     // Under a coat the conductor is seen from the coat's index (pbrt-v4 divides eta and k by it).
     const Float outside = prefix == "conductor." ? read_ior(params, "interface.eta", 1.5f, ctx) : 1.f;
     sampled_conductor_rgb(eta_pairs, k_pairs, outside, &m.eta, &m.k);
     e->used = kp->used = true;
-    ctx.warn("conductor \"" + prefix + "eta\" and \"" + prefix + "k\" spectra (files '" + e->file + "', '" + kp->file +
-             "') reduced to RGB, matching their normal-incidence reflectance");
+    for (const std::vector<Float>* pairs : {&eta_pairs, &k_pairs}) {
+      const std::vector<Float> samples = resample_spectrum(*pairs);
+      (pairs == &eta_pairs ? m.eta_spectrum : m.k_spectrum) =
+          static_cast<int32_t>(ctx.scene.spectra.size() / kSpectralSamples);
+      ctx.scene.spectra.insert(ctx.scene.spectra.end(), samples.begin(), samples.end());
+    }
+    const std::string files =
+        e->file.empty() || kp->file.empty() ? std::string() : " (files '" + e->file + "', '" + kp->file + "')";
+    ctx.warn("conductor \"" + prefix + "eta\" and \"" + prefix + "k\" spectra" + files +
+             " used as spectra with --spectral on; reduced to RGB (matching their normal-incidence reflectance) otherwise");
   } else {
     // A lone "float eta" is allowed too (grey).
     const Material defaults;

@@ -43,6 +43,7 @@ struct MeshDesc {
 
 struct AreaLightDesc {
   Rgb L{1.f};  // radiance with "scale" folded in
+  Float blackbody_kelvin = 0.f;  // "blackbody L": its temperature (spectral mode emits Planck's law)
   bool two_sided = false;
 };
 
@@ -114,6 +115,12 @@ struct SceneDesc {
   // sobol, paddedsobol, halton, pmj02bn, stratified) draw Owen-scrambled
   // Sobol points here; "independent" draws independent numbers.
   SamplerKind sampler = SamplerKind::Sobol;
+  // Spectral transport (kernels/spectral.h): paths carry three sampled
+  // wavelengths, as pbrt-v4's carry four; false: paths carry RGB.
+  bool spectral = false;
+  // Measured spectra (Material::eta_spectrum...), kSpectralSamples values
+  // each at 360, 365, ..., 830 nm: see add_sampled_spectrum().
+  std::vector<Float> spectra;
   std::vector<MeshDesc> meshes;
   std::vector<Material> materials;  // never empty after loading (index 0 = pbrt's default diffuse 0.5)
   std::vector<Texture> textures;

@@ -19,7 +19,10 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
         PixelSampler rng = PixelSampler::start(settings.sampler, settings.seed, pixel_index, si);
         const CameraSample cs = sample_camera_ray(s, x, y, rng);
         path.learn = settings.learn.learns(si);
-        Rgb L = trace_path<Spec>(s, tracer, cs.ray, rng, path, tc.path);
+        // Spectral transport: the path's three wavelengths (spectral.h).
+        Wavelengths wl;
+        if (s.spectral.enabled) wl = sample_wavelengths(rng.uniform());
+        Rgb L = trace_path<Spec>(s, tracer, cs.ray, rng, path, tc.path, s.spectral.enabled ? &wl : nullptr);
         if (!is_finite(L)) {
           ++tc.rejected_nonfinite;
           L = Rgb(0.f);
@@ -28,6 +31,9 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
           L = glm::max(L, Rgb(0.f));
         }
         if (is_black(L)) ++tc.zero_radiance;
+        // Radiance at three wavelengths to linear sRGB. A single sample's RGB
+        // may be negative (a spectral line outside the sRGB gamut): the mean is not.
+        if (s.spectral.enabled) L = spectral_to_rgb(s.spectral, wl, L);
         L = film_pixel_value(s.camera, L) * cs.filter_weight;
         for (int c = 0; c < 3; ++c) {
           acc.sum[c] += L[c];

@@ -10,6 +10,8 @@
 #include "kernels/equal_area.h"
 #include "kernels/vecmath.h"
 #include "scene/scene_effects.h"
+#include "scene/rgb_spectrum_fit.h"
+#include "scene/spectral_tables.h"
 
 namespace tessera {
 
@@ -70,6 +72,7 @@ void SceneData::flatten_meshes() {
           Light l;
           l.type = LightType::Area;
           l.L = al.L;
+          l.blackbody_kelvin = al.blackbody_kelvin;
           l.two_sided = al.two_sided;
           l.triangle = static_cast<uint32_t>(triangles_.size());
           l.area = 0.5f * glm::length(glm::cross(b - a, c - a));
@@ -86,6 +89,13 @@ void SceneData::flatten_meshes() {
 
 void SceneData::build_lights() {
   for (const Light& l : desc_.lights) lights_.push_back(l);
+  // Blackbody emitters: the luminance of Planck's law relative to its peak,
+  // as the spectral film integrates it (light_emission() divides by it).
+  for (Light& l : lights_)
+    if (l.blackbody_kelvin > 0.f) {
+      const double y = spectrum_luminance([&](double lambda) { return blackbody_relative(Float(lambda), l.blackbody_kelvin); });
+      l.blackbody_norm = y > 0. ? static_cast<Float>(1.0 / y) : 0.f;
+    }
   Float radius = triangles_.empty() ? 1.f : glm::max(1e-3f, 0.5f * glm::length(bounds_.hi - bounds_.lo));
 
   image_views_.reserve(desc_.images.size());
@@ -224,6 +234,8 @@ void SceneData::build_view() {
   v.num_infinite_lights = static_cast<uint32_t>(infinite_lights_.size());
   v.env_distributions = env_views_.data();
   v.camera = camera_;
+  if (desc_.spectral) v.spectral = srgb_spectral_tables().view();
+  v.spectra = desc_.spectra.empty() ? nullptr : desc_.spectra.data();
   for (const Material& m : desc_.materials) v.has_interfaces |= m.type == MaterialType::Interface;
   if (has_media_) {
     v.media = desc_.media.data();
@@ -313,7 +325,7 @@ uint64_t SceneData::film_fingerprint() const {
   const FilterDesc default_filter;
   const bool defaults = camera_.pixel_from_radiance == Mat3(1.f) && !std::isfinite(camera_.max_component_value) &&
                         camera_.lens_radius == 0.f && std::memcmp(&desc_.filter, &default_filter, sizeof default_filter) == 0 &&
-                        positions_end_.empty() && !camera_.moves;
+                        positions_end_.empty() && !camera_.moves && !desc_.spectral;
   if (defaults) return 0;
   Fnv1a f;
   f.add(&camera_.pixel_from_radiance, sizeof camera_.pixel_from_radiance);
@@ -322,6 +334,8 @@ uint64_t SceneData::film_fingerprint() const {
   f.add(&camera_.lens_radius, sizeof camera_.lens_radius);
   f.add(&camera_.focal_distance, sizeof camera_.focal_distance);
   f.add(&desc_.filter, sizeof desc_.filter);
+  const uint8_t spectral = desc_.spectral ? 1 : 0;
+  f.add(&spectral, 1);
   if (!positions_end_.empty() || camera_.moves) {  // motion blur: the shutter, the transforms' times, the camera's end
     f.add(&camera_.world_from_camera_linear_end, sizeof camera_.world_from_camera_linear_end);
     f.add(&camera_.origin_end, sizeof camera_.origin_end);

@@ -440,6 +440,80 @@ TEST(BsdfEnergy, WhiteFurnaces) {
   EXPECT_NEAR(a.z, 0.75, 1e-3);
 }
 
+namespace {
+// pbrt-v4's LayeredBxDF::Sample_f, written out from the interface and base
+// BSDFs: a physical random walk between the coat and the base. Returns the
+// sample's weight f |cos| / pdf (0 when the walk is absorbed or lost).
+Rgb layer_walk_weight(const BsdfParams& coat, Vec3 wo, Rng& rng) {
+  BsdfParams top = coat;
+  top.type = BsdfType::Dielectric;
+  BsdfParams base = coat;
+  if (coat.type == BsdfType::CoatedConductor) {
+    base.type = BsdfType::Conductor;
+    base.alpha_x = coat.base_alpha_x;
+    base.alpha_y = coat.base_alpha_y;
+    base.eta = coat.eta / coat.ior;  // relative to the coat, as pbrt-v4
+    base.k = coat.k / coat.ior;
+  } else {
+    base.type = BsdfType::Diffuse;
+  }
+  if (wo.z < 0.f) wo = -wo;  // two-sided
+  BsdfSample bs;
+  if (!bsdf_sample(top, wo, rng.uniform(), rng.uniform2(), &bs) || !(bs.pdf > 0.f) || bs.wi.z == 0.f) return Rgb(0.f);
+  if (bs.lobe & kLobeReflection) return bs.f * std::abs(bs.wi.z) / bs.pdf;
+  Rgb f = bs.f * std::abs(bs.wi.z);
+  Float pdf = bs.pdf;
+  Vec3 w = bs.wi;
+  bool at_top = true;
+  for (uint32_t depth = 0; depth < coat.layer_max_depth; ++depth) {
+    const Float rr = std::max({f.x, f.y, f.z}) / pdf;
+    if (depth > 3 && rr < 0.25f) {
+      const Float q = std::max(0.f, 1.f - rr);
+      if (rng.uniform() < q) return Rgb(0.f);
+      pdf *= 1.f - q;
+    }
+    at_top = !at_top;
+    f *= std::exp(-coat.thickness / std::abs(w.z));
+    BsdfSample s;
+    if (!bsdf_sample(at_top ? top : base, -w, rng.uniform(), rng.uniform2(), &s) || !(s.pdf > 0.f) || s.wi.z == 0.f)
+      return Rgb(0.f);
+    f *= s.f;
+    pdf *= s.pdf;
+    w = s.wi;
+    if (s.lobe & kLobeTransmission) return f * std::abs(w.z) / pdf;
+    f *= std::abs(w.z);
+  }
+  return Rgb(0.f);
+}
+}  // namespace
+
+// The layered value's expectation is the BSDF the layer walk simulates: the
+// albedo from our value (sampled from the exact-density proposal) equals the
+// walk's, rough coats included. (pbrt-v4's own f() weighs its two next-event
+// strategies at the base with densities of different directions and comes
+// out 5-15 % above its walk for these coats; this test fails for it.)
+TEST(BsdfEnergy, RoughCoatsAgreeWithTheLayerWalk) {
+  const BsdfParams cfgs[] = {coated(0.3f, Rgb(0.8f)), coated(0.1f, Rgb(0.5f, 0.8f, 0.2f)),
+                             coated_conductor(0.3f, 0.3f), coated_conductor(0.141f, 0.0447f, Rgb(0.155f, 0.117f, 0.138f),
+                                                                            Rgb(4.828f, 3.122f, 2.147f))};
+  int cfg = 0;
+  for (const BsdfParams& b : cfgs) {
+    for (double t : {0.3, 1.0}) {
+      const Vec3 wo = spherical(t, 0.4);
+      Rgb se;
+      const Rgb ours = albedo(b, wo, 200000, 40 + cfg, &se);
+      Rng rng = Rng::for_sample(50 + cfg, 1, 2);
+      Rgb walk(0.f);
+      const int n = 200000;
+      for (int i = 0; i < n; ++i) walk += layer_walk_weight(b, wo, rng);
+      walk /= static_cast<Float>(n);
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(ours[c], walk[c], 0.015f * walk[c] + 4.f * se[c]) << "config " << cfg << " theta " << t << " channel " << c;
+    }
+    ++cfg;
+  }
+}
+
 // ----------------------------------------------------------- reciprocity ---
 TEST(BsdfReciprocity, Reflection) {
   const BsdfParams cfgs[] = {diffuse(Rgb(0.4f, 0.5f, 0.6f)), conductor(0.3f, 0.3f), conductor(0.1f, 0.4f),
@@ -462,12 +536,9 @@ TEST(BsdfReciprocity, Reflection) {
   }
 }
 
-// The coated layer's value is a stochastic estimate: with a smooth coat it is
-// reciprocal in expectation, and averaged over many walks (pbrt's "nsamples")
-// both directions agree. (With a rough coat pbrt-v4's MIS weights between the
-// base's next-event estimate and its exit through the coat compare densities
-// on different sides of the interface, so pbrt's estimate, which we follow,
-// is only nearly reciprocal: a few per cent.)
+// The coated layer's value is a stochastic estimate: reciprocal in
+// expectation, and averaged over many walks (pbrt's "nsamples") both
+// directions agree.
 TEST(BsdfReciprocity, CoatedLayerInExpectation) {
   Rng rng = Rng::for_sample(24, 0, 0);
   for (int base : {0, 1}) {

@@ -50,8 +50,17 @@ TEST(SpectrumFile, SceneParametersReadFilesBesideTheScene) {
   EXPECT_VEC3_NEAR(m.k, Vec3(3.f), 3e-3f);
   bool warned = false;
   for (const std::string& w : s.warnings)
-    warned |= w.find("(files 'spds/eta.spd', 'spds/k.spd') reduced to RGB") != std::string::npos;
+    warned |= w.find("(files 'spds/eta.spd', 'spds/k.spd') used as spectra with --spectral on; reduced to RGB") !=
+              std::string::npos;
   EXPECT_TRUE(warned);
+  // The spectra themselves are kept, sampled every 5 nm, for spectral transport.
+  ASSERT_GE(m.eta_spectrum, 0);
+  ASSERT_GE(m.k_spectrum, 0);
+  ASSERT_EQ(s.spectra.size(), 2u * kSpectralSamples);
+  for (int i = 0; i < kSpectralSamples; ++i) {
+    EXPECT_NEAR(s.spectra[m.eta_spectrum * kSpectralSamples + i], 0.2f, 1e-6f);
+    EXPECT_NEAR(s.spectra[m.k_spectrum * kSpectralSamples + i], 3.f, 1e-6f);
+  }
   // A sloped reflectance reduces to a colour that follows the slope.
   dir.write("red.spd", "400 0.1 700 0.9\n");
   SceneDesc red = load_world(std::string("Material \"diffuse\" \"spectrum reflectance\" \"red.spd\"\n") + kTriangle, dir.path());
