@@ -6,6 +6,7 @@
 #include "app/scene_loading.h"
 #include "kernels/effects.h"
 #include "scene/scene_effects.h"
+#include "scene/spectral_choice.h"
 #include "worker/scene_data.h"
 
 namespace tessera {
@@ -40,6 +41,8 @@ int run_info(const std::string& path) {
     std::printf("bounds:         (%g, %g, %g) - (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
   std::printf("effects:        %s\n", describe_effects(scene.effects()).c_str());
   std::printf("specialisation: %s\n", describe_specialisation(specialisation_for(scene.effects())).c_str());
+  const std::string why = spectral_reason(scene.desc());
+  std::printf("transport:      %s\n", why.empty() ? "rgb (--spectral auto)" : ("spectral (--spectral auto: " + why + ")").c_str());
   std::printf("warnings:       %zu\n", scene.desc().warnings.size());
   return 0;
 }

@@ -19,6 +19,7 @@
 #include "master/snapshots.h"
 #include "master/stats_json.h"
 #include "scene/scene_effects.h"
+#include "scene/spectral_choice.h"
 #include "worker/cpu_affinity.h"
 #include "worker/farm_worker.h"
 
@@ -30,7 +31,7 @@ struct RenderArgs {
   int64_t spp = -1, max_depth = -1, threads = 0, tile = 16;
   int64_t seed = -1;
   std::string sampler;  // "" = the scene's
-  std::string spectral = "off";
+  std::string spectral = "auto";
   double time = 0.0;
   double target_error = 0.0;
   std::string snapshot_every;
@@ -62,7 +63,7 @@ SceneDesc load_desc(const RenderArgs& a) {
   if (a.seed >= 0) desc.seed = static_cast<uint64_t>(a.seed);
   if (a.sampler == "independent") desc.sampler = SamplerKind::Independent;
   else if (a.sampler == "sobol") desc.sampler = SamplerKind::Sobol;
-  desc.spectral = a.spectral == "on";
+  desc.spectral = a.spectral == "on" || (a.spectral == "auto" && !spectral_reason(desc).empty());
   return desc;
 }
 
@@ -165,6 +166,10 @@ void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks) {
                m.opt.spp > 0 ? (std::to_string(m.opt.spp) + " spp").c_str() : "unlimited spp", m.opt.max_depth);
   std::fprintf(stderr, "tessera: effects: %s; integrator specialisation: %s\n", describe_effects(scene.effects()).c_str(),
                describe_specialisation(spec).c_str());
+  const std::string why = spectral_reason(scene.desc());
+  std::fprintf(stderr, "tessera: transport: %s\n",
+               scene.desc().spectral ? ("spectral (" + (why.empty() ? std::string("--spectral on") : why) + ")").c_str()
+                                     : (why.empty() ? "rgb" : ("rgb (--spectral off; " + why + ")").c_str()));
   if (m.guide) {
     std::fprintf(stderr,
                  "tessera: guiding: %s (%s), %u direction bins, %s light selection, %s next-event estimation, budget "
@@ -408,8 +413,9 @@ CommandRunner add_render_command(CLI::App& app) {
                 "independent | sobol (Owen-scrambled Sobol points); default: the scene's Sampler (pbrt's default zsobol -> sobol)")
       ->check(CLI::IsMember({"independent", "sobol"}));
   c->add_option("--spectral", a->spectral,
-                "on: paths carry sampled wavelengths and colours become pbrt-v4's spectra; off: paths carry RGB")
-      ->check(CLI::IsMember({"on", "off"}));
+                "on: paths carry sampled wavelengths and colours become pbrt-v4's spectra; off: paths carry RGB; "
+                "auto (default): spectral where it changes the picture (measured spectra, strongly coloured lights)")
+      ->check(CLI::IsMember({"on", "off", "auto"}));
   c->add_option("--threads", a->threads, "Worker threads per process (0 = all cores, shared out among the ranks on a machine)")->check(CLI::Range(0, 4096));
   c->add_option("--tile", a->tile, "Tile size in pixels")->check(CLI::Range(1, 4096));
   c->add_option("--stats", a->stats, "Write render statistics as JSON");

@@ -49,6 +49,10 @@ struct Material {
   // (used in spectral mode; eta and k above are their RGB fit). -1: none.
   int32_t eta_spectrum = -1, k_spectrum = -1;
   Float ior = 1.5f;                          // dielectric eta / coateddiffuse coating eta
+  // A dispersive index (named glass, eta spectrum): index into
+  // SceneView::spectra, read at the path's first wavelength in spectral
+  // mode (ior above is its value at 550 nm). -1: none.
+  int32_t ior_spectrum = -1;
   Float alpha_x = 0.f, alpha_y = 0.f;        // GGX alpha, remapped from roughness by the loader (coated: the coat's)
   Float base_alpha_x = 0.f, base_alpha_y = 0.f;  // coatedconductor: the conductor's GGX alpha
   // Textured roughness (u, v): evaluated at the hit, then remapped

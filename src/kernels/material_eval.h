@@ -63,6 +63,11 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
     b.alpha_y = m->remap_roughness ? glm::sqrt(rv) : rv;
   }
   b.ior = m->ior;
+  if (wl && m->ior_spectrum >= 0) {
+    // Dispersion, as pbrt-v4: the index at the first wavelength, the others' paths end.
+    b.ior = sample_table(s.spectra + m->ior_spectrum * kSpectralSamples, 1, wl->lambda[0]);
+    terminate_secondary(*wl);
+  }
   switch (m->type) {
     case MaterialType::Conductor:
     case MaterialType::CoatedConductor:

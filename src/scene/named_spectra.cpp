@@ -35,7 +35,7 @@ Vec3 integrate_xyz(SpectrumFn&& s) {
 
 
 // Conductor values are the spectra averaged over rough R/G/B bands (about
-// 600-700, 500-600, 400-500 nm); glasses use n_d (587.6 nm) as "near 550 nm".
+// 600-700, 500-600, 400-500 nm). Glasses are in glass_sellmeier().
 const std::map<std::string, Rgb>& table() {
   static const std::map<std::string, Rgb> t = {
       {"metal-Au-eta", {0.143f, 0.375f, 1.442f}},   {"metal-Au-k", {3.983f, 2.386f, 1.603f}},
@@ -45,17 +45,50 @@ const std::map<std::string, Rgb>& table() {
       {"metal-CuZn-eta", {0.444f, 0.527f, 1.094f}}, {"metal-CuZn-k", {3.695f, 2.765f, 1.829f}},
       {"metal-MgO-eta", {1.732f, 1.738f, 1.760f}},  {"metal-MgO-k", {0.f, 0.f, 0.f}},
       {"metal-TiO2-eta", {2.74f, 2.87f, 3.10f}},    {"metal-TiO2-k", {0.f, 0.f, 0.0f}},
-      {"glass-BK7", Rgb(1.5168f)},                  {"glass-BAF10", Rgb(1.6700f)},
-      {"glass-FK51A", Rgb(1.4866f)},                {"glass-LASF9", Rgb(1.8503f)},
-      {"glass-F5", Rgb(1.6034f)},                   {"glass-F10", Rgb(1.6200f)},
-      {"glass-F11", Rgb(1.6209f)},
   };
   return t;
 }
 
+// pbrt-v4's named glasses as Schott's Sellmeier dispersion formulas
+// (n^2 = 1 + sum B_i l^2 / (l^2 - C_i), l in micrometres; catalogue data,
+// which reproduce each glass's n_d to 1e-5). pbrt-v4's "glass-F5", "-F10"
+// and "-F11" are the dense flints SF5, SF10 and SF11.
+struct Sellmeier {
+  double B[3], C[3];
+  double n(double lambda_nm) const {
+    const double l2 = lambda_nm * lambda_nm * 1e-6;
+    double n2 = 1.0;
+    for (int i = 0; i < 3; ++i) n2 += B[i] * l2 / (l2 - C[i]);
+    return std::sqrt(n2);
+  }
+};
+
+const Sellmeier* glass_sellmeier(const std::string& name) {
+  static const std::map<std::string, Sellmeier> glasses = {
+      {"glass-BK7", {{1.03961212, 0.231792344, 1.01046945}, {0.00600069867, 0.0200179144, 103.560653}}},
+      {"glass-BAF10", {{1.5851495, 0.143559385, 1.08521269}, {0.00926681282, 0.0424489805, 105.613573}}},
+      {"glass-FK51A", {{0.971247817, 0.216901417, 0.904651666}, {0.00472301995, 0.0153575612, 168.68133}}},
+      {"glass-LASF9", {{2.00029547, 0.298926886, 1.80691843}, {0.0121426017, 0.0538736236, 156.530829}}},
+      {"glass-F5", {{1.52481889, 0.187085527, 1.42729015}, {0.011254756, 0.0588995392, 129.141675}}},
+      {"glass-F10", {{1.62153902, 0.256287842, 1.64447552}, {0.0122241457, 0.0595736775, 147.468793}}},
+      {"glass-F11", {{1.73759695, 0.313747346, 1.89878101}, {0.013188707, 0.0623068142, 155.23629}}},
+  };
+  auto it = glasses.find(name);
+  return it == glasses.end() ? nullptr : &it->second;
+}
+
 }  // namespace
 
+std::optional<std::vector<Float>> named_spectrum_samples(const std::string& name) {
+  const Sellmeier* g = glass_sellmeier(name);
+  if (!g) return std::nullopt;
+  std::vector<Float> out(kSpectralSamples);
+  for (int i = 0; i < kSpectralSamples; ++i) out[i] = static_cast<Float>(g->n(kCieLambdaMin + kCieLambdaStep * i));
+  return out;
+}
+
 std::optional<Rgb> named_spectrum_rgb(const std::string& name) {
+  if (const Sellmeier* g = glass_sellmeier(name)) return Rgb(static_cast<Float>(g->n(550.0)));
   auto it = table().find(name);
   if (it != table().end()) return it->second;
   // Emission spectra: pbrt-v4 normalises them to unit luminance, and their

@@ -11,7 +11,7 @@
 namespace tessera {
 
 // pbrt-v4's built-in named spectra ("metal-Au-eta", "glass-BK7", "stdillum-D65"...)
-// as linear sRGB. Glasses give their index near 550 nm in all three channels;
+// as linear sRGB. Glasses give their index at 550 nm in all three channels;
 // standard illuminants give (1,1,1) because pbrt-v4 normalises emission spectra
 // to unit luminance. nullopt for an unknown name.
 std::optional<Rgb> named_spectrum_rgb(const std::string& name);
@@ -19,6 +19,10 @@ std::optional<Rgb> named_spectrum_rgb(const std::string& name);
 // Blackbody emission at `kelvin`, scaled to luminance 1 (pbrt-v4 normalises
 // blackbody emitters photometrically, so only the colour matters).
 Rgb blackbody_rgb(Float kelvin);
+
+// A named spectrum sampled at the spectral tables' wavelengths, for those
+// known as spectra (the glasses' dispersion); nullopt for others.
+std::optional<std::vector<Float>> named_spectrum_samples(const std::string& name);
 
 // Chromaticity (CIE 1931 x, y) of a blackbody at `kelvin`.
 Vec2 blackbody_xy(Float kelvin);

@@ -1,5 +1,6 @@
 #include "scene/pbrt_materials.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "scene/named_spectra.h"
@@ -33,15 +34,31 @@ void read_roughness(Material& m, const ParamSet& params, const DirectiveContext&
   m.alpha_x = m.alpha_y = 1.f;  // not smooth: the effects set counts it as glossy
 }
 
-// A dielectric index of refraction: a float, or a spectrum (named glasses)
-// read near 550 nm (green channel); dispersion is not modelled.
-Float read_ior(const ParamSet& params, const std::string& name, Float fallback, const DirectiveContext& ctx) {
+// A dielectric index of refraction: a float, or a spectrum (named glasses,
+// samples) read at 550 nm (green channel) for RGB transport. A spectrum
+// that varies is also kept (Material::ior_spectrum) for dispersion in
+// spectral transport, when `m` is given.
+Float read_ior(const ParamSet& params, const std::string& name, Float fallback, const DirectiveContext& ctx,
+               Material* m = nullptr) {
   if (params.get_texture(name)) {
     ctx.warn("a texture for '" + name + "' is not supported; using " + std::to_string(fallback));
     return fallback;
   }
-  if (auto rgb = params.get_rgb(name, /*allow_float=*/true)) return rgb->y;
-  return fallback;
+  const std::optional<Rgb> rgb = params.get_rgb(name, /*allow_float=*/true);
+  if (!rgb) return fallback;
+  const Param* p = params.find_any(name);
+  if (m && p && p->type == "spectrum") {
+    std::optional<std::vector<Float>> samples;
+    if (!p->strings.empty()) samples = named_spectrum_samples(p->strings[0]);
+    else samples = resample_spectrum(std::vector<Float>(p->numbers.begin(), p->numbers.end()));
+    const auto [lo, hi] = samples ? std::minmax_element(samples->begin(), samples->end())
+                                  : std::pair<std::vector<Float>::const_iterator, std::vector<Float>::const_iterator>{};
+    if (samples && *lo != *hi) {
+      m->ior_spectrum = static_cast<int32_t>(ctx.scene.spectra.size() / kSpectralSamples);
+      ctx.scene.spectra.insert(ctx.scene.spectra.end(), samples->begin(), samples->end());
+    }
+  }
+  return rgb->y;
 }
 
 Rgb read_constant_rgb(const ParamSet& params, const std::string& name, Rgb fallback, const DirectiveContext& ctx) {
@@ -118,15 +135,15 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
     read_conductor(m, params, ctx, "");
   } else if (type == "dielectric") {
     m.type = MaterialType::Dielectric;
-    m.ior = read_ior(params, "eta", 1.5f, ctx);
+    m.ior = read_ior(params, "eta", 1.5f, ctx, &m);
     read_roughness(m, params, ctx);
   } else if (type == "thindielectric") {
     m.type = MaterialType::ThinDielectric;  // pbrt-v4: smooth only
-    m.ior = read_ior(params, "eta", 1.5f, ctx);
+    m.ior = read_ior(params, "eta", 1.5f, ctx, &m);
   } else if (type == "coateddiffuse") {
     m.type = MaterialType::CoatedDiffuse;
     m.reflectance = spectrum_slot(params, "reflectance", Rgb(0.5f), ctx);
-    m.ior = read_ior(params, "eta", 1.5f, ctx);
+    m.ior = read_ior(params, "eta", 1.5f, ctx, &m);
     read_roughness(m, params, ctx);
     read_layer(m, params, ctx, type);
   } else if (type == "coatedconductor") {
@@ -144,7 +161,7 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
     m.type = MaterialType::CoatedConductor;
     m.base_alpha_x = m.alpha_x;
     m.base_alpha_y = m.alpha_y;
-    m.ior = read_ior(params, "interface.eta", 1.5f, ctx);
+    m.ior = read_ior(params, "interface.eta", 1.5f, ctx, &m);
     read_roughness(m, params, ctx, "interface.");
     read_layer(m, params, ctx, type);
   } else if (type == "interface" || type == "none" || type == "") {
