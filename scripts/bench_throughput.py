@@ -61,7 +61,7 @@ def main():
 
     def ours(spp, extra=()):
         return [a.tessera, "render", "-q", "--no-preview", "--res", f"{a.res}x{a.res}", "--spp", str(spp),
-                "--max-depth", str(a.depth), "--threads", str(a.threads), "--guide", "none",
+                "--max-depth", str(a.depth), "--threads", str(a.threads), "--guide", "none", "--spectral", "off",
                 "-o", os.path.join(tmp, "o.exr"), *extra]
 
     # Our own stats (render loop only) for rays/s and path statistics.

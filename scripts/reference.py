@@ -47,11 +47,17 @@ def _git_commit():
         return ""
 
 
+# Part of every cache key: raise it when Tessera's converged picture of a
+# scene changes (2: spectral transport chosen by --spectral auto, the
+# consistent layered BSDF), so that no stale reference is reused.
+PICTURE_REVISION = 2
+
+
 def cache_paths(scene, spp=DEFAULT_SPP, seed=DEFAULT_SEED, extra_args=(), cache=DEFAULT_CACHE):
     """(exr, json) where the reference of these settings lives."""
     with open(scene, "rb") as f:
         scene_hash = hashlib.sha256(f.read()).hexdigest()
-    key = hashlib.sha256(f"{scene_hash} {spp} {seed} {' '.join(extra_args)}".encode()).hexdigest()[:10]
+    key = hashlib.sha256(f"{scene_hash} {spp} {seed} {' '.join(extra_args)} r{PICTURE_REVISION}".encode()).hexdigest()[:10]
     stem = os.path.splitext(os.path.basename(scene))[0]
     exr = os.path.join(cache, f"{stem}-{spp}spp-{key}.exr")
     return exr, exr[:-4] + ".json", scene_hash

@@ -81,6 +81,7 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
   }
   RenderStats& stats = result.stats;
   stats.effects = scene.effects();
+  stats.spectral = scene.desc().spectral;
   stats.specialisation = effective_specialisation(scene, opt, guide != nullptr);
 
   std::unique_ptr<LocalPassExecutor> local;

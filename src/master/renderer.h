@@ -58,6 +58,7 @@ struct RenderStats {
   TileCounters counters;
   uint32_t effects = 0;
   uint32_t specialisation = 0;
+  bool spectral = false;            // spectral transport (else RGB)
   int32_t threads = 0;              // all ranks together
   int32_t ranks = 1;                // processes that rendered (farm)
   uint32_t resumed_at_spp = 0;      // > 0: continued from a checkpoint at this many spp

@@ -76,6 +76,7 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
   j.add("interface_crossings", c.path.interface_skips);
   j.add_string("effects", describe_effects(s.effects));
   j.add_string("specialisation", describe_specialisation(s.specialisation));
+  j.add_string("transport", s.spectral ? "spectral" : "rgb");
   j.add_string("guide", s.guide_mode);
   if (s.guide_mode != "none") {
     j.add("guide_cache_bytes", s.guide.bytes);

@@ -121,8 +121,12 @@ TEST_F(CliTest, RenderStatsAndCompare) {
   ASSERT_EQ(run("render -q --res 24x16 --spp 4 --seed 3 --threads 1 -o " + b).exit_code, 0);
   const std::string json = testing::read_text(stats);
   for (const char* key : {"\"spp\": 4", "\"samples_per_second\"", "\"rays_per_second\"", "\"mean_path_length\"",
-                          "\"zero_contribution_fraction\"", "\"nonfinite_samples_rejected\": 0", "\"effects\""})
+                          "\"zero_contribution_fraction\"", "\"nonfinite_samples_rejected\": 0", "\"effects\"",
+                          "\"transport\": \"spectral\""})
     EXPECT_NE(json.find(key), std::string::npos) << key << " in " << json;
+  // The built-in box's light is orange: --spectral auto chose spectral; off is RGB.
+  const std::string rgb = render_stats("--res 8x8 --spp 2 --spectral off", "rgb.json");
+  EXPECT_NE(rgb.find("\"transport\": \"rgb\""), std::string::npos) << rgb;
   // Same seed, different thread count: identical images, zero error.
   RunResult same = run("compare --json " + a + " " + b);
   EXPECT_EQ(same.exit_code, 0);
@@ -149,6 +153,9 @@ TEST_F(CliTest, ExrHasVarianceLayerAndMetadata) {
   auto* effects = h.findTypedAttribute<Imf::StringAttribute>("effects");
   ASSERT_NE(effects, nullptr);
   EXPECT_EQ(effects->value(), "diffuse, area-lights");
+  auto* transport = h.findTypedAttribute<Imf::StringAttribute>("transport");
+  ASSERT_NE(transport, nullptr);
+  EXPECT_EQ(transport->value(), "spectral");  // the built-in Cornell box's light is orange
   EXPECT_NE(h.findTypedAttribute<Imf::DoubleAttribute>("seconds"), nullptr);
   EXPECT_NE(h.findTypedAttribute<Imf::StringAttribute>("software"), nullptr);
 }
