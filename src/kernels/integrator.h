@@ -296,6 +296,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     }
 
     BsdfParams bsdf;
+    const int32_t single_before = wl ? wl->single : -1;
     if (!resolve_bsdf<Spec>(s, info.material, h, wo, &bsdf, wl)) {
       // Interface: continue through without counting a bounce (pbrt's SkipIntersection).
       ++c.interface_skips;
@@ -303,6 +304,13 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       if constexpr (kMedia) medium = medium_after(s, hit.triangle, h.ng, ray.d, medium);
       ray.o = offset_ray_origin(h, ray.d);
       continue;
+    }
+    if (wl && wl->single != single_before) {
+      // The path's first dispersive surface: from here on it carries one
+      // wavelength, for all three (spectral.h).
+      const Rgb mask = dispersion_mask(wl->single);
+      beta *= mask;
+      rr_beta *= mask;
     }
 
     if constexpr ((Spec & kSpecTextures) != 0) {

@@ -64,9 +64,10 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
   }
   b.ior = m->ior;
   if (wl && m->ior_spectrum >= 0) {
-    // Dispersion, as pbrt-v4: the index at the first wavelength, the others' paths end.
-    b.ior = sample_table(s.spectra + m->ior_spectrum * kSpectralSamples, 1, wl->lambda[0]);
-    terminate_secondary(*wl);
+    // Dispersion: the index at the one wavelength the path goes on with
+    // (spectral.h), picked by a hash of the hit like a mix's component.
+    const int32_t c = dispersion_channel(*wl, mix_hash_float(h.p, wo, material, 0x6469));
+    b.ior = sample_table(s.spectra + m->ior_spectrum * kSpectralSamples, 1, wl->lambda[c]);
   }
   switch (m->type) {
     case MaterialType::Conductor:
@@ -100,8 +101,9 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
     case MaterialType::DiffuseTransmission: {
       b.type = BsdfType::DiffuseTransmission;
       const Rgb t = (Spec & kSpecTextures) ? eval_slot(s, m->transmittance, h.uv) : m->transmittance.value;
-      b.reflectance = spectral_albedo(s.spectral, wl, glm::clamp(m->scale * refl, Rgb(0.f), Rgb(1.f)));
-      b.transmittance = spectral_albedo(s.spectral, wl, glm::clamp(m->scale * t, Rgb(0.f), Rgb(1.f)));
+      // pbrt-v4 scales the spectra, then clamps.
+      b.reflectance = glm::clamp(m->scale * spectral_albedo(s.spectral, wl, refl), Rgb(0.f), Rgb(1.f));
+      b.transmittance = glm::clamp(m->scale * spectral_albedo(s.spectral, wl, t), Rgb(0.f), Rgb(1.f));
       b.ior = 1.f;  // light passes straight through: no refraction, no eta^2 scaling
       break;
     }

@@ -17,8 +17,13 @@
 //
 // The three wavelengths are stratified over the visible range by one random
 // number (pbrt-v4's SampleVisibleWavelengths density, which follows the
-// luminance response). A dispersive refraction keeps only the first
-// (terminate_secondary), as pbrt-v4 does.
+// luminance response). At the first dispersive surface the path continues
+// at one of its wavelengths, picked uniformly, with 3 times the throughput,
+// and the others' throughput ends (dispersion_channel). Light gathered
+// before stays in all three. (pbrt-v4 instead drops the other wavelengths'
+// whole estimate, retroactively, which is unbiased only if no earlier
+// decision weighs the wavelengths unequally; here luminance-weighted lobe
+// and roulette choices would bias it.)
 #pragma once
 
 #include "vecmath.h"
@@ -43,7 +48,8 @@ struct SpectralView {
 
 struct Wavelengths {
   Vec3 lambda{550.f};
-  Vec3 pdf{1.f};  // per nm; 0 for a wavelength whose path was terminated
+  Vec3 pdf{1.f};        // per nm
+  int32_t single = -1;  // after a dispersive surface: the one wavelength the path continues at
 };
 
 // pbrt-v4's visible-wavelength density (integrates to 1 over 360-830 nm).
@@ -69,13 +75,19 @@ TESSERA_HOST_DEVICE inline Wavelengths sample_wavelengths(Float u) {
   return wl;
 }
 
-// After a wavelength-dependent refraction only the first wavelength's path is
-// valid: the others are dropped and it carries their share (pbrt-v4's
-// TerminateSecondary).
-TESSERA_HOST_DEVICE inline void terminate_secondary(Wavelengths& wl) {
-  if (wl.pdf[1] == 0.f && wl.pdf[2] == 0.f) return;
-  wl.pdf[0] /= 3.f;  // the film divides by the pdf: the first wavelength now counts thrice
-  wl.pdf[1] = wl.pdf[2] = 0.f;
+// The wavelength a dispersive surface scatters at: the path's one remaining
+// wavelength, or, at its first dispersive surface, one of the three picked by
+// u in [0,1) (the caller then multiplies that channel's throughput by 3 and
+// zeroes the others': dispersion_mask).
+TESSERA_HOST_DEVICE inline int32_t dispersion_channel(Wavelengths& wl, Float u) {
+  if (wl.single < 0) wl.single = glm::min(static_cast<int32_t>(u * 3.f), 2);
+  return wl.single;
+}
+
+TESSERA_HOST_DEVICE inline Rgb dispersion_mask(int32_t channel) {
+  Rgb m(0.f);
+  m[channel] = 3.f;
+  return m;
 }
 
 // Linear interpolation in a table sampled every 5 nm from 360 nm.

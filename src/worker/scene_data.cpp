@@ -10,6 +10,7 @@
 #include "kernels/equal_area.h"
 #include "kernels/vecmath.h"
 #include "scene/scene_effects.h"
+#include "scene/named_spectra.h"
 #include "scene/rgb_spectrum_fit.h"
 #include "scene/spectral_tables.h"
 
@@ -89,12 +90,15 @@ void SceneData::flatten_meshes() {
 
 void SceneData::build_lights() {
   for (const Light& l : desc_.lights) lights_.push_back(l);
-  // Blackbody emitters: the luminance of Planck's law relative to its peak,
-  // as the spectral film integrates it (light_emission() divides by it).
+  // Blackbody emitters: light_emission() turns luminance(L) into Planck's
+  // law of that luminance. L is scale x blackbody_rgb(T), whose luminance is
+  // 1 unless its RGB was clamped at 0 (very warm colours): divide by it, and
+  // by the luminance of B / B(peak) as the spectral film integrates it.
   for (Light& l : lights_)
     if (l.blackbody_kelvin > 0.f) {
       const double y = spectrum_luminance([&](double lambda) { return blackbody_relative(Float(lambda), l.blackbody_kelvin); });
-      l.blackbody_norm = y > 0. ? static_cast<Float>(1.0 / y) : 0.f;
+      const double rgb_y = luminance(blackbody_rgb(l.blackbody_kelvin));
+      l.blackbody_norm = y > 0. && rgb_y > 0. ? static_cast<Float>(1.0 / (y * rgb_y)) : 0.f;
     }
   Float radius = triangles_.empty() ? 1.f : glm::max(1e-3f, 0.5f * glm::length(bounds_.hi - bounds_.lo));
 
@@ -334,8 +338,7 @@ uint64_t SceneData::film_fingerprint() const {
   f.add(&camera_.lens_radius, sizeof camera_.lens_radius);
   f.add(&camera_.focal_distance, sizeof camera_.focal_distance);
   f.add(&desc_.filter, sizeof desc_.filter);
-  const uint8_t spectral = desc_.spectral ? 1 : 0;
-  f.add(&spectral, 1);
+  if (desc_.spectral) f.add("spectral", 8);  // only then: RGB checkpoints keep their fingerprints
   if (!positions_end_.empty() || camera_.moves) {  // motion blur: the shutter, the transforms' times, the camera's end
     f.add(&camera_.world_from_camera_linear_end, sizeof camera_.world_from_camera_linear_end);
     f.add(&camera_.origin_end, sizeof camera_.origin_end);

@@ -99,8 +99,8 @@ namespace tessera {
 namespace {
 
 // White light through a dispersive glass ball stays white on average: each
-// path keeps one wavelength after the glass (pbrt-v4's TerminateSecondary)
-// and counts it thrice, so the estimate is unbiased. A flint (SF11) splits
+// path goes on at one of its wavelengths after the glass, with 3 times the
+// throughput, so the estimate is unbiased. A flint (SF11) splits
 // light strongly; its mean colour still matches RGB transport at 550 nm.
 TEST(Spectral, DispersiveGlassKeepsWhiteLightWhite) {
   const std::string text = R"(

@@ -129,17 +129,23 @@ TEST(SpectralTables, BlackbodyHasItsColour) {
   EXPECT_NEAR(blackbody_relative(2.8977721e6f / 5000.f, 5000.f), 1.f, 1e-5f);
 }
 
-// A dispersive refraction keeps the first wavelength, counted thrice.
-TEST(SpectralTables, TerminatingSecondaryWavelengthsKeepsTheEstimate) {
+// At a dispersive surface the path goes on at one wavelength, picked
+// uniformly, with 3 times the throughput: light found afterwards keeps its
+// expected colour.
+TEST(SpectralTables, DispersionContinuesAtOneWavelengthUnbiased) {
   const SpectralView v = srgb_spectral_tables().view();
-  const int n = 100000;
+  const int n = 90000;
   Vec3 sum(0.f);
+  int picked[3] = {0, 0, 0};
   for (int i = 0; i < n; ++i) {
     Wavelengths wl = sample_wavelengths((i + 0.5f) / n);
-    const Rgb L = spectral_illuminant(v, &wl, Rgb(0.3f, 0.6f, 0.9f));
-    terminate_secondary(wl);
-    EXPECT_EQ(wl.pdf[1], 0.f);
+    const int32_t c = dispersion_channel(wl, static_cast<Float>(i % 3) / 3.f + 0.1f);
+    ++picked[c];
+    EXPECT_EQ(dispersion_channel(wl, 0.99f), c);  // later dispersive surfaces keep it
+    const Rgb L = dispersion_mask(c) * spectral_illuminant(v, &wl, Rgb(0.3f, 0.6f, 0.9f));
     sum += spectral_to_rgb(v, wl, L);
   }
+  EXPECT_EQ(picked[0], n / 3);
+  EXPECT_EQ(picked[2], n / 3);
   EXPECT_VEC3_NEAR(sum / static_cast<Float>(n), Vec3(0.3f, 0.6f, 0.9f), 5e-3f);
 }
