@@ -22,6 +22,13 @@ Rgb channel_means(const ImageRgb& img) {
   return Rgb(Float(s[0] / n), Float(s[1] / n), Float(s[2] / n));
 }
 
+// The one-bounce furnace (depth 1) with one piece of its text replaced.
+SceneDesc furnace_with(const std::string& from, const std::string& to, int spp) {
+  std::string text = furnace_scene(0.5, 1, 16, spp);
+  text.replace(text.find(from), from.size(), to);
+  return load_pbrt_string(text, "<test>", ".");
+}
+
 RenderResult render_spectral(SceneDesc desc, bool spectral, int threads = 0) {
   desc.spectral = spectral;
   RenderOptions opt;
@@ -47,10 +54,7 @@ TEST(Spectral, FurnaceInEveryChannel) {
 // multiply spectra, not RGB triples, so spectral transport gives a different
 // (pbrt-v4's) answer: the product of smooth spectra is less saturated.
 TEST(Spectral, ColouredFurnaceOneBounceIsTheRgb) {
-  std::string text = furnace_scene(0.5, 1, 16, 512);
-  const std::string grey = "[ 0.5 0.5 0.5 ]";
-  text.replace(text.find(grey), grey.size(), "[ 0.8 0.4 0.2 ]");
-  SceneDesc d = load_pbrt_string(text, "<test>", ".");
+  const SceneDesc d = furnace_with("[ 0.5 0.5 0.5 ]", "[ 0.8 0.4 0.2 ]", 512);
   const Rgb s = channel_means(film_mean(render_spectral(d, true).film));
   const Rgb expect(1.8f, 1.4f, 1.2f);  // Le + rho Le
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(s[c], expect[c], 0.01 * expect[c]) << "channel " << c;
@@ -82,10 +86,7 @@ TEST(Spectral, SameImageForAnyThreadCount) {
 // A blackbody emitter: Planck's law in spectral mode has the luminance and
 // colour that its RGB stands for in RGB mode.
 TEST(Spectral, BlackbodyLightMatchesItsRgb) {
-  std::string text = furnace_scene(0.5, 1, 16, 256);
-  const std::string white = "\"rgb L\" [ 1 1 1 ]";
-  text.replace(text.find(white), white.size(), "\"blackbody L\" [ 3000 ]");
-  SceneDesc d = load_pbrt_string(text, "<test>", ".");
+  const SceneDesc d = furnace_with("\"rgb L\" [ 1 1 1 ]", "\"blackbody L\" [ 3000 ]", 256);
   const Rgb rgb = channel_means(film_mean(render_spectral(d, false).film));
   const Rgb spec = channel_means(film_mean(render_spectral(d, true).film));
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(spec[c], rgb[c], 0.015 * rgb[c] + 0.003) << "channel " << c;
