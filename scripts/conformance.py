@@ -224,8 +224,8 @@ def fmt(v, spec=".2f"):
 
 
 def table(scenes):
-    rows = [f"| scene | status | seconds | R G B ratio | worst {BLOCK}x{BLOCK} block | blocks off >10% | warnings |",
-            "|---|---|---:|---|---|---:|---:|"]
+    rows = [f"| scene | status | transport | seconds | R G B ratio | worst {BLOCK}x{BLOCK} block | blocks off >10% | warnings |",
+            "|---|---|---|---:|---|---|---:|---:|"]
     for s in scenes:
         status = s.get("status", "?")
         if s.get("error"):
@@ -237,7 +237,8 @@ def table(scenes):
         if s.get("worst_block_ratio") is not None:
             worst = f"{s['worst_block_ratio']:.2f} @({s['worst_block'][0]},{s['worst_block'][1]})"
         off = fmt(100 * s["blocks_off_fraction"], ".0f") + " %" if s.get("blocks_off_fraction") is not None else "–"
-        rows.append(f"| {s['label']} | {status} | {fmt(s.get('seconds'), '.1f')} | {ratio} | {worst} | {off} | "
+        transport = (s.get("stats") or {}).get("transport", "–")  # rgb or spectral (--spectral auto decides)
+        rows.append(f"| {s['label']} | {status} | {transport} | {fmt(s.get('seconds'), '.1f')} | {ratio} | {worst} | {off} | "
                     f"{len(s.get('warnings', []))} |")
     return "\n".join(rows)
 
