@@ -48,4 +48,15 @@ TEST(SpectralChoice, NamedGlassesDisperse) {
   for (int i = 1; i < kSpectralSamples; ++i) EXPECT_LT(n[i], n[i - 1]);  // normal dispersion
   const SceneDesc bk7 = load_world(std::string("Material \"dielectric\" \"spectrum eta\" \"glass-BK7\"\n") + kTriangle);
   EXPECT_NEAR(bk7.materials.at(bk7.meshes.back().material).ior, 1.5185f, 2e-4f);
+  // An eta given as samples disperses too (linear between them, constant beyond);
+  // a flat one does not.
+  const SceneDesc sampled =
+      load_world(std::string("Material \"dielectric\" \"spectrum eta\" [ 400 1.6 700 1.5 ]\n") + kTriangle);
+  const Material& ms = sampled.materials.at(sampled.meshes.back().material);
+  ASSERT_GE(ms.ior_spectrum, 0);
+  EXPECT_NEAR(sampled.spectra[ms.ior_spectrum * kSpectralSamples + 0], 1.6f, 1e-6f);   // 360 nm
+  EXPECT_NEAR(sampled.spectra[ms.ior_spectrum * kSpectralSamples + 38], 1.55f, 1e-5f);  // 550 nm
+  const SceneDesc flat =
+      load_world(std::string("Material \"dielectric\" \"spectrum eta\" [ 400 1.5 700 1.5 ]\n") + kTriangle);
+  EXPECT_EQ(flat.materials.at(flat.meshes.back().material).ior_spectrum, -1);
 }
