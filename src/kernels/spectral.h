@@ -159,10 +159,11 @@ TESSERA_HOST_DEVICE inline Rgb eval_sigmoid_spectrum(Vec3 c, const Wavelengths& 
   return out;
 }
 
-// The three doors (see the top of the file). Identity in RGB mode (wl null).
+// The three doors (see the top of the file). In RGB mode (wl null) the
+// identity, except that an albedo is clamped to [0,1] in both modes.
 TESSERA_HOST_DEVICE inline Rgb spectral_albedo(const SpectralView& v, const Wavelengths* wl, Rgb rgb) {
-  if (!wl) return rgb;
   rgb = glm::clamp(rgb, Rgb(0.f), Rgb(1.f));
+  if (!wl) return rgb;
   if (!(rgb.x == rgb.x && rgb.y == rgb.y && rgb.z == rgb.z)) return Rgb(0.f);
   return eval_sigmoid_spectrum(rgb_sigmoid_coefficients(v, rgb), *wl);
 }

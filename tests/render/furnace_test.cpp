@@ -43,6 +43,19 @@ TEST(Furnace, HighAlbedoDeepPaths) {
   EXPECT_NEAR(mean, expected_furnace(0.9, 40), 0.02 * expected_furnace(0.9, 40));
 }
 
+// A reflectance above 1 is an albedo clamped to 1 (as pbrt-v4's albedo
+// spectra are), in RGB and spectral transport alike: never a surface that
+// creates light.
+TEST(Furnace, ReflectanceAboveOneIsClampedToOne) {
+  for (bool spectral : {false, true}) {
+    SceneDesc d = load_pbrt_string(furnace_scene(1.5, 3), "<test>", ".");
+    d.spectral = spectral;
+    RenderResult r = testing::render_desc(std::move(d), RenderOptions{});
+    const double mean = testing::image_mean(film_mean(r.film));
+    EXPECT_NEAR(mean, expected_furnace(1.0, 3), kRelTol * expected_furnace(1.0, 3)) << "spectral " << spectral;
+  }
+}
+
 TEST(Furnace, NeeAndBsdfSamplingAgree) {
   RenderOptions a, b;
   b.nee = false;

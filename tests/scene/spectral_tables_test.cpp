@@ -109,8 +109,10 @@ TEST(SpectralTables, FilmReturnsTheRgbOfIlluminantsAndReflectances) {
   const Wavelengths wl = sample_wavelengths(0.37f);
   EXPECT_VEC3_NEAR(spectral_unbounded(v, &wl, Rgb(6.f, 2.f, 1.f)), 2.f * spectral_unbounded(v, &wl, Rgb(3.f, 1.f, 0.5f)),
                    1e-5f);
-  // RGB mode: every door is the identity.
-  EXPECT_EQ(spectral_albedo(v, nullptr, Rgb(0.3f, 2.f, -1.f)), Rgb(0.3f, 2.f, -1.f));
+  // RGB mode: every door is the identity, but albedos are clamped to [0,1].
+  EXPECT_EQ(spectral_albedo(v, nullptr, Rgb(0.3f, 2.f, -1.f)), Rgb(0.3f, 1.f, 0.f));
+  EXPECT_EQ(spectral_unbounded(v, nullptr, Rgb(0.3f, 2.f, 7.f)), Rgb(0.3f, 2.f, 7.f));
+  EXPECT_EQ(spectral_illuminant(v, nullptr, Rgb(0.3f, 2.f, 7.f)), Rgb(0.3f, 2.f, 7.f));
 }
 
 // Planck's law through the film has the chromaticity of a blackbody.
