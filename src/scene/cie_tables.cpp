@@ -5,6 +5,8 @@
 // Tabulated standard data: there is no Debian package that ships it.
 #include "scene/cie_tables.h"
 
+#include <algorithm>
+
 namespace tessera {
 
 const float kCie1931Xyz[kCieSamples][3] = {
@@ -126,5 +128,12 @@ const float kCieD65[kCieSamples] = {
     63.843400f, 64.304000f, 61.877900f, 59.451900f, 55.705400f,
     51.959000f, 54.699800f, 57.440600f, 58.876500f, 60.312500f,
 };
+
+double cie_table_at(const float* table, int stride, double lambda) {
+  const double x = std::clamp((lambda - kCieLambdaMin) / kCieLambdaStep, 0.0, double(kCieSamples - 1));
+  const int i = std::min(int(x), kCieSamples - 2);
+  const double f = x - i;
+  return (1.0 - f) * table[i * stride] + f * table[(i + 1) * stride];
+}
 
 }  // namespace tessera

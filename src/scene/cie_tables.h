@@ -10,4 +10,8 @@ constexpr double kCieLambdaMin = 360.0, kCieLambdaStep = 5.0;
 extern const float kCie1931Xyz[kCieSamples][3];
 extern const float kCieD65[kCieSamples];
 
+// A table above at lambda (nm), linear between its samples, its end values
+// beyond them; `stride` floats between samples (3 for one matching function).
+double cie_table_at(const float* table, int stride, double lambda);
+
 }  // namespace tessera

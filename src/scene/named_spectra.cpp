@@ -11,11 +11,8 @@ namespace {
 
 // The CIE 1931 matching functions at lambda (nm), from the tabulated standard.
 Vec3 cie_xyz(double l) {
-  const double x = std::clamp((l - kCieLambdaMin) / kCieLambdaStep, 0.0, double(kCieSamples - 1));
-  const int i = std::min(int(x), kCieSamples - 2);
-  const double f = x - i;
   Vec3 v;
-  for (int c = 0; c < 3; ++c) v[c] = static_cast<Float>((1.0 - f) * kCie1931Xyz[i][c] + f * kCie1931Xyz[i + 1][c]);
+  for (int c = 0; c < 3; ++c) v[c] = static_cast<Float>(cie_table_at(&kCie1931Xyz[0][c], 3, l));
   return v;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "scene/named_spectra.h"
 #include "scene/pbrt_textures.h"
@@ -34,6 +35,14 @@ void read_roughness(Material& m, const ParamSet& params, const DirectiveContext&
   m.alpha_x = m.alpha_y = 1.f;  // not smooth: the effects set counts it as glossy
 }
 
+// Appends a sampled spectrum (kSpectralSamples values) to the scene's pool;
+// returns its index there.
+int32_t add_spectrum(SceneDesc& scene, const std::vector<Float>& samples) {
+  const auto index = static_cast<int32_t>(scene.spectra.size() / kSpectralSamples);
+  scene.spectra.insert(scene.spectra.end(), samples.begin(), samples.end());
+  return index;
+}
+
 // A dielectric index of refraction: a float, or a spectrum (named glasses,
 // samples) read at 550 nm (green channel) for RGB transport. A spectrum
 // that varies is also kept (Material::ior_spectrum) for dispersion in
@@ -51,12 +60,9 @@ Float read_ior(const ParamSet& params, const std::string& name, Float fallback, 
     std::optional<std::vector<Float>> samples;
     if (!p->strings.empty()) samples = named_spectrum_samples(p->strings[0]);
     else samples = resample_spectrum(std::vector<Float>(p->numbers.begin(), p->numbers.end()));
-    const auto [lo, hi] = samples ? std::minmax_element(samples->begin(), samples->end())
-                                  : std::pair<std::vector<Float>::const_iterator, std::vector<Float>::const_iterator>{};
-    if (samples && *lo != *hi) {
-      m->ior_spectrum = static_cast<int32_t>(ctx.scene.spectra.size() / kSpectralSamples);
-      ctx.scene.spectra.insert(ctx.scene.spectra.end(), samples->begin(), samples->end());
-    }
+    const bool varies = samples && std::adjacent_find(samples->begin(), samples->end(), std::not_equal_to<>()) !=
+                                       samples->end();
+    if (varies) m->ior_spectrum = add_spectrum(ctx.scene, *samples);
   }
   return rgb->y;
 }
@@ -84,12 +90,8 @@ void read_conductor(Material& m, const ParamSet& params, const DirectiveContext&
     const Float outside = prefix == "conductor." ? read_ior(params, "interface.eta", 1.5f, ctx) : 1.f;
     sampled_conductor_rgb(eta_pairs, k_pairs, outside, &m.eta, &m.k);
     e->used = kp->used = true;
-    for (const std::vector<Float>* pairs : {&eta_pairs, &k_pairs}) {
-      const std::vector<Float> samples = resample_spectrum(*pairs);
-      (pairs == &eta_pairs ? m.eta_spectrum : m.k_spectrum) =
-          static_cast<int32_t>(ctx.scene.spectra.size() / kSpectralSamples);
-      ctx.scene.spectra.insert(ctx.scene.spectra.end(), samples.begin(), samples.end());
-    }
+    m.eta_spectrum = add_spectrum(ctx.scene, resample_spectrum(eta_pairs));
+    m.k_spectrum = add_spectrum(ctx.scene, resample_spectrum(k_pairs));
     const std::string files =
         e->file.empty() || kp->file.empty() ? std::string() : " (files '" + e->file + "', '" + kp->file + "')";
     ctx.warn("conductor \"" + prefix + "eta\" and \"" + prefix + "k\" spectra" + files +

@@ -13,13 +13,6 @@ namespace {
 // the product of two piecewise-linear tables, and fine for smooth sigmoids.
 constexpr int kFine = (kCieSamples - 1) * 3 + 1;
 
-double lerp_table(const float* t, int stride, double lambda) {
-  double x = std::clamp((lambda - kCieLambdaMin) / kCieLambdaStep, 0.0, double(kCieSamples - 1));
-  int i = std::min(int(x), kCieSamples - 2);
-  double f = x - i;
-  return (1.0 - f) * t[i * stride] + f * t[(i + 1) * stride];
-}
-
 struct FineGrid {
   double lambda[kFine];
   double weight[kFine];
@@ -35,8 +28,8 @@ const FineGrid& fine_grid() {
       f.lambda[i] = kCieLambdaMin + i * h;
       double w = (i == 0 || i == kFine - 1) ? 1.0 : (i % 3 == 0 ? 2.0 : 3.0);
       f.weight[i] = w * 3.0 * h / 8.0;
-      for (int c = 0; c < 3; ++c) f.cmf[i][c] = lerp_table(&kCie1931Xyz[0][c], 3, f.lambda[i]);
-      f.d65[i] = lerp_table(kCieD65, 1, f.lambda[i]);
+      for (int c = 0; c < 3; ++c) f.cmf[i][c] = cie_table_at(&kCie1931Xyz[0][c], 3, f.lambda[i]);
+      f.d65[i] = cie_table_at(kCieD65, 1, f.lambda[i]);
     }
     return f;
   }();
