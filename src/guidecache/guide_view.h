@@ -52,8 +52,8 @@ constexpr uint32_t kGuideNeeEntries = 2;
 // weight a_k, the mean over guided vertices of the estimator's second moment
 // had the vertex sampled with a_k (importance-weighted from the weight it
 // used), in units of the cell's own scale. The smallest one wins.
-constexpr uint32_t kGuideMixEntries = 5;
-TESSERA_HOST_DEVICE inline Float guide_mix_candidate(uint32_t k) { return 0.2f + 0.15f * static_cast<Float>(k); }
+constexpr uint32_t kGuideMixEntries = 6;
+TESSERA_HOST_DEVICE inline Float guide_mix_candidate(uint32_t k) { return 0.05f + 0.15f * static_cast<Float>(k); }
 
 // Surface points are split by the dominant axis of their normal (+-x, +-y,
 // +-z), so surfaces facing different ways never share a cell.
@@ -82,7 +82,7 @@ struct GuideView {
   uint32_t grid = 12;      // bins per side of the equal-area square
   uint32_t bins = 144;     // grid * grid
   uint32_t lights = 0;     // learned light-selection entries per cell (0 = off)
-  uint32_t stride = 151;   // entries per cell: bins, lights, kGuideNeeEntries, kGuideMixEntries
+  uint32_t stride = 152;   // entries per cell: bins, lights, kGuideNeeEntries, kGuideMixEntries
   uint32_t nee_entry = 144;  // first next-event statistic: bins + lights
   uint32_t mix_entry = 146;  // first mixture statistic: nee_entry + kGuideNeeEntries
   const Vec3* bin_dirs = nullptr;  // centre direction of each bin

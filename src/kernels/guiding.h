@@ -76,25 +76,56 @@ struct GuideMixSample {
   Float guide_pdf = 0.f;  // density of the guide's strategy for it
   Float bsdf_pdf = 0.f;   // density of the BSDF's strategy for it
   Float mix_pdf = 0.f;    // the mixture density it was drawn with
+  // Emission met along it that the integrator weighs by MIS against NEE
+  // (left out of the learning target, which is NEE's to deliver): its
+  // luminance and the light-sampling density of the direction. Its weight
+  // depends on the mixture density, so every candidate sees it with its own.
+  Float emitted = 0.f;
+  Float light_pdf = 0.f;
+  // The vertex's own next-event sample, whose MIS weight also depends on the
+  // mixture density: luminance of f |cos| tr L, its light density, and the
+  // guide's and the BSDF's densities of its direction (nee_value 0: none).
+  Float nee_value = 0.f;
+  Float nee_light_pdf = 0.f;
+  Float nee_guide_pdf = 0.f;
+  Float nee_bsdf_pdf = 0.f;
 };
 
 // Records, for every candidate weight a_k, the second moment the vertex's
-// estimator would have had with a_k, estimated from this sample drawn with
-// the current weight: (f cos T / s)^2 / (p_k p_cur), with T the learning
-// target (the radiance estimate along the direction) and s the cell's scale
-// (its learned irradiance / pi). A sample too large for the fixed point is
-// counted in rejected[2], for all candidates alike.
+// estimator would have had with a_k, estimated from this vertex's two samples
+// (s is the cell's scale, see below):
+// - the direction, drawn with the current weight: (f cos L_k / s)^2 /
+//   (p_k p_cur), with L_k the radiance it brings: the learning target T plus
+//   the MIS-weighted emission it met, weighted as it would be with p_k;
+// - the next-event sample, drawn independently of a_k:
+//   (f cos tr Le w_k / (p_light s))^2, its MIS weight w_k taken against p_k.
+// Scored on T alone, a cell lit directly by a large emitter (an environment)
+// saw only the indirect light the guide finds, chose high guide weights, and
+// took from the direct light the BSDF samples that its MIS with NEE needs
+// (material-testball's floor: 7x the variance of no guiding).
+// A sample too large for the fixed point is counted in rejected[2], for all
+// candidates alike.
 TESSERA_HOST_DEVICE inline void guide_record_mix(const GuideView& g, int32_t cell, const GuideMixSample& m,
                                                  Float target) {
-  const Float scale = g.irradiance[cell] * kInvPi;
+  // The cell's scale: the radiance it reflects, learned indirect plus NEE's
+  // direct share, so that cells lit mostly directly stay in range too.
+  const Float direct = g.value[static_cast<size_t>(cell) * g.stride + g.nee_entry];
+  const Float scale = g.irradiance[cell] * kInvPi + glm::max(direct, 0.f);
   if (!(scale > 0.f) || !(m.mix_pdf > 0.f) || !(target >= 0.f)) return;
-  const Float v = m.fcos * target / scale;
+  const Float f_scaled = m.fcos / scale;
   Float s[kGuideMixEntries];
   Float largest = 0.f;
   for (uint32_t k = 0; k < kGuideMixEntries; ++k) {
     const Float a = guide_mix_candidate(k);
     const Float pk = a * m.guide_pdf + (1.f - a) * m.bsdf_pdf;
+    const Float radiance = m.emitted > 0.f ? target + m.emitted * power_heuristic(pk, m.light_pdf) : target;
+    const Float v = f_scaled * radiance;
     s[k] = pk > 0.f ? v * v / (pk * m.mix_pdf) : 3.4e38f;
+    if (m.nee_value > 0.f && m.nee_light_pdf > 0.f) {
+      const Float pk_light_dir = a * m.nee_guide_pdf + (1.f - a) * m.nee_bsdf_pdf;
+      const Float nee = m.nee_value * power_heuristic(m.nee_light_pdf, pk_light_dir) / (m.nee_light_pdf * scale);
+      s[k] += nee * nee;
+    }
     largest = glm::max(largest, s[k]);
   }
   if (!(largest <= g.max_target)) {

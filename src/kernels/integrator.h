@@ -164,11 +164,23 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   // (mix_pdf 0: the vertex did not take part).
   GuideMixSample pend_mix;
   // Sends the pending target (and its mixture statistics) to x's cell.
+  // MIS-weighted emission met by the pending direction, for its mixture
+  // statistics (several environments: their luminances add, and the density
+  // is their luminance-weighted mean).
+  auto note_mis_emission = [&](Float le, Float light_pdf) {
+    if (pend_cell < 0 || !(pend_mix.mix_pdf > 0.f) || !(le > 0.f)) return;
+    const Float total = pend_mix.emitted + le;
+    pend_mix.light_pdf = (pend_mix.light_pdf * pend_mix.emitted + light_pdf * le) / total;
+    pend_mix.emitted = total;
+  };
   auto finish_target = [&](Float target) {
     target *= segment_tr;
     if (guide_record(g, pend_cell, pend_bin, target)) {
       ++c.guide_updates;
-      if (pend_mix.mix_pdf > 0.f) guide_record_mix(g, pend_cell, pend_mix, target);
+      if (pend_mix.mix_pdf > 0.f) {
+        pend_mix.emitted *= segment_tr;
+        guide_record_mix(g, pend_cell, pend_mix, target);
+      }
     }
   };
 
@@ -263,6 +275,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           } else {
             Float light_pdf = light_select_pmf(s, guide, prev_cell, li) * environment_pdf(s, li, ray.d);
             L += beta * Le * power_heuristic(prev_scatter_pdf, light_pdf);
+            if constexpr (kGuide) note_mis_emission(luminance(Le), light_pdf);
           }
         }
       }
@@ -290,6 +303,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             Float light_pdf = light_select_pmf(s, guide, prev_cell, static_cast<uint32_t>(info.light)) *
                               area_light_pdf(l.area, glm::length(h.p - prev_p), cos_l);
             L += beta * Le_hit * power_heuristic(prev_scatter_pdf, light_pdf);
+            if constexpr (kGuide) note_mis_emission(luminance(Le_hit), light_pdf);
           }
         }
       }
@@ -355,6 +369,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
 
     // Next-event estimation at non-specular vertices (pbrt-v4's SampleLd).
     Float direct_estimate = 0.f;  // its unweighted estimate of light reflected here (guide targets)
+    GuideMixSample nee_mix;  // the NEE sample's share of the mixture statistics (guided vertices)
     const bool nee_vertex = settings.nee && lobes_have_non_specular(lobes) && s.num_lights > 0;
     if (nee_vertex) {
       Float u_select = rng.uniform();
@@ -399,8 +414,16 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             Float w = 1.f;
             if (!ls.delta) {
               Float scatter_pdf = eval_pdf<Spec>(bsdf, wo_l, wi_l);
-              if (light_dir_entry)
-                scatter_pdf = guide_p * g.entry_pdf(*light_dir_entry) + (1.f - guide_p) * scatter_pdf;
+              if (light_dir_entry) {
+                const Float guide_pdf_l = g.entry_pdf(*light_dir_entry);
+                if (learn) {
+                  nee_mix.nee_value = luminance(f * tr * ls.L);
+                  nee_mix.nee_light_pdf = light_pdf;
+                  nee_mix.nee_guide_pdf = guide_pdf_l;
+                  nee_mix.nee_bsdf_pdf = scatter_pdf;
+                }
+                scatter_pdf = guide_p * guide_pdf_l + (1.f - guide_p) * scatter_pdf;
+              }
               w = power_heuristic(light_pdf, scatter_pdf);
             }
             L += beta * f * tr * ls.L * (w / light_pdf);
@@ -478,7 +501,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       pend_at_delta = false;
       // Only vertices that sample with the cell's own weight (not faded by a
       // glossy lobe) inform it.
-      pend_mix = GuideMixSample{};
+      pend_mix = nee_mix;
       if (g.learn_mix && guided_vertex && guide_p == g.cell_guide_prob(cell)) {
         pend_mix.fcos = luminance(bs.f) * abs_cos_theta(bs.wi);
         pend_mix.bsdf_pdf = bsdf_pdf;

@@ -380,15 +380,16 @@ TEST(GuideField, MixtureWeightIsTheCandidateWithTheSmallestSecondMoment) {
   cfg.guide_prob = 0.5f;
   GuideField f = make_field(cfg);
   GuideView g = f.view();
-  const Float moments[kGuideMixEntries] = {5.f, 4.f, 3.f, 1.f, 2.f};
+  const Float moments[kGuideMixEntries] = {6.f, 5.f, 4.f, 3.f, 1.f, 2.f};
   for (int i = 0; i < 128; ++i)
     for (uint32_t k = 0; k < kGuideMixEntries; ++k) guide_record(g, 0, g.mix_entry + k, moments[k]);
   for (int i = 0; i < 127; ++i)
     for (uint32_t k = 0; k < kGuideMixEntries; ++k) guide_record(g, 1, g.mix_entry + k, moments[k]);
   f.fold();
   g = f.view();
-  EXPECT_FLOAT_EQ(g.cell_mix[0], guide_mix_candidate(3));
-  EXPECT_FLOAT_EQ(guide_mix_candidate(3), 0.65f);
+  EXPECT_FLOAT_EQ(g.cell_mix[0], guide_mix_candidate(4));
+  EXPECT_FLOAT_EQ(guide_mix_candidate(4), 0.65f);
+  EXPECT_FLOAT_EQ(guide_mix_candidate(0), 0.05f) << "a cell can all but switch its guide off";
   EXPECT_EQ(g.cell_mix[1], 0.5f);  // too few vertices yet
   EXPECT_EQ(f.stats().mix_learned_cells, 0u) << "no cell has learned light, so none guides";
   f.set_guide_prob(0.3f);
@@ -421,6 +422,39 @@ TEST(GuideField, MixtureStatisticsAreImportanceWeightedSecondMoments) {
     EXPECT_NEAR(v[k], x * x / (pk * 1.25), 1e-5 * x * x) << "candidate " << k;
   }
   EXPECT_EQ(f.stats().mix_out_of_range, 1u);
+}
+
+// With MIS-weighted emission along the direction and a next-event sample at
+// the vertex, each candidate weighs both by the power heuristic against its
+// own mixture density: L_k = T + Le w(p_k, p_l) for the direction, plus
+// (f cos tr Le w(p_l, p_k(w_l)) / (p_l s))^2 for the shadow ray.
+TEST(GuideField, MixtureStatisticsWeighMisEmissionAndNextEventByEachCandidate) {
+  GuideField f = make_field();
+  teach_peaked(f, 0);
+  GuideView g = f.view();
+  const double scale = g.irradiance[0] * kInvPi;
+  GuideMixSample m;
+  m.fcos = 0.3f;
+  m.guide_pdf = 0.05f;  // the guide looks elsewhere ...
+  m.bsdf_pdf = 0.3f;    // ... the BSDF towards the emitter
+  m.mix_pdf = 0.5f * 0.05f + 0.5f * 0.3f;
+  m.emitted = 4.f;
+  m.light_pdf = 0.2f;
+  m.nee_value = 0.25f;
+  m.nee_light_pdf = 0.4f;
+  m.nee_guide_pdf = 0.05f;
+  m.nee_bsdf_pdf = 0.3f;
+  guide_record_mix(g, 0, m, 0.1f);
+  f.fold();
+  const Float* v = f.cell_values(0) + g.mix_entry;
+  auto power = [](double a, double b) { return a * a / (a * a + b * b); };
+  for (uint32_t k = 0; k < kGuideMixEntries; ++k) {
+    const double a = guide_mix_candidate(k), pk = a * 0.05 + (1.0 - a) * 0.3;
+    const double dir = 0.3 * (0.1 + 4.0 * power(pk, 0.2)) / scale;
+    const double nee = 0.25 * power(0.4, pk) / (0.4 * scale);
+    const double expected = dir * dir / (pk * m.mix_pdf) + nee * nee;
+    EXPECT_NEAR(v[k], expected, 1e-5 * expected) << "candidate " << k;
+  }
 }
 
 TEST(GuideSerialisation, RoundTripIsExact) {

@@ -133,7 +133,8 @@ TEST(GuideTrial, SwitchesGuidingOffWhereItCannotPayAndStaysUnbiased) {
 }
 
 TEST(GuideTrial, KeepsGuidingWhereItPaysAndTheImageMatchesUnguided) {
-  GuidedScene s(testing::shipped("door-ajar", 40, 30, 104, 8));
+  // 64x48: at 40x30 the 32 training spp leave the guide too young to win on every seed.
+  GuidedScene s(testing::shipped("door-ajar", 64, 48, 104, 8));
   GuideField guide = s.make_guide();
   RenderResult g = s.run(&guide, trial_options(104));
   EXPECT_EQ(g.stats.guide_trial.state, GuideTrialState::Kept);
