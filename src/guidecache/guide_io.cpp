@@ -46,7 +46,7 @@ void GuideField::serialize(Archive& ar) {
 
 namespace {
 constexpr char kMagic[] = "tessera-guide-cache";
-constexpr uint32_t kVersion = 3;  // 2: next-event statistics per cell; 3: mixture statistics
+constexpr uint32_t kVersion = 4;  // 2: next-event statistics per cell; 3: mixture statistics; 4: six mixture candidates
 }  // namespace
 
 void GuideField::save(std::ostream& out, uint64_t scene_fingerprint) const {

@@ -11,8 +11,8 @@ namespace {
 
 constexpr char kMagic[] = "tessera-checkpoint";
 // 2: per-pass error estimates; 3: next-event skip counter, guide cache v2; 4: medium
-// vertex counter, --guide auto's trial
-constexpr uint32_t kVersion = 4;
+// vertex counter, --guide auto's trial; 5: guide cache v4
+constexpr uint32_t kVersion = 5;
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.
 uint64_t fnv1a(const std::string& s) {
