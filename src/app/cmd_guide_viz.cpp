@@ -15,6 +15,7 @@
 #include "kernels/guide_diagnostic.h"
 #include "master/image_output.h"
 #include "master/renderer.h"
+#include "scene/sampler_setup.h"
 
 namespace tessera {
 namespace {
@@ -100,7 +101,7 @@ int run_guide_viz(VizArgs a) {
     opt.spp = static_cast<uint32_t>(a.train_spp);
     opt.max_depth = scene.desc().max_depth;
     opt.seed = static_cast<uint64_t>(a.seed);
-    opt.sampler = scene.desc().sampler;
+    opt.sampler = sampler_setup(scene.desc());
     opt.progress = false;
     apply_guide_render_options(a.guide, &opt);
     render(scene, embree, opt, field.get());

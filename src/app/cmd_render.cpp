@@ -18,6 +18,7 @@
 #include "master/renderer.h"
 #include "master/snapshots.h"
 #include "master/stats_json.h"
+#include "scene/sampler_setup.h"
 #include "scene/scene_effects.h"
 #include "scene/spectral_choice.h"
 #include "worker/cpu_affinity.h"
@@ -61,8 +62,7 @@ SceneDesc load_desc(const RenderArgs& a) {
   if (a.max_depth >= 0) desc.max_depth = static_cast<int32_t>(a.max_depth);
   if (a.spp >= 0) desc.spp = static_cast<int32_t>(a.spp);
   if (a.seed >= 0) desc.seed = static_cast<uint64_t>(a.seed);
-  if (a.sampler == "independent") desc.sampler = SamplerKind::Independent;
-  else if (a.sampler == "sobol") desc.sampler = SamplerKind::Sobol;
+  if (!a.sampler.empty()) desc.sampler = sampler_kind_named(a.sampler);
   desc.spectral = a.spectral == "on" || (a.spectral == "auto" && !spectral_reason(desc).empty());
   return desc;
 }
@@ -77,7 +77,7 @@ RenderOptions make_options(const RenderArgs& a, const SceneDesc& desc) {
   opt.target_error = a.target_error;
   opt.max_depth = desc.max_depth;
   opt.seed = desc.seed;
-  opt.sampler = desc.sampler;
+  opt.sampler = sampler_setup(desc);
   opt.threads = static_cast<int32_t>(a.threads);
   opt.tile_size = static_cast<int32_t>(a.tile);
   opt.progress = !a.quiet;
@@ -209,7 +209,7 @@ void write_atomically(const std::string& path, Write write) {
 ExrMetadata base_metadata(const MasterSetup& m, uint32_t spec) {
   ExrMetadata meta;
   meta.strings["seed"] = std::to_string(m.opt.seed);
-  meta.strings["sampler"] = m.opt.sampler == SamplerKind::Sobol ? "sobol" : "independent";
+  meta.strings["sampler"] = sampler_name(m.opt.sampler.kind);
   meta.strings["effects"] = describe_effects(m.scene->effects());
   meta.strings["transport"] = m.scene->desc().spectral ? "spectral" : "rgb";
   meta.strings["specialisation"] = describe_specialisation(spec);
@@ -410,8 +410,8 @@ CommandRunner add_render_command(CLI::App& app) {
   c->add_option("--max-depth", a->max_depth, "Maximum path depth, counted as pbrt-v4 does (overrides the Integrator)")->check(CLI::Range(0, 1 << 20));
   c->add_option("--seed", a->seed, "Random seed (same seed -> bit-identical image)")->check(CLI::NonNegativeNumber);
   c->add_option("--sampler", a->sampler,
-                "independent | sobol (Owen-scrambled Sobol points); default: the scene's Sampler (pbrt's default zsobol -> sobol)")
-      ->check(CLI::IsMember({"independent", "sobol"}));
+                "zsobol | paddedsobol | sobol | stratified | independent (pbrt-v4's samplers; sobol is drawn as paddedsobol); default: the scene's Sampler")
+      ->check(CLI::IsMember({"zsobol", "paddedsobol", "sobol", "stratified", "independent"}));
   c->add_option("--spectral", a->spectral,
                 "on: paths carry sampled wavelengths and colours become pbrt-v4's spectra; off: paths carry RGB; "
                 "auto (default): spectral where it changes the picture (measured spectra, strongly coloured lights)")

@@ -13,12 +13,12 @@ struct NoGeometryTracer {
 };
 
 template <uint32_t Spec>
-__global__ void trace_pixels_kernel(SceneView scene, PathSettings settings, SamplerKind sampler, uint64_t seed, Rgb* out) {
+__global__ void trace_pixels_kernel(SceneView scene, PathSettings settings, SamplerSetup sampler, Rgb* out) {
   const int32_t x = blockIdx.x * blockDim.x + threadIdx.x;
   const int32_t y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= scene.camera.width || y >= scene.camera.height) return;
   const uint64_t pixel = static_cast<uint64_t>(y) * scene.camera.width + x;
-  PixelSampler rng = PixelSampler::start(sampler, seed, pixel, 0);
+  PixelSampler rng = PixelSampler::start(sampler, static_cast<uint32_t>(x), static_cast<uint32_t>(y), pixel, 0);
   const CameraSample cs = sample_camera_ray(scene, x, y, rng);
   PathCounters counters;
   out[pixel] = film_pixel_value(scene.camera, trace_path<Spec>(scene, NoGeometryTracer{}, cs.ray, rng, settings, counters)) *
@@ -26,7 +26,7 @@ __global__ void trace_pixels_kernel(SceneView scene, PathSettings settings, Samp
 }
 
 // Instantiate the lean and the full specialisation.
-template __global__ void trace_pixels_kernel<0u>(SceneView, PathSettings, SamplerKind, uint64_t, Rgb*);
-template __global__ void trace_pixels_kernel<kSpecAll>(SceneView, PathSettings, SamplerKind, uint64_t, Rgb*);
+template __global__ void trace_pixels_kernel<0u>(SceneView, PathSettings, SamplerSetup, Rgb*);
+template __global__ void trace_pixels_kernel<kSpecAll>(SceneView, PathSettings, SamplerSetup, Rgb*);
 
 }  // namespace tessera

@@ -2,98 +2,189 @@
 // function of (seed, pixel, sample index, dimension), so that any thread or
 // rank renders the same image.
 //
-// Two kinds, chosen by pbrt-v4's Sampler directive:
+// The kinds follow pbrt-v4's Sampler directive:
 // * Independent: PCG32 (pbrt-v4's IndependentSampler).
-// * Sobol: every 1D and 2D request is the next point of the first two Sobol
-//   dimensions (a (0,2)-sequence) with Burley's (2020) hash-based Owen
-//   scrambling, and the sample index itself Owen-shuffled, both with seeds
-//   hashed from (seed, pixel, dimension) - pbrt-v4's padded Sobol with
-//   FastOwen randomisation. Every power-of-two prefix of a pixel's samples is
-//   stratified in each 1D and 2D request, for any sample count, so passes of
-//   any length keep the stratification of the whole.
+// * Sobol ("paddedsobol"; also pbrt's global "sobol", whose pixel ordering we
+//   do not reproduce): every 1D and 2D request is the next point of the first
+//   two Sobol dimensions with Owen scrambling, and the sample index itself
+//   Owen-shuffled, seeds hashed from (seed, pixel, dimension). Every
+//   power-of-two prefix of a pixel's samples is stratified in each request.
+// * ZSobol (pbrt-v4's default): the same points, but all pixels share one
+//   Sobol sequence in Morton order with randomly permuted digits
+//   (zsobol_index.h): the pixel's own samples are as well stratified, and
+//   neighbouring pixels' errors are spread like blue noise.
+// * Stratified: sx x sy jittered strata in every 2D request and sx * sy in
+//   every 1D one, the strata of each dimension visited in a random order
+//   (pbrt-v4's StratifiedSampler); past sx * sy samples the next round uses
+//   fresh orders.
 #pragma once
 
 #include "rng.h"
+#include "sobol_points.h"
+#include "zsobol_index.h"
 
 namespace tessera {
 
-enum class SamplerKind : uint32_t { Independent = 0, Sobol = 1 };
+enum class SamplerKind : uint32_t { Independent = 0, Sobol = 1, ZSobol = 2, Stratified = 3 };
 
-namespace sobol_detail {
+// What a render's sampler needs beside the pixel and sample: one per render.
+struct SamplerSetup {
+  SamplerKind kind = SamplerKind::ZSobol;
+  uint64_t seed = 0;
+  uint32_t log2_spp = 4;   // ZSobol: samples per epoch = 2^log2_spp (the scene's pixelsamples, rounded up)
+  uint32_t strata_x = 4;   // Stratified: strata per pixel along x and y
+  uint32_t strata_y = 4;
+  bool jitter = true;      // Stratified: a random point in each stratum (else its centre)
+};
 
-TESSERA_HOST_DEVICE inline uint32_t reverse_bits(uint32_t v) {
-  v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
-  v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
-  v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
-  v = ((v >> 8) & 0x00ff00ffu) | ((v & 0x00ff00ffu) << 8);
-  return (v >> 16) | (v << 16);
+// The smallest L with 2^L >= spp (at most 30).
+TESSERA_HOST_DEVICE inline uint32_t ceil_log2_spp(uint64_t spp) {
+  uint32_t l = 0;
+  while (l < 30u && (1ull << l) < spp) ++l;
+  return l;
 }
 
-// Laine-Karras style permutation of the bits above each bit (Burley 2020).
-TESSERA_HOST_DEVICE inline uint32_t laine_karras(uint32_t x, uint32_t seed) {
-  x ^= x * 0x3d20adeau;
-  x += seed;
-  x *= (seed >> 16) | 1u;
-  x ^= x * 0x05526c56u;
-  x ^= x * 0x53a22864u;
-  return x;
+// Element i of a random permutation of [0, n), chosen by `key`: a bijective
+// hash on the smallest power-of-two domain holding n (xor, odd multiplies and
+// xor-shifts modulo 2^w are each invertible), walked until it lands in range.
+TESSERA_HOST_DEVICE inline uint32_t permutation_element(uint32_t i, uint32_t n, uint64_t key) {
+  if (n <= 1u) return 0u;
+  uint32_t mask = n - 1u;
+  mask |= mask >> 1;
+  mask |= mask >> 2;
+  mask |= mask >> 4;
+  mask |= mask >> 8;
+  mask |= mask >> 16;
+  const uint32_t k0 = static_cast<uint32_t>(key), k1 = static_cast<uint32_t>(key >> 32);
+  do {
+    i ^= k0;
+    i *= 0xe170893du;
+    i ^= k1;
+    i ^= (i & mask) >> 4;
+    i ^= k0 >> 16;
+    i *= 0x0929eb3fu;
+    i ^= k1 >> 16;
+    i ^= (i & mask) >> 1;
+    i *= 1u | (k0 >> 27);
+    i *= 0x6935fa69u;
+    i ^= (i & mask) >> 11;
+    i *= 0x74dcb303u;
+    i ^= (i & mask) >> 2;
+    i *= 0x9e501cc3u;
+    i ^= (i & mask) >> 2;
+    i *= 0xc860a3dfu;
+    i &= mask;
+    i ^= i >> 5;
+  } while (i >= n);
+  return i;
 }
-
-// Owen scrambling of a value whose bits are read from the most significant.
-TESSERA_HOST_DEVICE inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t seed) {
-  return reverse_bits(laine_karras(reverse_bits(x), seed));
-}
-
-// The second Sobol dimension: the generator matrix of the primitive
-// polynomial x + 1 (direction numbers m_k = m_{k-1} xor 2 m_{k-1}, m_1 = 1).
-TESSERA_HOST_DEVICE inline uint32_t sobol_dim1(uint32_t index) {
-  uint32_t v = 0, direction = 0x80000000u;
-  for (; index != 0; index >>= 1, direction ^= direction >> 1)
-    if (index & 1u) v ^= direction;
-  return v;
-}
-
-TESSERA_HOST_DEVICE inline Float to_unit(uint32_t v) {
-  return glm::min(static_cast<Float>(v >> 8) * 0x1p-24f, 0x1.fffffep-1f);
-}
-
-}  // namespace sobol_detail
 
 struct PixelSampler {
   SamplerKind kind = SamplerKind::Independent;
-  Rng rng;               // Independent
-  uint64_t stream = 0;   // Sobol: hash of (seed, pixel)
-  uint32_t index = 0;    // Sobol: sample index within the pixel
+  Rng rng;                 // Independent
+  uint64_t stream = 0;     // Sobol, Stratified: hash of (seed, pixel); ZSobol: hash of the seed
+  uint64_t morton = 0;     // ZSobol: the pixel's Morton code
+  uint32_t index = 0;      // sample index within the pixel (ZSobol, Stratified: within its epoch)
+  uint32_t epoch = 0;      // ZSobol, Stratified: which round of 2^L (sx * sy) samples
   uint32_t dimension = 0;
+  uint32_t log2_spp = 0;
+  uint32_t strata_x = 1, strata_y = 1;
+  bool jitter = true;
 
-  TESSERA_HOST_DEVICE static PixelSampler start(SamplerKind kind, uint64_t seed, uint64_t pixel, uint64_t sample) {
+  TESSERA_HOST_DEVICE static PixelSampler start(const SamplerSetup& setup, uint32_t x, uint32_t y, uint64_t pixel,
+                                                uint64_t sample) {
     PixelSampler s;
-    s.kind = kind;
-    if (kind == SamplerKind::Independent) {
-      s.rng = Rng::for_sample(seed, pixel, sample);
-    } else {
-      s.stream = hash_stream(seed, pixel, 0x50b01ull);
-      s.index = static_cast<uint32_t>(sample);
+    s.kind = setup.kind;
+    switch (setup.kind) {
+      case SamplerKind::Independent:
+        s.rng = Rng::for_sample(setup.seed, pixel, sample);
+        break;
+      case SamplerKind::Sobol:
+        s.stream = hash_stream(setup.seed, pixel, 0x50b01ull);
+        s.index = static_cast<uint32_t>(sample);
+        break;
+      case SamplerKind::ZSobol:
+        s.stream = mix_bits(setup.seed ^ 0x7a50b01ull);
+        s.morton = zsobol_detail::morton2(x, y);
+        s.log2_spp = setup.log2_spp;
+        s.index = static_cast<uint32_t>(sample & ((1ull << setup.log2_spp) - 1ull));
+        s.epoch = static_cast<uint32_t>(sample >> setup.log2_spp);
+        break;
+      case SamplerKind::Stratified: {
+        const uint64_t n = static_cast<uint64_t>(setup.strata_x) * setup.strata_y;
+        s.stream = hash_stream(setup.seed, pixel, 0x57a7ull);
+        s.strata_x = setup.strata_x;
+        s.strata_y = setup.strata_y;
+        s.jitter = setup.jitter;
+        s.index = static_cast<uint32_t>(sample % n);
+        s.epoch = static_cast<uint32_t>(sample / n);
+        break;
+      }
     }
     return s;
   }
 
   TESSERA_HOST_DEVICE Float uniform() {
-    if (kind == SamplerKind::Independent) return rng.uniform();
     using namespace sobol_detail;
-    const uint64_t h = mix_bits(stream ^ (static_cast<uint64_t>(dimension++) * 0x9e3779b97f4a7c15ull));
-    const uint32_t i = nested_uniform_scramble(index, static_cast<uint32_t>(h));
-    return to_unit(nested_uniform_scramble(reverse_bits(i), static_cast<uint32_t>(h >> 32)));
+    switch (kind) {
+      case SamplerKind::Independent:
+        return rng.uniform();
+      case SamplerKind::Sobol: {
+        const uint64_t h = dimension_hash();
+        return scrambled_dim0(nested_uniform_scramble(index, static_cast<uint32_t>(h)), static_cast<uint32_t>(h >> 32));
+      }
+      case SamplerKind::ZSobol: {
+        const uint64_t key = dimension_hash();
+        const uint64_t i = zsobol_detail::permuted_index(morton, index, log2_spp, key);
+        return scrambled_dim0(static_cast<uint32_t>(i), static_cast<uint32_t>(mix_bits(key ^ (i >> 32))));
+      }
+      case SamplerKind::Stratified: {
+        const uint64_t key = dimension_hash();
+        const uint32_t n = strata_x * strata_y;
+        const uint32_t stratum = permutation_element(index, n, key);
+        return glm::min((static_cast<Float>(stratum) + jitter_value(key, 0)) / static_cast<Float>(n), 0x1.fffffep-1f);
+      }
+    }
+    return 0.f;
   }
 
   TESSERA_HOST_DEVICE Vec2 uniform2() {
-    if (kind == SamplerKind::Independent) return rng.uniform2();
     using namespace sobol_detail;
-    const uint64_t h = mix_bits(stream ^ (static_cast<uint64_t>(dimension++) * 0x9e3779b97f4a7c15ull));
-    const uint64_t h2 = mix_bits(h);
-    const uint32_t i = nested_uniform_scramble(index, static_cast<uint32_t>(h));
-    return Vec2(to_unit(nested_uniform_scramble(reverse_bits(i), static_cast<uint32_t>(h >> 32))),
-                to_unit(nested_uniform_scramble(sobol_dim1(i), static_cast<uint32_t>(h2))));
+    switch (kind) {
+      case SamplerKind::Independent:
+        return rng.uniform2();
+      case SamplerKind::Sobol: {
+        const uint64_t h = dimension_hash();
+        const uint64_t h2 = mix_bits(h);
+        return scrambled_dims01(nested_uniform_scramble(index, static_cast<uint32_t>(h)), (h >> 32) | (h2 << 32));
+      }
+      case SamplerKind::ZSobol: {
+        const uint64_t key = dimension_hash();
+        const uint64_t i = zsobol_detail::permuted_index(morton, index, log2_spp, key);
+        return scrambled_dims01(static_cast<uint32_t>(i), mix_bits(key ^ (i >> 32)));
+      }
+      case SamplerKind::Stratified: {
+        const uint64_t key = dimension_hash();
+        const uint32_t stratum = permutation_element(index, strata_x * strata_y, key);
+        const Float sx = static_cast<Float>(stratum % strata_x), sy = static_cast<Float>(stratum / strata_x);
+        return Vec2(glm::min((sx + jitter_value(key, 0)) / static_cast<Float>(strata_x), 0x1.fffffep-1f),
+                    glm::min((sy + jitter_value(key, 1)) / static_cast<Float>(strata_y), 0x1.fffffep-1f));
+      }
+    }
+    return Vec2(0.f);
+  }
+
+ private:
+  // The hash of this request's dimension (and epoch), then advances it.
+  TESSERA_HOST_DEVICE uint64_t dimension_hash() {
+    const uint64_t d = static_cast<uint64_t>(dimension++) | (static_cast<uint64_t>(epoch) << 32);
+    return mix_bits(stream ^ (d * 0x9e3779b97f4a7c15ull));
+  }
+  // Stratified: the jitter of coordinate c within the sample's stratum.
+  TESSERA_HOST_DEVICE Float jitter_value(uint64_t key, uint32_t c) const {
+    if (!jitter) return 0.5f;
+    const uint64_t h = mix_bits(key ^ mix_bits((static_cast<uint64_t>(index) << 1 | c) + 0x632be59bd9b4e019ull));
+    return static_cast<Float>(static_cast<uint32_t>(h >> 40)) * 0x1p-24f;
   }
 };
 

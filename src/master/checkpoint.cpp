@@ -47,7 +47,10 @@ uint64_t render_options_fingerprint(const RenderOptions& o, int32_t width, int32
   if (o.guide_roulette_window != kGuidedRouletteWindow) s << " window " << o.guide_roulette_window;
   // Checkpoints from before the taper learned every K-th sample throughout.
   if (o.guide_learn.taper) s << " taper";
-  if (o.sampler == SamplerKind::Sobol) s << " sobol";
+  if (o.sampler.kind == SamplerKind::Sobol) s << " sobol";
+  if (o.sampler.kind == SamplerKind::ZSobol) s << " zsobol " << o.sampler.log2_spp;
+  if (o.sampler.kind == SamplerKind::Stratified)
+    s << " stratified " << o.sampler.strata_x << 'x' << o.sampler.strata_y << ' ' << o.sampler.jitter;
   return fnv1a(s.str());
 }
 

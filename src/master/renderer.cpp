@@ -27,6 +27,7 @@ TileSettings make_tile_settings(const RenderOptions& opt, uint32_t specialisatio
   TileSettings ts;
   ts.seed = opt.seed;
   ts.sampler = opt.sampler;
+  ts.sampler.seed = opt.seed;
   ts.path.max_depth = opt.max_depth;
   ts.path.nee = opt.nee;
   ts.specialisation = specialisation;

@@ -25,7 +25,7 @@ struct RenderOptions {
   int32_t max_depth = 5;
   bool nee = true;
   uint64_t seed = 0;
-  SamplerKind sampler = SamplerKind::Sobol;  // pbrt-v4's default (zsobol) is low-discrepancy too
+  SamplerSetup sampler;         // kind and parameters (its seed is `seed`)
   int32_t threads = 0;          // 0 = all cores
   int32_t tile_size = 16;
   uint32_t max_pass_spp = 8;

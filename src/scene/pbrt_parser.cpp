@@ -15,6 +15,7 @@
 #include "scene/pbrt_paths.h"
 #include "scene/pbrt_shapes.h"
 #include "scene/pbrt_textures.h"
+#include "scene/sampler_setup.h"
 #include "scene/named_spectra.h"
 #include "scene/spectrum_file.h"
 
@@ -269,16 +270,26 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     scene_.spp = ps.get_int("pixelsamples", 16);
     if (scene_.spp <= 0) fail(at, "pixelsamples must be positive");
     scene_.seed = static_cast<uint64_t>(ps.get_int("seed", static_cast<int>(scene_.seed)));
-    if (type == "independent") {
-      scene_.sampler = SamplerKind::Independent;
+    if (type == "independent" || type == "zsobol" || type == "paddedsobol" || type == "sobol" || type == "stratified") {
+      scene_.sampler = sampler_kind_named(type);
+      if (type == "sobol")
+        warn("sampler \"sobol\": drawn as \"paddedsobol\" (Owen-scrambled Sobol points per pixel); the same image "
+             "in expectation, not pbrt-v4's global Sobol ordering of the pixels");
     } else {
-      scene_.sampler = SamplerKind::Sobol;
-      if (type != "zsobol" && type != "sobol" && type != "paddedsobol" && type != "halton" && type != "pmj02bn" &&
-          type != "stratified")
-        warn("sampler \"" + type + "\" is unknown; using Owen-scrambled Sobol points");
-      else if (type != "paddedsobol")
-        warn("sampler \"" + type + "\": drawn as Owen-scrambled (padded) Sobol points; the same image in expectation, "
-             "but not pbrt-v4's own point set or pixel ordering");
+      scene_.sampler = SamplerKind::ZSobol;
+      if (type == "halton" || type == "pmj02bn")
+        warn("sampler \"" + type + "\": drawn as \"zsobol\"; the same image in expectation, not pbrt-v4's own point set");
+      else
+        warn("sampler \"" + type + "\" is unknown; using \"zsobol\"");
+    }
+    if (type == "stratified") {
+      // pbrt-v4: xsamples x ysamples jittered strata; pixelsamples is not read.
+      scene_.strata_x = ps.get_int("xsamples", 4);
+      scene_.strata_y = ps.get_int("ysamples", 4);
+      if (scene_.strata_x <= 0 || scene_.strata_y <= 0 || scene_.strata_x > 65536 || scene_.strata_y > 65536)
+        fail(at, "xsamples and ysamples must be in 1..65536");
+      scene_.spp = scene_.strata_x * scene_.strata_y;
+      scene_.sampler_jitter = ps.get_bool("jitter", true);
     }
     ps.find_any("jitter");
     ps.find_any("randomization");

@@ -111,10 +111,12 @@ struct SceneDesc {
   int32_t spp = 16;        // pbrt-v4 default pixelsamples
   int32_t max_depth = 5;   // pbrt-v4 default maxdepth
   uint64_t seed = 0;       // Sampler "integer seed"
-  // Sampler type: pbrt-v4's low-discrepancy samplers (zsobol, the default,
-  // sobol, paddedsobol, halton, pmj02bn, stratified) draw Owen-scrambled
-  // Sobol points here; "independent" draws independent numbers.
-  SamplerKind sampler = SamplerKind::Sobol;
+  // Sampler type (kernels/sampler.h): zsobol (pbrt-v4's default), paddedsobol
+  // (also drawn for pbrt's global "sobol"), stratified, independent; halton
+  // and pmj02bn are drawn as zsobol (a warning says so).
+  SamplerKind sampler = SamplerKind::ZSobol;
+  int32_t strata_x = 4, strata_y = 4;  // stratified: "xsamples", "ysamples" (spp = their product)
+  bool sampler_jitter = true;          // stratified: "jitter"
   // Spectral transport (kernels/spectral.h): paths carry three sampled
   // wavelengths, as pbrt-v4's carry four; false: paths carry RGB.
   bool spectral = false;

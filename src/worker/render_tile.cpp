@@ -16,7 +16,7 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
       const uint64_t pixel_index = static_cast<uint64_t>(y) * static_cast<uint64_t>(s.camera.width) + x;
       PixelAccum& acc = pixels.at(job, x, y);
       for (uint32_t si = job.sample_begin; si < job.sample_end; ++si) {
-        PixelSampler rng = PixelSampler::start(settings.sampler, settings.seed, pixel_index, si);
+        PixelSampler rng = PixelSampler::start(settings.sampler, static_cast<uint32_t>(x), static_cast<uint32_t>(y), pixel_index, si);
         const CameraSample cs = sample_camera_ray(s, x, y, rng);
         path.learn = settings.learn.learns(si);
         // Spectral transport: the path's three wavelengths (spectral.h).

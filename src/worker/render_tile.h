@@ -49,7 +49,7 @@ struct GuideLearnSchedule {
 
 struct TileSettings {
   uint64_t seed = 0;
-  SamplerKind sampler = SamplerKind::Independent;
+  SamplerSetup sampler;  // its seed is `seed`
   PathSettings path;
   GuideLearnSchedule learn;
   uint32_t specialisation = kSpecAll;

@@ -33,17 +33,20 @@ TEST(Determinism, BitIdenticalAcrossThreadCountsAndTiles) {
   EXPECT_EQ(one.stats.counters.path.rays, four.stats.counters.path.rays);
 }
 
-TEST(Determinism, SobolSamplerIsBitIdenticalAcrossThreadCountsAndTiles) {
-  RenderResult one = render_cornell(1, 16, 42, SamplerKind::Sobol);
-  RenderResult four = render_cornell(4, 7, 42, SamplerKind::Sobol);
-  EXPECT_TRUE(testing::films_identical(one.film, four.film));
-  EXPECT_FALSE(testing::films_identical(one.film, render_cornell(1, 16, 42).film));
+TEST(Determinism, EverySamplerIsBitIdenticalAcrossThreadCountsAndTiles) {
+  for (SamplerKind kind : {SamplerKind::Sobol, SamplerKind::ZSobol, SamplerKind::Stratified}) {
+    RenderResult one = render_cornell(1, 16, 42, kind);
+    RenderResult four = render_cornell(4, 7, 42, kind);
+    EXPECT_TRUE(testing::films_identical(one.film, four.film)) << static_cast<int>(kind);
+    EXPECT_FALSE(testing::films_identical(one.film, render_cornell(1, 16, 42).film));
+  }
 }
 
 // At equal samples, stratified points converge faster than independent ones
 // on a soft shadow (direct light from an area light, one bounce): the error
-// against a converged render is at least 1.5x lower.
-TEST(Determinism, SobolPointsBeatIndependentNumbersAtEqualSamples) {
+// against a converged render is at least 1.5x lower for every
+// low-discrepancy sampler.
+TEST(Determinism, LowDiscrepancySamplersBeatIndependentNumbersAtEqualSamples) {
   const std::string scene = R"(
 LookAt 0 4 0  0 0 0  0 0 1
 Camera "perspective" "float fov" [ 40 ]
@@ -73,12 +76,16 @@ Shape "trianglemesh" "point3 P" [ -5 0 -5  5 0 -5  5 0 5  -5 0 5 ] "integer indi
     for (size_t i = 0; i < img.rgb.size(); ++i) s += (img.rgb[i] - truth.rgb[i]) * (img.rgb[i] - truth.rgb[i]);
     return s / img.rgb.size();
   };
-  double independent = 0, sobol = 0;
+  double independent = 0, padded = 0, zsobol = 0, stratified = 0;
   for (uint64_t seed = 1; seed <= 4; ++seed) {
     independent += mse(render_with(SamplerKind::Independent, 16, seed));
-    sobol += mse(render_with(SamplerKind::Sobol, 16, seed));
+    padded += mse(render_with(SamplerKind::Sobol, 16, seed));
+    zsobol += mse(render_with(SamplerKind::ZSobol, 16, seed));
+    stratified += mse(render_with(SamplerKind::Stratified, 16, seed));
   }
-  EXPECT_LT(sobol * 1.5, independent) << "sobol " << sobol << " independent " << independent;
+  EXPECT_LT(padded * 1.5, independent) << "paddedsobol " << padded << " independent " << independent;
+  EXPECT_LT(zsobol * 1.5, independent) << "zsobol " << zsobol << " independent " << independent;
+  EXPECT_LT(stratified * 1.5, independent) << "stratified " << stratified << " independent " << independent;
 }
 
 TEST(Determinism, SeedChangesTheImage) {

@@ -201,7 +201,7 @@ TEST(ErrorEstimate, MatchesMeasuredRelMseOnFurnace) {
     opt.seed = seed;
     // Independent samples: the variance-based estimate is then the expected
     // error; with stratified (Sobol) samples it is an upper bound.
-    opt.sampler = SamplerKind::Independent;
+    opt.sampler.kind = SamplerKind::Independent;
     SceneData scene(std::move(desc));
     EmbreeScene embree(scene);
     RenderResult r = render(scene, embree, opt, nullptr, nullptr, nullptr,

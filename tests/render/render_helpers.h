@@ -7,6 +7,7 @@
 #include "master/film.h"
 #include "master/renderer.h"
 #include "scene/pbrt_loader.h"
+#include "scene/sampler_setup.h"
 #include "worker/embree_backend.h"
 #include "worker/scene_data.h"
 
@@ -16,7 +17,7 @@ inline RenderResult render_desc(SceneDesc desc, RenderOptions opt) {
   opt.progress = false;
   opt.spp = static_cast<uint32_t>(desc.spp);  // the scene (as edited by the test) decides
   opt.max_depth = desc.max_depth;
-  opt.sampler = desc.sampler;
+  opt.sampler = sampler_setup(desc);
   SceneData scene(std::move(desc));
   EmbreeScene embree(scene);
   return render(scene, embree, opt);

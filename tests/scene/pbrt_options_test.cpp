@@ -1,5 +1,6 @@
 // Camera, Film, Sampler, Integrator and PixelFilter, and warnings.
 #include "scene/pbrt_film.h"
+#include "scene/sampler_setup.h"
 #include "scene_test_helpers.h"
 
 namespace tessera {
@@ -40,12 +41,45 @@ TEST(PbrtOptions, FilmSamplerIntegrator) {
   EXPECT_EQ(s.spp, 128);
   EXPECT_EQ(s.seed, 7u);
   EXPECT_EQ(s.max_depth, 3);
-  EXPECT_EQ(s.sampler, SamplerKind::Sobol);
-  ASSERT_EQ(s.warnings.size(), 1u);  // zsobol's blue-noise ordering is not reproduced: said so
-  EXPECT_NE(s.warnings[0].find("sampler \"zsobol\": drawn as Owen-scrambled"), std::string::npos);
+  EXPECT_EQ(s.sampler, SamplerKind::ZSobol);
+  EXPECT_TRUE(s.warnings.empty());
   EXPECT_EQ(load_with_options("Sampler \"independent\"\n").sampler, SamplerKind::Independent);
-  EXPECT_EQ(load_with_options("").sampler, SamplerKind::Sobol);  // pbrt's default, zsobol
-  EXPECT_TRUE(load_with_options("Sampler \"paddedsobol\"\n").warnings.empty());
+  EXPECT_EQ(load_with_options("").sampler, SamplerKind::ZSobol);  // pbrt's default
+  const SceneDesc padded = load_with_options("Sampler \"paddedsobol\"\n");
+  EXPECT_EQ(padded.sampler, SamplerKind::Sobol);
+  EXPECT_TRUE(padded.warnings.empty());
+  // pbrt's global "sobol" ordering is not reproduced, nor halton's and pmj02bn's points: said so.
+  const SceneDesc sobol = load_with_options("Sampler \"sobol\"\n");
+  EXPECT_EQ(sobol.sampler, SamplerKind::Sobol);
+  ASSERT_EQ(sobol.warnings.size(), 1u);
+  EXPECT_NE(sobol.warnings[0].find("drawn as \"paddedsobol\""), std::string::npos) << sobol.warnings[0];
+  for (const char* other : {"halton", "pmj02bn"}) {
+    const SceneDesc d = load_with_options(std::string("Sampler \"") + other + "\"\n");
+    EXPECT_EQ(d.sampler, SamplerKind::ZSobol);
+    ASSERT_EQ(d.warnings.size(), 1u);
+    EXPECT_NE(d.warnings[0].find("drawn as \"zsobol\""), std::string::npos) << d.warnings[0];
+  }
+}
+
+// pbrt-v4's stratified sampler takes xsamples x ysamples (pixelsamples is not
+// read) and "jitter"; --spp splits into the most nearly square strata.
+TEST(PbrtOptions, StratifiedSamplerReadsItsStrata) {
+  const SceneDesc s = load_with_options(
+      "Sampler \"stratified\" \"integer xsamples\" 3 \"integer ysamples\" 5 \"bool jitter\" false "
+      "\"integer pixelsamples\" 64\n");
+  EXPECT_EQ(s.sampler, SamplerKind::Stratified);
+  EXPECT_EQ(s.spp, 15);
+  SamplerSetup setup = sampler_setup(s);
+  EXPECT_EQ(setup.strata_x, 3u);
+  EXPECT_EQ(setup.strata_y, 5u);
+  EXPECT_FALSE(setup.jitter);
+  SceneDesc overridden = s;
+  overridden.spp = 24;
+  setup = sampler_setup(overridden);
+  EXPECT_EQ(setup.strata_x, 6u);
+  EXPECT_EQ(setup.strata_y, 4u);
+  EXPECT_EQ(sampler_setup(load_with_options("Sampler \"zsobol\" \"integer pixelsamples\" 100\n")).log2_spp, 7u);
+  EXPECT_THROW(load_with_options("Sampler \"stratified\" \"integer xsamples\" 0\n"), std::exception);
 }
 
 TEST(PbrtOptions, OtherIntegratorsWarn) {
