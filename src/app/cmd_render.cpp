@@ -15,6 +15,7 @@
 #include "master/checkpoint.h"
 #include "master/farm_master.h"
 #include "master/image_output.h"
+#include "master/interrupt.h"
 #include "master/renderer.h"
 #include "master/snapshots.h"
 #include "master/stats_json.h"
@@ -231,6 +232,8 @@ std::string describe_stop(const RenderStats& s) {
   else if (s.target_error > 0)
     std::snprintf(b, sizeof b, "%s (target relMSE %.3g not reached: too few samples to estimate it)", s.stop_reason.c_str(),
                   s.target_error);
+  else if (s.stop_reason == "interrupted")
+    std::snprintf(b, sizeof b, "an interrupt (SIGINT/SIGTERM): the image so far is written");
   else
     std::snprintf(b, sizeof b, "%s", s.stop_reason.c_str());
   return b;
@@ -390,7 +393,13 @@ int run_render_farm(const RenderArgs& a) {
   }
 }
 
-int run_render(const RenderArgs& a) { return launched_by_mpirun() ? run_render_farm(a) : run_render_local(a); }
+// Ctrl-C or SIGTERM: the render stops after its pass and writes what it has
+// (master/interrupt.h); the exit status then says it was interrupted.
+int run_render(const RenderArgs& a) {
+  install_interrupt_handlers();
+  const int rc = launched_by_mpirun() ? run_render_farm(a) : run_render_local(a);
+  return rc == 0 && interrupt_requested() ? 130 : rc;
+}
 
 }  // namespace
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "master/error_estimate.h"
+#include "master/interrupt.h"
 #include "master/progress.h"
 #include "worker/cpu_affinity.h"
 #include "worker/thread_guide_accumulators.h"
@@ -121,6 +122,10 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
   uint32_t spp_done = stats.spp;
   double last_pass_s = stats.pass_stats.empty() ? 0.0 : stats.pass_stats.back().seconds;
   for (uint32_t pass = stats.passes;; ++pass) {
+    if (interrupt_requested()) {
+      stats.stop_reason = "interrupted";
+      break;
+    }
     if (opt.spp > 0 && spp_done >= opt.spp) {
       stats.stop_reason = "spp";
       break;

@@ -62,7 +62,7 @@ struct RenderStats {
   int32_t threads = 0;              // all ranks together
   int32_t ranks = 1;                // processes that rendered (farm)
   uint32_t resumed_at_spp = 0;      // > 0: continued from a checkpoint at this many spp
-  std::string stop_reason;         // spp | time | target-error
+  std::string stop_reason;         // spp | time | target-error | interrupted (SIGINT/SIGTERM)
   double target_error = 0.0;       // the --target-error asked for (0 = none)
   double estimated_rel_mse = -1.0; // of the final image, from its per-pixel variances (< 0 = too few samples)
   double pass_end_seconds = 0.0;   // of `seconds`, spent in the pass-end hook (checkpoints, snapshots)

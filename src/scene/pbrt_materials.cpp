@@ -177,6 +177,18 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
       if (it == ctx.names.materials.end()) ctx.fail("unknown named material \"" + names[i] + "\" in mix");
       m.mix[i] = it->second;
     }
+    // Mixes of mixes resolve in a bounded loop: deeper nesting is an error
+    // here, not a silent default material at render time. The parser adds
+    // this material next, at index materials.size().
+    int32_t depth = 1;
+    for (int32_t component : m.mix) {
+      auto d = ctx.names.mix_depth.find(component);
+      if (d != ctx.names.mix_depth.end()) depth = std::max(depth, d->second + 1);
+    }
+    if (depth > kMaxMixNesting)
+      ctx.fail("mix material nests " + std::to_string(depth) + " mixes deep; at most " +
+               std::to_string(kMaxMixNesting) + " are supported");
+    ctx.names.mix_depth[static_cast<int32_t>(ctx.scene.materials.size())] = depth;
     m.amount = float_slot(params, "amount", 0.5f, ctx);
   } else if (type == "subsurface") {
     ctx.warn("subsurface is approximated by dielectric (no scattering inside)");

@@ -22,6 +22,23 @@
 namespace tessera {
 namespace {
 
+// Embree traces rays whose origins lie within +-1.844e18 (FLT_LARGE) and
+// asserts beyond; past about 1e18 single-precision hit points are off by
+// more than 1e11 anyway. Coordinates beyond this are an error at load.
+constexpr Float kMaxCoordinate = 1e18f;
+
+bool representable(const Vec3& p) {
+  return std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate && std::abs(p.z) <= kMaxCoordinate;
+}
+
+std::string describe_far(const Vec3& p) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "at (%g, %g, %g): beyond +-%g (or not finite), where single-precision ray tracing cannot go",
+                p.x + 0.f, p.y + 0.f, p.z + 0.f, kMaxCoordinate);  // + 0: no "-0"
+  return buf;
+}
+
+
 constexpr int kMaxIncludeDepth = 32;
 
 [[noreturn]] void fail(const Token& at, const std::string& problem) { throw SceneError(at.where() + ": " + problem); }
@@ -382,6 +399,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
         copy.n_end = std::move(end.n_end);
       }
       copy.where = at.where();
+      check_coordinates(copy, at);
       scene_.meshes.push_back(std::move(copy));
     }
   } else if (d == "ActiveTransform") {
@@ -441,11 +459,19 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
   }
 }
 
+void PbrtParser::check_coordinates(const MeshDesc& mesh, const Token& at) const {
+  for (const std::vector<Vec3>* points : {&mesh.p, &mesh.p_end})
+    for (const Vec3& p : *points)
+      if (!representable(p)) fail(at, "a vertex of the shape is " + describe_far(p));
+}
+
 void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet& params) {
   std::vector<std::string>& warnings = scene_.warnings;
   if (type != "perspective") warnings.push_back(at.where() + ": camera \"" + type + "\" treated as \"perspective\"");
   if (glm::determinant(state_.ctm) == 0.f) fail(at, "camera transform is singular");
   scene_.camera.world_from_camera = glm::inverse(state_.ctm);
+  if (!representable(Vec3(scene_.camera.world_from_camera[3])))
+    fail(at, "the camera is " + describe_far(Vec3(scene_.camera.world_from_camera[3])));
   scene_.camera.world_from_camera_end = scene_.camera.world_from_camera;
   if (state_.ctm_end != state_.ctm) {
     if (glm::determinant(state_.ctm_end) == 0.f) fail(at, "camera end transform is singular");
@@ -530,6 +556,7 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
     }
     instances_[open_instance_].push_back(std::move(*mesh));
   } else {
+    check_coordinates(*mesh, at);
     scene_.meshes.push_back(std::move(*mesh));
   }
 }

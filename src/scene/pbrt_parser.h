@@ -43,6 +43,9 @@ class PbrtParser {
   void directive(const std::vector<Token>& tokens, size_t& pos, const std::string& including_dir);
   void shape(const Token& at, const std::string& type, const ParamSet& params, const std::string& including_dir);
   void camera(const Token& at, const std::string& type, const ParamSet& params);
+  // Fails unless every vertex (and its end position when it moves) is within
+  // the range single-precision ray tracing represents.
+  void check_coordinates(const MeshDesc& mesh, const Token& at) const;
   void push(char kind, const Token& at);
   void pop(char kind, const Token& at);
   void require_world(const Token& at, bool inside) const;

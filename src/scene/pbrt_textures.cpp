@@ -1,5 +1,6 @@
 #include "scene/pbrt_textures.h"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "scene/image_io.h"
@@ -8,9 +9,21 @@
 namespace tessera {
 namespace {
 
-int32_t add_texture(SceneDesc& scene, const Texture& t) {
-  scene.textures.push_back(t);
-  return static_cast<int32_t>(scene.textures.size() - 1);
+// Adds the texture; one that nests deeper than the kernels evaluate is an
+// error here, not a stack overflow at render time.
+int32_t add_texture(const DirectiveContext& ctx, const Texture& t) {
+  std::vector<int32_t>& depth = ctx.names.texture_depth;
+  int32_t d = 1;
+  for (const TextureSlot* slot : {&t.a, &t.b, &t.amount})
+    if (slot->texture >= 0 && static_cast<size_t>(slot->texture) < depth.size())
+      d = std::max(d, depth[static_cast<size_t>(slot->texture)] + 1);
+  if (d > kMaxTextureNesting)
+    ctx.fail("texture nests " + std::to_string(d) + " textures deep; at most " + std::to_string(kMaxTextureNesting) +
+             " are supported");
+  depth.resize(ctx.scene.textures.size(), 1);
+  depth.push_back(d);
+  ctx.scene.textures.push_back(t);
+  return static_cast<int32_t>(ctx.scene.textures.size() - 1);
 }
 
 // "uv" mapping parameters shared by imagemap and checkerboard.
@@ -142,7 +155,7 @@ void make_named_texture(const std::string& name, const std::string& kind, const 
   }
   auto& table = spectrum ? ctx.names.spectrum_textures : ctx.names.float_textures;
   if (table.count(name)) ctx.warn(kind + " texture \"" + name + "\" redefined");
-  table[name] = add_texture(ctx.scene, t);
+  table[name] = add_texture(ctx, t);
 }
 
 }  // namespace tessera

@@ -93,6 +93,23 @@ std::vector<std::string> split_words(const std::string& line) {
   return words;
 }
 
+// A header word for an error message: control bytes (a binary body read as
+// header text) written as \xNN, and at most 32 characters.
+std::string printable(const std::string& word) {
+  std::string out;
+  for (size_t i = 0; i < word.size() && i < 32; ++i) {
+    const unsigned char c = static_cast<unsigned char>(word[i]);
+    if (c < 0x20 || c >= 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return word.size() > 32 ? out + "..." : out;
+}
+
 PlyHeader parse_header(const std::string& bytes, const PlyFailure& fail) {
   PlyHeader h;
   size_t pos = 0, line_number = 0;
@@ -121,34 +138,34 @@ PlyHeader parse_header(const std::string& bytes, const PlyFailure& fail) {
       if (w[1] == "ascii") h.format = PlyFormat::Ascii;
       else if (w[1] == "binary_little_endian") h.format = PlyFormat::BinaryLittleEndian;
       else if (w[1] == "binary_big_endian") h.format = PlyFormat::BinaryBigEndian;
-      else fail(where + "unknown format '" + w[1] + "'");
+      else fail(where + "unknown format '" + printable(w[1]) + "'");
       have_format = true;
     } else if (w[0] == "element") {
       if (w.size() != 3) fail(where + "expected 'element <name> <count>'");
       uint64_t count = 0;
       auto [end, ec] = std::from_chars(w[2].data(), w[2].data() + w[2].size(), count);
       if (ec != std::errc() || end != w[2].data() + w[2].size())
-        fail(where + "element count '" + w[2] + "' is not a non-negative integer");
+        fail(where + "element count '" + printable(w[2]) + "' is not a non-negative integer");
       h.elements.push_back(PlyElement{w[1], count, {}});
     } else if (w[0] == "property") {
       if (h.elements.empty()) fail(where + "property before any element");
       PlyProperty p;
       if (w.size() == 5 && w[1] == "list") {
         std::optional<PlyType> count_type = parse_type(w[2]), value_type = parse_type(w[3]);
-        if (!count_type || !value_type) fail(where + "unknown type in list property '" + w[4] + "'");
+        if (!count_type || !value_type) fail(where + "unknown type in list property '" + printable(w[4]) + "'");
         if (*count_type == PlyType::Float32 || *count_type == PlyType::Float64)
           fail(where + "list property '" + w[4] + "' has a floating-point count type");
         p = PlyProperty{w[4], *value_type, true, *count_type};
       } else if (w.size() == 3 && w[1] != "list") {
         std::optional<PlyType> type = parse_type(w[1]);
-        if (!type) fail(where + "unknown property type '" + w[1] + "'");
+        if (!type) fail(where + "unknown property type '" + printable(w[1]) + "'");
         p = PlyProperty{w[2], *type, false, PlyType::UInt8};
       } else {
         fail(where + "expected 'property <type> <name>' or 'property list <count type> <type> <name>'");
       }
       h.elements.back().properties.push_back(p);
     } else {
-      fail(where + "unknown keyword '" + w[0] + "'");
+      fail(where + "unknown keyword '" + printable(w[0]) + "'");
     }
   }
   if (!have_format) fail("header has no format line");

@@ -201,6 +201,27 @@ TEST_F(CliTest, GuideCacheOptions) {
 
 // The learning schedule reaches the render and its stats; fewer learning
 // samples mean fewer guide updates; bad values are refused.
+// Ctrl-C (SIGINT) during a long render: it stops after the pass under way
+// and writes the image so far, its stats and the checkpoint, and exits 130.
+TEST_F(CliTest, InterruptWritesTheImageSoFar) {
+  const std::string out = (dir_ / "interrupted.exr").string(), stats = (dir_ / "interrupted.json").string();
+  const std::string ckpt = (dir_ / "interrupted.ckpt").string();
+  RunResult r = testing::run_shell(std::string(TESSERA_BINARY) + " render -q --time 120 --res 64x48 --threads 1 -o " +
+                                   out + " --stats " + stats + " --checkpoint " + ckpt +
+                                   " & pid=$!; sleep 3; kill -INT $pid; wait $pid; echo exit=$?");
+  EXPECT_NE(r.output.find("exit=130"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("interrupted"), std::string::npos) << r.output;
+  ASSERT_TRUE(fs::exists(out)) << r.output;
+  EXPECT_TRUE(fs::exists(ckpt));
+  const std::string json = testing::read_text(stats);
+  EXPECT_NE(json.find("\"stop_reason\": \"interrupted\""), std::string::npos) << json;
+  EXPECT_GT(json_number(json, "spp"), 0.0) << json;
+  // The checkpoint resumes it.
+  RunResult resumed = run("render -q --spp " + std::to_string(static_cast<int>(json_number(json, "spp")) + 8) +
+                          " --res 64x48 -o " + out + " --resume " + ckpt);
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.output;
+}
+
 TEST_F(CliTest, GuideLearningScheduleOptions) {
   auto updates = [&](const std::string& args, const std::string& name) {
     return render_stats("--res 16x16 --spp 12 --seed 2 --guide qtable " + args, name);

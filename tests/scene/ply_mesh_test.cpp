@@ -166,6 +166,12 @@ TEST(PlyMesh, HeaderWithoutEndHeaderIsAnError) {
             std::string::npos);
   EXPECT_NE(parse_error("ply\nformat ascii 1.0\nelement vertex -3\nend_header\n").find("not a non-negative integer"),
             std::string::npos);
+  // A binary body read as header lines: its bytes are escaped and cut short in the message.
+  const std::string binary = parse_error(std::string("ply\nformat binary_little_endian 1.0\n\x01\x02\x7f") +
+                                         std::string(100, 'z') + "\n");
+  EXPECT_NE(binary.find("unknown keyword '\\x01\\x02\\x7fzzz"), std::string::npos) << binary;
+  EXPECT_NE(binary.find("...'"), std::string::npos) << binary;
+  for (char c : binary) EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == 0x7f) << binary;
 }
 
 TEST(PlyMesh, IndicesOutsideTheVertexListAreErrors) {

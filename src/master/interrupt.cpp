@@ -1,0 +1,35 @@
+#include "master/interrupt.h"
+
+#include <csignal>
+#include <unistd.h>
+
+namespace tessera {
+namespace {
+
+volatile std::sig_atomic_t g_signals = 0;
+
+extern "C" void on_interrupt(int sig) {
+  if (g_signals > 0) _exit(128 + sig);
+  g_signals = 1;
+  static const char msg[] =
+      "\ntessera: interrupted: finishing this pass and writing the image so far (again to quit at once)\n";
+  const ssize_t ignored = write(STDERR_FILENO, msg, sizeof msg - 1);
+  (void)ignored;
+}
+
+}  // namespace
+
+void install_interrupt_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+bool interrupt_requested() { return g_signals > 0; }
+void request_interrupt() { g_signals = 1; }
+void clear_interrupt() { g_signals = 0; }
+
+}  // namespace tessera
