@@ -14,6 +14,10 @@
 // (binary Owen scrambling of the pair), so that a pixel's first 2^k samples
 // stay a (0,k,2)-net for every k <= L, odd k included (passes are 8 spp).
 //
+// The points are then Owen-scrambled per request, with one scramble for
+// each aligned 8 x 8 block of pixels (sampler.h), so the net property holds
+// within such blocks.
+//
 // Past 2^L samples (a --time render longer than the scene's pixelsamples)
 // a pixel does not run into its neighbour's indices: each further block of
 // 2^L samples (an "epoch") is the same construction under fresh hashes.
