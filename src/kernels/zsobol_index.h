@@ -5,14 +5,14 @@
 // All pixels draw from one Sobol sequence: pixel (x, y)'s samples are the
 // indices (morton(x, y) << L) | s, s < 2^L, so that neighbouring pixels hold
 // neighbouring blocks of the sequence and their errors are spread like blue
-// noise. Every base-4 digit of that index (two bits: one level of the
-// Morton quadtree) is then permuted, by a permutation chosen by a hash of
-// the digits above it and of the dimension: a random relabelling of the
-// quadtree that decorrelates the dimensions and keeps every aligned block of
-// indices aligned. Pixel digits take any of the 24 permutations of
-// {0,1,2,3}; sample digits only the 8 that keep their two bits' nesting
-// (binary Owen scrambling of the pair), so that a pixel's first 2^k samples
-// stay a (0,k,2)-net for every k <= L, odd k included (passes are 8 spp).
+// noise. The index is then Owen-scrambled as a whole, per request: every bit
+// flipped by a hash of the bits above it. That relabels the Morton
+// quadtree's children at every level (pbrt-v4 draws each level's relabelling
+// from all 24 permutations of four children; binary scrambling from the 8
+// that keep the two bits nested) and keeps every aligned block of indices
+// aligned, so a pixel's first 2^k samples stay a (0,k,2)-net for every
+// k <= L, and so do the samples of an aligned block of pixels. One hash per
+// request: per-level hashing cost as much as the rest of a path.
 //
 // The points are then Owen-scrambled per request, with one scramble for
 // each aligned 8 x 8 block of pixels (sampler.h), so the net property holds
@@ -23,13 +23,10 @@
 // 2^L samples (an "epoch") is the same construction under fresh hashes.
 #pragma once
 
-#include "rng.h"
+#include "sobol_points.h"
 
 namespace tessera {
 namespace zsobol_detail {
-
-// Pixel coordinates up to 2^16 per side: 16 base-4 digits of Morton code.
-constexpr uint32_t kPixelLevels = 16;
 
 // Interleaves the bits of x (even positions) and y (odd positions).
 TESSERA_HOST_DEVICE inline uint64_t morton2(uint32_t x, uint32_t y) {
@@ -45,47 +42,29 @@ TESSERA_HOST_DEVICE inline uint64_t morton2(uint32_t x, uint32_t y) {
   return spread(x) | (spread(y) << 1);
 }
 
-// Digit d (0..3) under permutation p (0..23) of {0,1,2,3}, p read as a
-// Lehmer code (factorial number system): its digits pick, in turn, one of
-// the elements not yet used.
-TESSERA_HOST_DEVICE inline uint32_t permute_digit(uint32_t p, uint32_t d) {
-  uint32_t unused = 0x3210u;  // nibbles: the elements not yet placed, in order
-  uint32_t out = 0;
-  const uint32_t radix[4] = {6u, 2u, 1u, 1u};
-  for (uint32_t pos = 0; pos <= d; ++pos) {
-    const uint32_t pick = (p / radix[pos]) % (4u - pos);
-    out = (unused >> (4u * pick)) & 0xfu;
-    // Remove the picked nibble.
-    const uint32_t low = unused & ((1u << (4u * pick)) - 1u);
-    unused = ((unused >> (4u * (pick + 1u))) << (4u * pick)) | low;
-  }
-  return out;
+TESSERA_HOST_DEVICE inline uint64_t reverse_bits64(uint64_t v) {
+  return (static_cast<uint64_t>(sobol_detail::reverse_bits(static_cast<uint32_t>(v))) << 32) |
+         sobol_detail::reverse_bits(static_cast<uint32_t>(v >> 32));
 }
 
-// The permuted index of sample s of the pixel with Morton code m, for one
-// dimension, with L = log2 of the samples per epoch and `key` a hash of
-// (seed, dimension, epoch).
+// Owen scrambling of a 64-bit index: bit k flipped by a hash of the bits
+// above it (Burley's Laine-Karras construction on the reversed bits: each
+// step only lets a bit affect higher ones).
+TESSERA_HOST_DEVICE inline uint64_t nested_scramble64(uint64_t index, uint64_t seed) {
+  uint64_t x = reverse_bits64(index);
+  x ^= x * 0x3d20adea2e0c5b1aull;
+  x += seed;
+  x *= (seed >> 32) | 1ull;
+  x ^= x * 0x05526c56a1e0f2c4ull;
+  x ^= x * 0x53a22864bc9e3d16ull;
+  return reverse_bits64(x);
+}
+
+// The scrambled index of sample s of the pixel with Morton code m, with
+// L = log2 of the samples per epoch and `key` a hash of (seed, request, epoch).
 TESSERA_HOST_DEVICE inline uint64_t permuted_index(uint64_t m, uint32_t s, uint32_t L, uint64_t key) {
   const uint64_t index = (m << L) | (L == 0 ? 0ull : (static_cast<uint64_t>(s) & ((1ull << L) - 1ull)));
-  const uint32_t odd = L & 1u;
-  const uint32_t digits = kPixelLevels + L / 2u;
-  uint64_t out = 0;
-  for (uint32_t i = digits; i-- > 0;) {
-    const uint32_t shift = 2u * i + odd;
-    const uint32_t digit = static_cast<uint32_t>(index >> shift) & 3u;
-    const uint64_t higher = shift + 2u < 64u ? index >> (shift + 2u) : 0ull;
-    const uint64_t r = mix_bits(higher ^ key ^ (static_cast<uint64_t>(i) << 58));
-    uint32_t permuted;
-    if (shift >= L) {
-      permuted = permute_digit(static_cast<uint32_t>((r >> 24) % 24u), digit);
-    } else {
-      const uint32_t hi = digit >> 1, lo = digit & 1u;
-      permuted = ((hi ^ static_cast<uint32_t>(r & 1u)) << 1) | (lo ^ static_cast<uint32_t>((r >> (1u + hi)) & 1u));
-    }
-    out |= static_cast<uint64_t>(permuted) << shift;
-  }
-  if (odd) out |= (index & 1ull) ^ (mix_bits((index >> 1) ^ key) & 1ull);
-  return out;
+  return nested_scramble64(index, key);
 }
 
 }  // namespace zsobol_detail
