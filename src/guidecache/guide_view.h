@@ -177,6 +177,14 @@ TESSERA_HOST_DEVICE inline uint32_t guide_octant_step(const Vec3& p, Vec3* lo, F
   return octant;
 }
 
+// The cell of a grid of n along one axis holding coordinate x (in cells),
+// clamped to the grid. NaN (a degenerate hit) maps to 0: converting it to
+// an integer would be undefined behaviour.
+TESSERA_HOST_DEVICE inline uint32_t guide_grid_index(Float x, uint32_t n) {
+  const Float last = static_cast<Float>(n - 1);
+  return x > 0.f ? static_cast<uint32_t>(glm::min(x, last)) : 0u;
+}
+
 // The leaf cell holding point p on a surface whose normal (on the side the
 // path is on) is n.
 TESSERA_HOST_DEVICE inline int32_t guide_find_cell(const GuideView& g, const Vec3& p, const Vec3& n) {
@@ -189,9 +197,9 @@ TESSERA_HOST_DEVICE inline int32_t guide_find_cell(const GuideView& g, const Vec
     // outside the cube go to the nearest one, as the descent would take them).
     size = g.extent * (1.f / static_cast<Float>(kGuideTopSide));
     const Vec3 rel = (p - g.lo) / size;
-    const uint32_t ix = glm::min(static_cast<uint32_t>(glm::max(rel.x, 0.f)), kGuideTopSide - 1);
-    const uint32_t iy = glm::min(static_cast<uint32_t>(glm::max(rel.y, 0.f)), kGuideTopSide - 1);
-    const uint32_t iz = glm::min(static_cast<uint32_t>(glm::max(rel.z, 0.f)), kGuideTopSide - 1);
+    const uint32_t ix = guide_grid_index(rel.x, kGuideTopSide);
+    const uint32_t iy = guide_grid_index(rel.y, kGuideTopSide);
+    const uint32_t iz = guide_grid_index(rel.z, kGuideTopSide);
     lo = g.lo + Vec3(static_cast<Float>(ix), static_cast<Float>(iy), static_cast<Float>(iz)) * size;
     node = &g.nodes[g.top_nodes[normal_class * kGuideTopCells + (iz * kGuideTopSide + iy) * kGuideTopSide + ix]];
   }
@@ -201,9 +209,8 @@ TESSERA_HOST_DEVICE inline int32_t guide_find_cell(const GuideView& g, const Vec
 
 TESSERA_HOST_DEVICE inline uint32_t guide_bin_of(const GuideView& g, const Vec3& dir) {
   Vec2 uv = equal_area_sphere_to_square(dir);
-  uint32_t ix = glm::min(static_cast<uint32_t>(glm::max(uv.x, 0.f) * g.grid), g.grid - 1);
-  uint32_t iy = glm::min(static_cast<uint32_t>(glm::max(uv.y, 0.f) * g.grid), g.grid - 1);
-  return iy * g.grid + ix;
+  return guide_grid_index(uv.y * static_cast<Float>(g.grid), g.grid) * g.grid +
+         guide_grid_index(uv.x * static_cast<Float>(g.grid), g.grid);
 }
 
 TESSERA_HOST_DEVICE inline Float guide_value(const GuideView& g, int32_t cell, uint32_t entry) {

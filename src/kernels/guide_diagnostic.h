@@ -16,6 +16,7 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g
                                           int32_t max_depth) {
   constexpr uint32_t kSpec = kSpecSurfaceAll & ~kSpecGuiding;
   Rgb beta(1.f);
+  int32_t interface_skips = 0;
   for (int32_t depth = 0;; ++depth) {
     TraceHit hit;
     if (!tracer.intersect(ray.o, ray.d, kInfinity, &hit)) {
@@ -33,7 +34,10 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g
     }
     BsdfParams bsdf;
     if (!resolve_bsdf<kSpec>(s, info.material, h, wo, &bsdf)) {
+      // Through an interface without a bounce (as the integrator), a bounded number of times.
+      if (++interface_skips > 256) return Rgb(0.f);
       ray.o = offset_ray_origin(h, ray.d);
+      --depth;
       continue;
     }
     Vec3 n_side = glm::dot(h.ng, wo) >= 0.f ? h.ng : -h.ng;
@@ -49,7 +53,7 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g
     }
     // Shade with the albedo-like reflectance so materials stay recognisable.
     beta *= bsdf.type == BsdfType::Diffuse || bsdf.type == BsdfType::CoatedDiffuse ? bsdf.reflectance : Rgb(1.f);
-    if (!(best > 0.f) || depth == max_depth) return beta * (kInvPi * g.irradiance[cell]);
+    if (!(best > 0.f) || depth >= max_depth) return beta * (kInvPi * g.irradiance[cell]);
     ray.d = g.bin_dirs[best_bin];
     ray.o = offset_ray_origin(h, ray.d);
   }

@@ -89,6 +89,9 @@ std::vector<Param> parse_param_list(const std::vector<Token>& tokens, size_t& po
         if (v->kind != TokenKind::Number) fail(v->where(), "malformed number '" + v->text + "' for \"" + decl.text + "\"");
         if (p.type == "integer" && v->number != std::floor(v->number))
           fail(v->where(), "non-integer value '" + v->text + "' for \"" + decl.text + "\"");
+        // Integers are read as int: a value beyond its range would convert with undefined behaviour.
+        if (p.type == "integer" && !(std::abs(v->number) <= 2147483647.0))
+          fail(v->where(), "integer '" + v->text + "' for \"" + decl.text + "\" is out of range");
         p.numbers.push_back(v->number);
       }
     }

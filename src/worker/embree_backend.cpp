@@ -41,9 +41,19 @@ EmbreeScene::EmbreeScene(const SceneData& data) {
   try {
     build(data);
   } catch (...) {
-    this->~EmbreeScene();
+    // The destructor does not run for a constructor that throws: release
+    // the handles here (calling ~EmbreeScene() would destroy the members,
+    // and the unwinding destroys them again).
+    release();
     throw;
   }
+}
+
+void EmbreeScene::release() {
+  if (scene_) rtcReleaseScene(scene_);
+  if (device_) rtcReleaseDevice(device_);
+  scene_ = nullptr;
+  device_ = nullptr;
 }
 
 void EmbreeScene::build(const SceneData& data) {
@@ -86,11 +96,6 @@ void EmbreeScene::build(const SceneData& data) {
   if (!error_.empty()) throw std::runtime_error("embree: " + error_);
 }
 
-EmbreeScene::~EmbreeScene() {
-  if (scene_) rtcReleaseScene(scene_);
-  if (device_) rtcReleaseDevice(device_);
-  scene_ = nullptr;
-  device_ = nullptr;
-}
+EmbreeScene::~EmbreeScene() { release(); }
 
 }  // namespace tessera

@@ -68,6 +68,7 @@ class EmbreeScene {
 
  private:
   void build(const SceneData& data);
+  void release();  // the Embree handles (constructor failure and destructor)
   std::string error_;  // first error Embree reported
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;

@@ -457,6 +457,21 @@ TEST(GuideField, MixtureStatisticsWeighMisEmissionAndNextEventByEachCandidate) {
   }
 }
 
+// Grid lookups clamp, and map NaN (a degenerate hit point or direction) to
+// cell 0 instead of converting it to an integer (undefined behaviour).
+TEST(GuideField, GridLookupsClampAndSurviveNaN) {
+  EXPECT_EQ(guide_grid_index(std::nanf(""), 8), 0u);
+  EXPECT_EQ(guide_grid_index(-3.f, 8), 0u);
+  EXPECT_EQ(guide_grid_index(2.5f, 8), 2u);
+  EXPECT_EQ(guide_grid_index(7.99f, 8), 7u);
+  EXPECT_EQ(guide_grid_index(1e30f, 8), 7u);
+  GuideField f = make_field();
+  const GuideView g = f.view();
+  const Float nan = std::nanf("");
+  EXPECT_LT(guide_bin_of(g, Vec3(nan, nan, nan)), g.bins);
+  EXPECT_GE(guide_find_cell(g, Vec3(nan, 0.f, 1e30f), Vec3(0.f, 0.f, 1.f)), 0);
+}
+
 TEST(GuideSerialisation, RoundTripIsExact) {
   GuideConfig cfg;
   cfg.split_updates = 50;

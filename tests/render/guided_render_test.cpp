@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "guided_helpers.h"
+#include "kernels/guide_diagnostic.h"
 #include "scene/builtin_scenes.h"
 
 namespace tessera {
@@ -98,6 +99,45 @@ AttributeEnd
   EXPECT_LT(g.stats.guide.mean_mix, 0.2);
   EXPECT_LT(relative_variance_per_sample(g.film), 1.25 * relative_variance_per_sample(u.film));
   expect_agree(channel_stats(g.film), channel_stats(u.film), "sky-lit ground");
+}
+
+// guide-viz's greedy paths (kernels/guide_diagnostic.h) pass through
+// interfaces without a bounce and stop at their depth: with the camera inside
+// an interface sphere in a closed, lit box and depth 0, the old loop counted
+// the interface as the bounce, missed depth == 0 and followed the guide
+// around the box for ever.
+TEST(GuideDiagnostic, GreedyPathsStopAfterAnInterface) {
+  GuidedScene s(load_pbrt_string(R"(
+LookAt 0 0 0  0 0 1  0 1 0
+Camera "perspective" "float fov" [ 40 ]
+Film "rgb" "integer xresolution" [ 8 ] "integer yresolution" [ 8 ]
+Sampler "independent" "integer pixelsamples" [ 16 ]
+Integrator "path" "integer maxdepth" [ 5 ]
+WorldBegin
+AttributeBegin
+AreaLightSource "diffuse" "rgb L" [ 4 4 4 ]
+Shape "trianglemesh" "point3 P" [ -1 4.9 -1  1 4.9 -1  1 4.9 1  -1 4.9 1 ] "integer indices" [ 0 1 2 0 2 3 ]
+AttributeEnd
+Material "diffuse" "rgb reflectance" [ 0.7 0.7 0.7 ]
+AttributeBegin
+ReverseOrientation
+Shape "sphere" "float radius" [ 5 ]
+AttributeEnd
+Material "interface"
+Shape "sphere" "float radius" [ 1 ]
+)",
+                                 "<greedy>", "."));
+  GuideField guide = s.make_guide();
+  s.run(&guide);
+  const GuideView g = guide.view();
+  const EmbreeTracer tracer = s.embree.tracer();
+  const SceneView& v = s.scene.view();
+  for (int32_t depth : {0, 1, 3})
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) {
+        const Rgb L = trace_greedy_path(v, g, tracer, generate_camera_ray(v.camera, Vec2(x + 0.5f, y + 0.5f)), depth);
+        EXPECT_TRUE(is_finite(L));
+      }
 }
 
 // The hard scenes: guided means agree with unguided ones.

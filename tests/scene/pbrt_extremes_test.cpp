@@ -52,6 +52,16 @@ TEST(PbrtExtremes, FarVerticesAreAnError) {
   EXPECT_ERROR_CONTAINS(load_error(instance), "a vertex of the shape is at (5e+18");
 }
 
+// Integers beyond int's range were converted with undefined behaviour (a huge
+// xresolution was then reported as "must be positive").
+TEST(PbrtExtremes, IntegersBeyondIntAreAnError) {
+  EXPECT_ERROR_CONTAINS(load_error("Film \"rgb\" \"integer xresolution\" [ 4294967296 ]\nWorldBegin\n"),
+                        "bad.pbrt:1: integer '4294967296' for \"integer xresolution\" is out of range");
+  EXPECT_ERROR_CONTAINS(load_error("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] "
+                                   "\"integer indices\" [ 0 1 -3000000000 ]\n"),
+                        "bad.pbrt:2: integer '-3000000000'");
+}
+
 TEST(PbrtExtremes, TextureNestingIsBounded) {
   const std::string ok = std::string(kCamera) + "WorldBegin\n" + texture_chain(kMaxTextureNesting) +
                          "Material \"diffuse\" \"texture reflectance\" \"t" + std::to_string(kMaxTextureNesting - 1) +
