@@ -6,6 +6,8 @@
 #include <regex>
 #include <sstream>
 
+#include <unistd.h>
+
 #include "app/commands.h"
 #include "app/guide_setup.h"
 #include "app/scene_loading.h"
@@ -105,6 +107,21 @@ OutputPaths output_paths(const RenderArgs& a, const SceneDesc& desc) {
   return o;
 }
 
+// Fails before the render, not after it, when `path` (given by `option`)
+// cannot be written: its folder must exist and be writable, and the path
+// must not be a folder.
+void check_writable(const std::string& path, const char* option) {
+  if (path.empty()) return;
+  namespace fs = std::filesystem;
+  fs::path dir = fs::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  const std::string what = std::string(option) + " '" + path + "': ";
+  if (!fs::is_directory(dir, ec)) throw std::runtime_error(what + "folder '" + dir.string() + "' does not exist");
+  if (access(dir.c_str(), W_OK) != 0) throw std::runtime_error(what + "folder '" + dir.string() + "' is not writable");
+  if (fs::is_directory(path, ec)) throw std::runtime_error(what + "is a folder");
+}
+
 Bytes guide_bytes(const GuideField& guide, const SceneData& scene) {
   std::ostringstream s(std::ios::binary);
   guide.save(s, scene.fingerprint());
@@ -134,6 +151,11 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   SceneDesc desc = load_desc(a);
   m.opt = make_options(a, desc);
   m.out = output_paths(a, desc);
+  check_writable(m.out.exr, "-o");
+  check_writable(m.out.preview, "--preview");
+  check_writable(a.stats, "--stats");
+  check_writable(a.checkpoint, "--checkpoint");
+  check_writable(a.guide.out, "--guide-out");
   if (!a.snapshot_every.empty()) m.snapshots = parse_snapshot_policy(a.snapshot_every);
   if (scene_bytes) *scene_bytes = encode_scene(desc);
   m.scene = std::make_unique<SceneData>(std::move(desc));

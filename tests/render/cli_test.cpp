@@ -65,6 +65,22 @@ void expect_one_line_error(const RunResult& r, const std::string& where) {
   EXPECT_EQ(lines, 1u) << r.output;
 }
 
+// Outputs that cannot be written are found before rendering (the render
+// asked for here would take hours), with one line naming the option and path.
+TEST_F(CliTest, UnwritableOutputsFailBeforeRendering) {
+  const std::string missing = (dir_ / "no-such-folder").string();
+  const std::string good = (dir_ / "ok.exr").string();
+  const std::string slow = "render -q --spp 1000000 --res 512x512 ";
+  expect_one_line_error(run(slow + "-o " + missing + "/x.exr"), "-o '" + missing + "/x.exr': folder '" + missing + "' does not exist");
+  expect_one_line_error(run(slow + "-o " + good + " --preview " + missing + "/x.png"), "--preview '");
+  expect_one_line_error(run(slow + "-o " + good + " --stats " + missing + "/s.json"), "--stats '");
+  expect_one_line_error(run(slow + "-o " + good + " --checkpoint " + missing + "/c.ckpt"), "--checkpoint '");
+  expect_one_line_error(run(slow + "-o " + good + " --guide-out " + missing + "/g.guide"), "--guide-out '");
+  fs::create_directories(dir_ / "folder.exr");
+  expect_one_line_error(run(slow + "-o " + (dir_ / "folder.exr").string()), "is a folder");
+  EXPECT_FALSE(fs::exists(good));
+}
+
 TEST_F(CliTest, BadNumber) {
   auto f = write("bad_number.pbrt", std::string(kHeader) + "Shape \"sphere\" \"float radius\" [ 1.2.3 ]\n");
   expect_one_line_error(run("render -q " + f + " -o " + (dir_ / "x.exr").string()), "bad_number.pbrt:6");
