@@ -99,7 +99,17 @@ Checkpoint read_checkpoint(const std::string& path, uint64_t scene_fingerprint, 
   if (scene != scene_fingerprint) throw fail("checkpoint of another scene");
   if (options != options_fingerprint)
     throw fail("checkpoint made with other render options (resolution, seed, depth or guiding differ)");
-  if (size > (uint64_t(1) << 40)) throw fail("corrupt checkpoint (absurd size)");
+  // The payload must be exactly what is left of the file: a truncated file
+  // is refused before its claimed size is allocated, trailing bytes are not
+  // silently ignored.
+  const std::streamoff header_end = f.tellg();
+  f.seekg(0, std::ios::end);
+  const std::streamoff file_end = f.tellg();
+  f.seekg(header_end);
+  if (header_end < 0 || file_end < header_end) throw fail("cannot read");
+  const uint64_t left = static_cast<uint64_t>(file_end - header_end);
+  if (size > left) throw fail("truncated checkpoint (" + std::to_string(left) + " of " + std::to_string(size) + " bytes)");
+  if (size < left) throw fail("corrupt checkpoint (" + std::to_string(left - size) + " bytes after its end)");
   std::string payload(static_cast<size_t>(size), '\0');
   if (!f.read(payload.data(), static_cast<std::streamsize>(size))) throw fail("truncated checkpoint");
   if (fnv1a(payload) != hash) throw fail("corrupt checkpoint (checksum mismatch)");

@@ -9,6 +9,7 @@
 #include <OpenEXR/ImfInputFile.h>
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -117,6 +118,13 @@ TEST_F(FarmCliTest, BadCheckpointsAreRefusedAndLeaveOutputsAlone) {
   std::string flipped = bytes;
   flipped[flipped.size() * 3 / 4] ^= 0x5a;
   std::ofstream(path("flipped.ckpt"), std::ios::binary) << flipped;
+  std::ofstream(path("trailing.ckpt"), std::ios::binary) << bytes << "trailing garbage";
+  // The payload size field (after the 19-byte magic, version, scene and
+  // options fingerprints) claiming 512 GiB: refused before anything is allocated.
+  std::string huge = bytes;
+  const uint64_t claimed = uint64_t(1) << 39;
+  std::memcpy(&huge[19 + 4 + 8 + 8], &claimed, sizeof claimed);
+  std::ofstream(path("huge.ckpt"), std::ios::binary) << huge;
   std::ofstream(path("out.exr")) << "a good image";
   // The same scene through another pixel filter: the same geometry, other pixels.
   std::ofstream(path("door-box.pbrt")) << "PixelFilter \"box\"\n" << read_text(testing::source_dir() + "/scenes/door-ajar.pbrt");
@@ -127,6 +135,8 @@ TEST_F(FarmCliTest, BadCheckpointsAreRefusedAndLeaveOutputsAlone) {
   } cases[] = {
       {args + " --resume " + path("truncated.ckpt"), "truncated", 1},
       {args + " --resume " + path("flipped.ckpt"), "checksum", 2},
+      {args + " --resume " + path("trailing.ckpt"), "bytes after its end", 1},
+      {args + " --resume " + path("huge.ckpt"), "truncated checkpoint (", 1},
       {args + " --resume " + path("missing.ckpt"), "cannot open", 2},
       {kDoor + " -q --no-preview --res 32x24 --spp 4 --seed 5 --resume " + ck, "other render options", 1},
       {path("door-box.pbrt") + " -q --no-preview --res 32x24 --spp 4 --seed 4 --resume " + ck, "other render options", 1},
