@@ -330,6 +330,11 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, const EmbreeS
     };
   }
   RenderResult r = render(*m.scene, embree, m.opt, m.guide.get(), executor, m.resume ? &m.resume->so_far : nullptr, hook);
+  if (r.stats.stop_reason == "interrupted" && r.stats.spp == 0) {
+    // Interrupted while loading: an empty image must not replace earlier outputs.
+    std::fprintf(stderr, "tessera: interrupted before the first pass: nothing written\n");
+    return r;
+  }
   // The finished render is a checkpoint too: --resume with a larger --spp continues it.
   if (!a.checkpoint.empty() && checkpointed_spp != r.stats.spp)
     write_checkpoint(a.checkpoint, r, m.guide.get(), m.scene->fingerprint(), m.options_fingerprint);

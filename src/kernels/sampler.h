@@ -37,10 +37,12 @@ struct SamplerSetup {
   bool jitter = true;      // Stratified: a random point in each stratum (else its centre)
 };
 
-// The smallest L with 2^L >= spp (at most 30).
+// The smallest L with 2^L >= spp, at most 26: the Sobol points use 32 bits
+// of the index, and L + 6 of them must stay below the 8 x 8 pixel block
+// whose bits seed the scramble (more samples start new epochs).
 TESSERA_HOST_DEVICE inline uint32_t ceil_log2_spp(uint64_t spp) {
   uint32_t l = 0;
-  while (l < 30u && (1ull << l) < spp) ++l;
+  while (l < 26u && (1ull << l) < spp) ++l;
   return l;
 }
 

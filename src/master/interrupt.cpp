@@ -1,16 +1,20 @@
 #include "master/interrupt.h"
 
-#include <csignal>
 #include <unistd.h>
+
+#include <atomic>
+#include <csignal>
 
 namespace tessera {
 namespace {
 
-volatile std::sig_atomic_t g_signals = 0;
+// Set by the handler (on whichever thread takes the signal), read by the
+// render loop: a lock-free atomic is safe for both.
+std::atomic<int> g_signals{0};
+static_assert(std::atomic<int>::is_always_lock_free);
 
 extern "C" void on_interrupt(int sig) {
-  if (g_signals > 0) _exit(128 + sig);
-  g_signals = 1;
+  if (g_signals.exchange(1) > 0) _exit(128 + sig);
   static const char msg[] =
       "\ntessera: interrupted: finishing this pass and writing the image so far (again to quit at once)\n";
   const ssize_t ignored = write(STDERR_FILENO, msg, sizeof msg - 1);
@@ -28,7 +32,7 @@ void install_interrupt_handlers() {
   sigaction(SIGTERM, &sa, nullptr);
 }
 
-bool interrupt_requested() { return g_signals > 0; }
+bool interrupt_requested() { return g_signals.load() > 0; }
 void request_interrupt() { g_signals = 1; }
 void clear_interrupt() { g_signals = 0; }
 

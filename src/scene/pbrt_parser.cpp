@@ -303,11 +303,13 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
       // pbrt-v4: xsamples x ysamples jittered strata; pixelsamples is not read.
       scene_.strata_x = ps.get_int("xsamples", 4);
       scene_.strata_y = ps.get_int("ysamples", 4);
-      if (scene_.strata_x <= 0 || scene_.strata_y <= 0 || scene_.strata_x > 65536 || scene_.strata_y > 65536)
-        fail(at, "xsamples and ysamples must be in 1..65536");
+      if (scene_.strata_x <= 0 || scene_.strata_y <= 0 ||
+          static_cast<int64_t>(scene_.strata_x) * scene_.strata_y > 1073741824)
+        fail(at, "xsamples and ysamples must be positive, their product at most 2^30");
       scene_.spp = scene_.strata_x * scene_.strata_y;
       scene_.sampler_jitter = ps.get_bool("jitter", true);
     }
+    scene_.sampler_spp = scene_.spp;
     ps.find_any("jitter");
     ps.find_any("randomization");
     ps.report_unused(warnings);

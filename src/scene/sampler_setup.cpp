@@ -1,6 +1,6 @@
 #include "scene/sampler_setup.h"
 
-#include <cmath>
+#include <algorithm>
 #include <stdexcept>
 
 namespace tessera {
@@ -27,18 +27,10 @@ SamplerSetup sampler_setup(const SceneDesc& desc) {
   SamplerSetup s;
   s.kind = desc.sampler;
   s.seed = desc.seed;
-  const uint64_t spp = static_cast<uint64_t>(std::max(1, desc.spp));
-  s.log2_spp = ceil_log2_spp(spp);
+  s.log2_spp = ceil_log2_spp(static_cast<uint64_t>(std::max(1, desc.sampler_spp)));
   s.jitter = desc.sampler_jitter;
-  if (static_cast<uint64_t>(desc.strata_x) * static_cast<uint64_t>(desc.strata_y) == spp) {
-    s.strata_x = static_cast<uint32_t>(desc.strata_x);
-    s.strata_y = static_cast<uint32_t>(desc.strata_y);
-  } else {
-    uint64_t div = static_cast<uint64_t>(std::sqrt(static_cast<double>(spp)));
-    while (div > 1 && spp % div != 0) --div;
-    s.strata_y = static_cast<uint32_t>(div);
-    s.strata_x = static_cast<uint32_t>(spp / div);
-  }
+  s.strata_x = static_cast<uint32_t>(std::max(1, desc.strata_x));
+  s.strata_y = static_cast<uint32_t>(std::max(1, desc.strata_y));
   return s;
 }
 

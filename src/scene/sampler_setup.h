@@ -15,9 +15,10 @@ SamplerKind sampler_kind_named(const std::string& name);
 const char* sampler_name(SamplerKind kind);
 
 // The setup of the scene's sampler (its seed is the scene's). ZSobol's epoch
-// is the scene's sample count rounded up to a power of two; a stratified
-// sampler whose strata do not multiply to the sample count (--spp overrode
-// it) splits the count into the most nearly square strata, as pbrt-v4 does.
+// is the scene's own sample count rounded up to a power of two, and the
+// strata are the scene's: --spp changes neither (pbrt-v4 re-splits its
+// strata for --spp), so that a checkpoint resumes with any --spp; samples
+// past one epoch or round start the next.
 SamplerSetup sampler_setup(const SceneDesc& desc);
 
 }  // namespace tessera

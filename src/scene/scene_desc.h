@@ -116,6 +116,10 @@ struct SceneDesc {
   // and pmj02bn are drawn as zsobol (a warning says so).
   SamplerKind sampler = SamplerKind::ZSobol;
   int32_t strata_x = 4, strata_y = 4;  // stratified: "xsamples", "ysamples" (spp = their product)
+  // The scene's own sample count (pixelsamples, or xsamples * ysamples), which
+  // --spp does not change: zsobol's epoch is built from it, so a checkpoint
+  // resumes with any --spp.
+  int32_t sampler_spp = 16;
   bool sampler_jitter = true;          // stratified: "jitter"
   // Spectral transport (kernels/spectral.h): paths carry three sampled
   // wavelengths, as pbrt-v4's carry four; false: paths carry RGB.

@@ -64,7 +64,10 @@ void run_farm_worker(Transport& t, const SceneView& view, const EmbreeScene& emb
       settings.specialisation = start.specialisation;
       settings.path.guided_roulette = start.guided_roulette;
       const bool guided = guide && (start.specialisation & kSpecGuiding) != 0;
-      if (guided) settings.path.guide = guide->view();
+      // An unguided pass (the --guide auto trial's, or after it switched
+      // guiding off) gets no view at all: the last guided pass's view points
+      // into accumulators that folding may have reallocated since.
+      settings.path.guide = guided ? guide->view() : GuideView{};
       render_pass_tiles(t, view, tracer, settings, arena, capacity);
       if (guided) {
         if (sync_guide) t.allreduce_sum(guide->accumulators());

@@ -84,24 +84,26 @@ TEST_F(FarmCliTest, KilledRenderResumesBitIdenticallyOnOtherRankCounts) {
   EXPECT_TRUE(exr_channels(path("resumed.exr")) == exr_channels(path("whole.exr")));
 }
 
-// Ctrl-C to mpirun (it passes SIGINT on to every rank): the master stops the
+// Ctrl-C to mpirun (it sends SIGTERM to every rank and kills them
+// odls_base_sigkill_timeout seconds later; 5 here): the master stops the
 // farm after the pass under way and writes the image so far and its
-// checkpoint; resumed on another rank count, it ends as an uninterrupted
-// render would.
+// checkpoint; resumed on another rank count and with another --spp, it ends
+// as an uninterrupted render would. The scene is drawn with zsobol, whose
+// epoch --spp must not change for the resume to be accepted.
 TEST_F(FarmCliTest, InterruptedFarmWritesTheImageSoFarAndResumes) {
   const std::string args = kDoor + " -q --no-preview --res 64x48 --seed 5";
   const std::string ck = path("farm.ckpt");
   RunResult interrupted = run_shell(
-      "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe -np 2 " +
+      "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe --mca odls_base_sigkill_timeout 5 -np 2 " +
       std::string(TESSERA_BINARY) + " render " + args + " --time 120 -o " + path("interrupted.exr") + " --stats " +
-      path("interrupted.json") + " --checkpoint " + ck + " & P=$!; sleep 5; kill -INT $P; wait $P; echo done=$?");
+      path("interrupted.json") + " --checkpoint " + ck + " --sampler zsobol --threads 1 & P=$!; sleep 3; kill -INT $P; wait $P; echo done=$?");
   ASSERT_NE(interrupted.output.find("done="), std::string::npos) << interrupted.output;
   ASSERT_TRUE(fs::exists(path("interrupted.exr"))) << interrupted.output;
   const std::string stats = read_text(path("interrupted.json"));
   EXPECT_NE(stats.find("\"stop_reason\": \"interrupted\""), std::string::npos) << stats;
   const int spp = static_cast<int>(json_number(stats, "spp"));
   EXPECT_GT(spp, 0);
-  const std::string more = " --spp " + std::to_string(spp + 16);
+  const std::string more = " --sampler zsobol --spp " + std::to_string(spp + 16);
   RunResult resumed = run_mpi(3, "render " + args + more + " -o " + path("resumed.exr") + " --resume " + ck);
   ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
   RunResult whole = run("render " + args + more + " -o " + path("whole.exr"));

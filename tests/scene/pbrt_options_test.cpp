@@ -62,7 +62,8 @@ TEST(PbrtOptions, FilmSamplerIntegrator) {
 }
 
 // pbrt-v4's stratified sampler takes xsamples x ysamples (pixelsamples is not
-// read) and "jitter"; --spp splits into the most nearly square strata.
+// read) and "jitter". --spp changes neither the strata nor zsobol's epoch
+// (checkpoints resume with any --spp).
 TEST(PbrtOptions, StratifiedSamplerReadsItsStrata) {
   const SceneDesc s = load_with_options(
       "Sampler \"stratified\" \"integer xsamples\" 3 \"integer ysamples\" 5 \"bool jitter\" false "
@@ -76,10 +77,16 @@ TEST(PbrtOptions, StratifiedSamplerReadsItsStrata) {
   SceneDesc overridden = s;
   overridden.spp = 24;
   setup = sampler_setup(overridden);
-  EXPECT_EQ(setup.strata_x, 6u);
-  EXPECT_EQ(setup.strata_y, 4u);
-  EXPECT_EQ(sampler_setup(load_with_options("Sampler \"zsobol\" \"integer pixelsamples\" 100\n")).log2_spp, 7u);
+  EXPECT_EQ(setup.strata_x, 3u);
+  EXPECT_EQ(setup.strata_y, 5u);
+  SceneDesc z = load_with_options("Sampler \"zsobol\" \"integer pixelsamples\" 100\n");
+  EXPECT_EQ(sampler_setup(z).log2_spp, 7u);
+  z.spp = 4096;
+  EXPECT_EQ(sampler_setup(z).log2_spp, 7u);
   EXPECT_THROW(load_with_options("Sampler \"stratified\" \"integer xsamples\" 0\n"), std::exception);
+  // 65536 x 65536 strata overflowed int.
+  EXPECT_THROW(load_with_options("Sampler \"stratified\" \"integer xsamples\" 65536 \"integer ysamples\" 65536\n"),
+               std::exception);
 }
 
 TEST(PbrtOptions, OtherIntegratorsWarn) {
