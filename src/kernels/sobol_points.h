@@ -36,25 +36,37 @@ TESSERA_HOST_DEVICE inline uint32_t nested_uniform_scramble(uint32_t x, uint32_t
 }
 
 // The second Sobol dimension: the generator matrix of the primitive
-// polynomial x + 1 (direction numbers m_k = m_{k-1} xor 2 m_{k-1}, m_1 = 1).
-TESSERA_HOST_DEVICE inline uint32_t sobol_dim1(uint32_t index) {
-  uint32_t v = 0, direction = 0x80000000u;
-  for (; index != 0; index >>= 1, direction ^= direction >> 1)
-    if (index & 1u) v ^= direction;
-  return v;
+// polynomial x + 1 (direction numbers m_k = m_{k-1} xor 2 m_{k-1}, m_1 = 1),
+// which is Pascal's triangle mod 2. By Lucas' theorem the output bit p
+// places below the top is the xor of the index bits j with p & j == p: a
+// xor "superset sum" over 5-bit positions, five shift-and-mask steps
+// instead of a loop over the index's 32 bits.
+// sobol_dim1 with its bits reversed (least significant = the top bit of the point).
+TESSERA_HOST_DEVICE inline uint32_t sobol_dim1_reversed(uint32_t index) {
+  uint32_t x = index;
+  x ^= (x >> 1) & 0x55555555u;
+  x ^= (x >> 2) & 0x33333333u;
+  x ^= (x >> 4) & 0x0f0f0f0fu;
+  x ^= (x >> 8) & 0x00ff00ffu;
+  x ^= (x >> 16) & 0x0000ffffu;
+  return x;
 }
+TESSERA_HOST_DEVICE inline uint32_t sobol_dim1(uint32_t index) { return reverse_bits(sobol_dim1_reversed(index)); }
 
 TESSERA_HOST_DEVICE inline Float to_unit(uint32_t v) {
   return glm::min(static_cast<Float>(v >> 8) * 0x1p-24f, 0x1.fffffep-1f);
 }
 
-// Owen-scrambled points of dimension 0, and of dimensions 0 and 1, of index i.
+// Owen-scrambled points of dimension 0, and of dimensions 0 and 1, of index
+// i. Scrambling a point reverses its bits, hashes and reverses back; the
+// points are themselves reversed forms (dimension 0 is reverse_bits(i)), so
+// two of the four reversals cancel.
 TESSERA_HOST_DEVICE inline Float scrambled_dim0(uint32_t i, uint32_t seed) {
-  return to_unit(nested_uniform_scramble(reverse_bits(i), seed));
+  return to_unit(reverse_bits(laine_karras(i, seed)));
 }
 TESSERA_HOST_DEVICE inline Vec2 scrambled_dims01(uint32_t i, uint64_t seeds) {
-  return Vec2(to_unit(nested_uniform_scramble(reverse_bits(i), static_cast<uint32_t>(seeds))),
-              to_unit(nested_uniform_scramble(sobol_dim1(i), static_cast<uint32_t>(seeds >> 32))));
+  return Vec2(to_unit(reverse_bits(laine_karras(i, static_cast<uint32_t>(seeds)))),
+              to_unit(reverse_bits(laine_karras(sobol_dim1_reversed(i), static_cast<uint32_t>(seeds >> 32)))));
 }
 
 }  // namespace sobol_detail

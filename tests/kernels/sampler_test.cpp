@@ -60,6 +60,23 @@ bool is_02_net(const std::vector<Vec2>& pts) {
   return true;
 }
 
+// The closed form of Sobol's second dimension equals the generator matrix
+// applied bit by bit (direction numbers m_k = m_{k-1} xor 2 m_{k-1}).
+TEST(Sampler, SobolSecondDimensionMatchesItsDirectionNumbers) {
+  auto by_loop = [](uint32_t index) {
+    uint32_t v = 0, direction = 0x80000000u;
+    for (; index != 0; index >>= 1, direction ^= direction >> 1)
+      if (index & 1u) v ^= direction;
+    return v;
+  };
+  Rng rng = Rng::for_sample(1, 2, 3);
+  for (uint32_t i = 0; i < 4096; ++i) EXPECT_EQ(sobol_detail::sobol_dim1(i), by_loop(i)) << i;
+  for (int k = 0; k < 100000; ++k) {
+    const uint32_t i = rng.next_u32();
+    ASSERT_EQ(sobol_detail::sobol_dim1(i), by_loop(i)) << i;
+  }
+}
+
 TEST(Sampler, SobolPrefixesAreZeroTwoNetsInEveryRequest) {
   for (SamplerKind kind : {SamplerKind::Sobol, SamplerKind::ZSobol}) {
     for (int request : {0, 1, 5, 17}) {
