@@ -65,7 +65,7 @@ SceneDesc load_desc(const RenderArgs& a) {
   if (a.max_depth >= 0) desc.max_depth = static_cast<int32_t>(a.max_depth);
   if (a.spp >= 0) desc.spp = static_cast<int32_t>(a.spp);
   if (a.seed >= 0) desc.seed = static_cast<uint64_t>(a.seed);
-  if (!a.sampler.empty()) desc.sampler = sampler_kind_named(a.sampler);
+  if (!a.sampler.empty()) desc.sampler = sampler_kind_named(a.sampler).value();  // CLI11 checked the name
   desc.spectral = a.spectral == "on" || (a.spectral == "auto" && !spectral_reason(desc).empty());
   return desc;
 }

@@ -10,7 +10,7 @@
 //   Owen-shuffled, seeds hashed from (seed, pixel, dimension). Every
 //   power-of-two prefix of a pixel's samples is stratified in each request.
 // * ZSobol (pbrt-v4's default): the same points, but all pixels share one
-//   Sobol sequence in Morton order with randomly permuted digits
+//   Sobol sequence in Morton order, the index Owen-scrambled per request
 //   (zsobol_index.h): the pixel's own samples are as well stratified, and
 //   neighbouring pixels' errors are spread like blue noise.
 // * Stratified: sx x sy jittered strata in every 2D request and sx * sy in

@@ -38,7 +38,6 @@ std::string describe_far(const Vec3& p) {
   return buf;
 }
 
-
 constexpr int kMaxIncludeDepth = 32;
 
 [[noreturn]] void fail(const Token& at, const std::string& problem) { throw SceneError(at.where() + ": " + problem); }
@@ -287,8 +286,8 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     scene_.spp = ps.get_int("pixelsamples", 16);
     if (scene_.spp <= 0) fail(at, "pixelsamples must be positive");
     scene_.seed = static_cast<uint64_t>(ps.get_int("seed", static_cast<int>(scene_.seed)));
-    if (type == "independent" || type == "zsobol" || type == "paddedsobol" || type == "sobol" || type == "stratified") {
-      scene_.sampler = sampler_kind_named(type);
+    if (const std::optional<SamplerKind> kind = sampler_kind_named(type)) {
+      scene_.sampler = *kind;
       if (type == "sobol")
         warn("sampler \"sobol\": drawn as \"paddedsobol\" (Owen-scrambled Sobol points per pixel); the same image "
              "in expectation, not pbrt-v4's global Sobol ordering of the pixels");

@@ -1,16 +1,15 @@
 #include "scene/sampler_setup.h"
 
 #include <algorithm>
-#include <stdexcept>
 
 namespace tessera {
 
-SamplerKind sampler_kind_named(const std::string& name) {
+std::optional<SamplerKind> sampler_kind_named(const std::string& name) {
   if (name == "zsobol") return SamplerKind::ZSobol;
   if (name == "paddedsobol" || name == "sobol") return SamplerKind::Sobol;
   if (name == "stratified") return SamplerKind::Stratified;
   if (name == "independent") return SamplerKind::Independent;
-  throw std::invalid_argument("unknown sampler \"" + name + "\"");
+  return std::nullopt;
 }
 
 const char* sampler_name(SamplerKind kind) {

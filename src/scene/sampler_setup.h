@@ -2,6 +2,7 @@
 // parameters each kind takes from the scene.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "kernels/sampler.h"
@@ -10,8 +11,8 @@
 namespace tessera {
 
 // "zsobol", "paddedsobol", "sobol" (drawn as paddedsobol), "stratified",
-// "independent"; throws std::invalid_argument for any other name.
-SamplerKind sampler_kind_named(const std::string& name);
+// "independent"; nothing for any other name.
+std::optional<SamplerKind> sampler_kind_named(const std::string& name);
 const char* sampler_name(SamplerKind kind);
 
 // The setup of the scene's sampler (its seed is the scene's). ZSobol's epoch
