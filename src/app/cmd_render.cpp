@@ -23,6 +23,7 @@
 #include "master/stats_json.h"
 #include "scene/sampler_setup.h"
 #include "scene/scene_effects.h"
+#include "scene/light_paths.h"
 #include "scene/spectral_choice.h"
 #include "worker/cpu_affinity.h"
 #include "worker/farm_worker.h"
@@ -36,6 +37,7 @@ struct RenderArgs {
   int64_t seed = -1;
   std::string sampler;  // "" = the scene's
   std::string spectral = "auto";
+  std::string light_paths = "auto";
   double time = 0.0;
   double target_error = 0.0;
   std::string snapshot_every;
@@ -85,6 +87,7 @@ RenderOptions make_options(const RenderArgs& a, const SceneDesc& desc) {
   opt.tile_size = static_cast<int32_t>(a.tile);
   opt.progress = !a.quiet;
   opt.force_full_specialisation = a.full_specialisation;
+  opt.light_paths = light_paths_enabled(desc, light_paths_mode_named(a.light_paths));
   apply_guide_render_options(a.guide, &opt);
   if (opt.spp == 0 && opt.time_budget_s <= 0 && opt.target_error <= 0)
     throw std::runtime_error("--spp 0 needs a --time budget or a --target-error");
@@ -193,6 +196,13 @@ void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks) {
   std::fprintf(stderr, "tessera: transport: %s\n",
                scene.desc().spectral ? ("spectral (" + (why.empty() ? std::string("--spectral on") : why) + ")").c_str()
                                      : (why.empty() ? "rgb" : ("rgb (--spectral off; " + why + ")").c_str()));
+  if (m.opt.light_paths) {
+    std::fprintf(stderr, "tessera: caustics of area, point and spot lights seen through specular surfaces: traced from the lights\n");
+  } else if (wants_bidirectional(scene.desc())) {
+    const std::string obstacle = light_paths_obstacle(scene.desc());
+    std::fprintf(stderr, "tessera: integrator \"%s\": caustics from path tracing alone (%s)\n",
+                 scene.desc().integrator.c_str(), obstacle.empty() ? "--light-paths off" : obstacle.c_str());
+  }
   if (m.guide) {
     std::fprintf(stderr,
                  "tessera: guiding: %s (%s), %u direction bins, %s light selection, %s next-event estimation, budget "
@@ -451,6 +461,10 @@ CommandRunner add_render_command(CLI::App& app) {
   c->add_option("--spectral", a->spectral,
                 "on: paths carry sampled wavelengths and colours become pbrt-v4's spectra; off: paths carry RGB; "
                 "auto (default): spectral where it changes the picture (measured spectra, strongly coloured lights)")
+      ->check(CLI::IsMember({"on", "off", "auto"}));
+  c->add_option("--light-paths", a->light_paths,
+                "Trace caustics of small lights seen through glass or mirrors from the lights: on, off, or auto (default: "
+                "where the scene's Integrator is bdpt, mlt, sppm or lighttracer)")
       ->check(CLI::IsMember({"on", "off", "auto"}));
   c->add_option("--threads", a->threads, "Worker threads per process (0 = all cores, shared out among the ranks on a machine)")->check(CLI::Range(0, 4096));
   c->add_option("--tile", a->tile, "Tile size in pixels")->check(CLI::Range(1, 4096));

@@ -56,9 +56,10 @@ struct FarmHello {
 struct TileWork {
   TileJob job;
   std::vector<PixelAccum> pixels;  // row-major, (x1 - x0) * (y1 - y0)
+  std::vector<Splat> splats;       // results only: the tile's light-path splats, in order
   template <class Archive>
   void serialize(Archive& ar) {
-    ar(raw_value(job), raw(pixels));
+    ar(raw_value(job), raw(pixels), raw(splats));
   }
 };
 

@@ -31,6 +31,9 @@ struct PathCounters {
   uint64_t guided_roulette = 0;    // roulette decisions the guide's prediction took part in
   uint64_t nee_skipped = 0;        // vertices that skipped next-event estimation (GuideView::nee_prob)
   uint64_t medium_vertices = 0;    // scattering events in participating media
+  uint64_t light_paths = 0;        // light paths traced for caustics (light_paths.h)
+  uint64_t light_splats = 0;       // pixel contributions they made
+  uint64_t caustic_emission_skipped = 0;  // emitter hits left to the light tracer
 };
 
 struct PathSettings {
@@ -48,6 +51,10 @@ struct PathSettings {
   // predicted radiance always survives (see guided_survival): smaller windows
   // give shorter paths, less time per sample and more noise per sample.
   Float guided_roulette_window = kGuidedRouletteWindow;
+  // The light tracer (light_paths.h) delivers the emission of paths whose
+  // first vertex scatters non-specularly and whose later vertices are all
+  // delta-only surfaces: the path tracer leaves it out.
+  bool light_traced_caustics = false;
 };
 
 namespace detail {
@@ -147,6 +154,12 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   Float path_expected = 0.f;
   int32_t depth = 0;
   bool specular_bounce = false;
+  // Light-traced caustics (PathSettings::light_traced_caustics): the light
+  // tracer takes a path that ends on an emitter if its first vertex scattered
+  // non-specularly (it connects there) and the vertex before the emitter has
+  // only delta lobes (its walk starts with such a chain).
+  bool first_vertex_connectable = false;
+  bool last_vertex_delta_only = false;
   Float prev_scatter_pdf = 0.f;  // pdf of the last sampled direction (the mixture's when guided)
   Vec3 prev_p(0.f);  // last scattering point: MIS on emitter hits measures from it, as NEE does
   int32_t prev_cell = -1;  // guide cell of the last scattering point (its light selection)
@@ -210,6 +223,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           if (seg.scattered) {
             if (is_black(beta) || depth++ == settings.max_depth) break;
             ++c.medium_vertices;
+            if (depth == 1) first_vertex_connectable = settings.light_traced_caustics;
+            last_vertex_delta_only = false;
             const Vec3 p = ray.o + seg.t * ray.d;
             const Vec3 wo = -ray.d;
             const Float u_select = rng.uniform();
@@ -295,7 +310,9 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       if (info.light >= 0) {
         const Light& l = s.lights[info.light];
         Float cos_l = glm::dot(h.ng, wo);
-        if (l.two_sided || cos_l > 0.f) {
+        if ((l.two_sided || cos_l > 0.f) && first_vertex_connectable && last_vertex_delta_only) {
+          ++c.caustic_emission_skipped;
+        } else if (l.two_sided || cos_l > 0.f) {
           Le_hit = light_emission(s, wl, l, l.L);
           if (depth == 0 || specular_bounce || !settings.nee) {
             L += beta * Le_hit;
@@ -514,6 +531,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     prev_scatter_pdf = scatter_pdf;
     prev_cell = cell;
     specular_bounce = (bs.lobe & kLobeSpecular) != 0;
+    if (depth == 1) first_vertex_connectable = settings.light_traced_caustics && !specular_bounce;
+    last_vertex_delta_only = !lobes_have_non_specular(lobes);
     if (bs.lobe & kLobeTransmission) eta_scale *= sqr(bs.eta);
     ray.o = offset_ray_origin(h, wi);
     ray.d = wi;

@@ -11,8 +11,8 @@ namespace {
 
 constexpr char kMagic[] = "tessera-checkpoint";
 // 2: per-pass error estimates; 3: next-event skip counter, guide cache v2; 4: medium
-// vertex counter, --guide auto's trial; 5: guide cache v4
-constexpr uint32_t kVersion = 5;
+// vertex counter, --guide auto's trial; 5: guide cache v4; 6: light-path splats
+constexpr uint32_t kVersion = 6;
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.
 uint64_t fnv1a(const std::string& s) {
@@ -27,7 +27,7 @@ struct CheckpointBody {
   void serialize(Archive& ar) {
     RenderResult& r = c->so_far;
     RenderStats& s = r.stats;
-    ar(r.film.width, r.film.height, raw(r.film.pixels));
+    ar(r.film.width, r.film.height, raw(r.film.pixels), raw(r.film.splats), r.film.light_paths);
     ar(s.spp, s.passes, s.seconds, raw_value(s.counters), raw(s.pass_stats), s.guide_fold_seconds, s.guide_sync_seconds,
        s.guide_syncs);
     ar(s.estimated_rel_mse, s.pass_end_seconds);
@@ -51,6 +51,7 @@ uint64_t render_options_fingerprint(const RenderOptions& o, int32_t width, int32
   if (o.sampler.kind == SamplerKind::ZSobol) s << " zsobol " << o.sampler.log2_spp;
   if (o.sampler.kind == SamplerKind::Stratified)
     s << " stratified " << o.sampler.strata_x << 'x' << o.sampler.strata_y << ' ' << o.sampler.jitter;
+  if (o.light_paths) s << " light-paths";
   return fnv1a(s.str());
 }
 
@@ -123,7 +124,8 @@ Checkpoint read_checkpoint(const std::string& path, uint64_t scene_fingerprint, 
     throw fail(std::string("corrupt checkpoint (") + e.what() + ")");
   }
   const Film& film = c.so_far.film;
-  if (film.width <= 0 || film.height <= 0 || film.pixels.size() != static_cast<size_t>(film.width) * film.height)
+  if (film.width <= 0 || film.height <= 0 || film.pixels.size() != static_cast<size_t>(film.width) * film.height ||
+      (!film.splats.empty() && film.splats.size() != film.pixels.size()))
     throw fail("corrupt checkpoint (film size)");
   return c;
 }

@@ -23,14 +23,11 @@ ErrorEstimate estimate_rel_mse(const Film& film) {
   ErrorEstimate e;
   if (film.pixels.empty()) return e;
   double sum = 0.0;
-  for (const PixelAccum& p : film.pixels) {
-    if (p.n < kMinSppForErrorEstimate) return e;
-    const double n = static_cast<double>(p.n);
+  for (size_t i = 0; i < film.pixels.size(); ++i) {
+    if (film.pixels[i].n < kMinSppForErrorEstimate) return e;
     for (int c = 0; c < 3; ++c) {
-      const double mean = p.sum[c] / n;
-      // Sample variance from the double sums; rounding can make it slightly negative.
-      const double var = std::max(0.0, (p.sum_sq[c] - p.sum[c] * mean) / (n - 1.0));
-      sum += rel_mse_term(mean, var / n);
+      const PixelEstimate p = pixel_estimate(film, i, c);
+      sum += rel_mse_term(p.mean, p.var_of_mean);
     }
   }
   e.valid = std::isfinite(sum);

@@ -10,13 +10,14 @@
 #include <thread>
 
 #include "comm/farm_protocol.h"
+#include "master/ordered_splats.h"
 #include "worker/thread_guide_accumulators.h"
 
 namespace tessera {
 namespace {
 
 TileWork tile_work(const TileJob& job, const Film& film) {
-  TileWork w{job, {}};
+  TileWork w{job, {}, {}};
   w.pixels.reserve(static_cast<size_t>(job.x1 - job.x0) * (job.y1 - job.y0));
   for (int32_t y = job.y0; y < job.y1; ++y)
     for (int32_t x = job.x0; x < job.x1; ++x) w.pixels.push_back(film.at(x, y));
@@ -60,6 +61,8 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
   std::atomic<uint32_t> empty_replies{0};
   ThreadGuideAccumulators guide_acc(settings);
   std::atomic<bool> failed{false};
+  const bool light_paths = settings.path.light_traced_caustics;
+  OrderedSplats splats(film, jobs.size());
   const uint32_t all_done = kRequestsInFlight * static_cast<uint32_t>(workers);
   std::mutex comm_mutex, counters_mutex;
 
@@ -68,14 +71,16 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
       throw std::runtime_error("rank " + std::to_string(m.source) + ": " + decode<FarmError>(m.bytes).message);
     if (m.tag != kTagRequest) throw std::runtime_error("rank " + std::to_string(m.source) + ": unexpected message");
     TileRequest req = decode<TileRequest>(m.bytes);
-    for (const TileWork& w : req.results) {
+    for (TileWork& w : req.results) {
       const TileJob& j = w.job;
       if (j.x0 < 0 || j.y0 < 0 || j.x1 > film.width || j.y1 > film.height ||
-          w.pixels.size() != static_cast<size_t>(j.x1 - j.x0) * (j.y1 - j.y0))
+          w.pixels.size() != static_cast<size_t>(j.x1 - j.x0) * (j.y1 - j.y0) || j.index >= jobs.size() ||
+          (!light_paths && !w.splats.empty()))
         throw std::runtime_error("rank " + std::to_string(m.source) + ": malformed tile result");
       size_t k = 0;
       for (int32_t y = j.y0; y < j.y1; ++y)
         for (int32_t x = j.x0; x < j.x1; ++x) film.at(x, y) = w.pixels[k++];
+      if (light_paths) splats.add(j.index, std::move(w.splats), job_light_paths(settings, j));
       if (on_tile_done) on_tile_done(job_samples(j));
     }
     {
@@ -107,7 +112,10 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
             serve();
             const size_t i = next.fetch_add(1);  // one tile at a time, so the workers find the rest
             if (i >= jobs.size()) break;
-            TileCounters tc = render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]));
+            std::vector<Splat> tile_splats;
+            TileCounters tc = render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]),
+                                          light_paths ? &tile_splats : nullptr);
+            if (light_paths) splats.add(jobs[i].index, std::move(tile_splats), job_light_paths(settings, jobs[i]));
             {
               std::lock_guard<std::mutex> lock(counters_mutex);
               counters->add(tc);
@@ -128,6 +136,7 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
     failed = true;
     throw;
   }
+  if (light_paths) splats.finish();
   guide_acc.gather();
 }
 

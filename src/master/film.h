@@ -17,9 +17,26 @@ struct PixelAccum {
   uint64_t n = 0;
 };
 
+// Light paths' contributions to a pixel (kernels/light_paths.h): sums over
+// all light paths traced for the image, each path adding at most once.
+struct SplatAccum {
+  double sum[3] = {0, 0, 0};
+  double sum_sq[3] = {0, 0, 0};
+};
+
+// One light path's contribution to one pixel.
+struct Splat {
+  uint64_t pixel = 0;  // y * width + x
+  float value[3] = {0, 0, 0};
+};
+
 struct Film {
   int32_t width = 0, height = 0;
   std::vector<PixelAccum> pixels;
+  // Light-traced caustics: empty unless they are traced. A pixel's value is
+  // its camera samples' mean plus its splat sum over light_paths.
+  std::vector<SplatAccum> splats;
+  uint64_t light_paths = 0;
 
   Film() = default;
   Film(int32_t w, int32_t h) : width(w), height(h), pixels(static_cast<size_t>(w) * h) {}
@@ -32,6 +49,18 @@ struct ImageRgb {
   int32_t width = 0, height = 0;
   std::vector<float> rgb;  // 3 floats per pixel, row 0 = top
 };
+
+// Adds a tile's splats, in their order, and the number of light paths it traced.
+void film_add_splats(Film& film, const std::vector<Splat>& splats, uint64_t light_paths);
+
+// Pixel i's estimate in channel c and the variance of that estimate (camera
+// samples and light paths are independent: their variances add). Valid only
+// with at least two camera samples.
+struct PixelEstimate {
+  double mean = 0.0;
+  double var_of_mean = 0.0;
+};
+PixelEstimate pixel_estimate(const Film& film, size_t i, int c);
 
 ImageRgb film_mean(const Film& film);
 ImageRgb film_variance_of_mean(const Film& film);

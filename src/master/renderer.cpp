@@ -12,6 +12,7 @@
 
 #include "master/error_estimate.h"
 #include "master/interrupt.h"
+#include "master/ordered_splats.h"
 #include "master/progress.h"
 #include "worker/cpu_affinity.h"
 #include "worker/thread_guide_accumulators.h"
@@ -35,6 +36,7 @@ TileSettings make_tile_settings(const RenderOptions& opt, uint32_t specialisatio
   ts.learn = opt.guide_learn;
   ts.path.guided_roulette = guiding && opt.guide_roulette;
   ts.path.guided_roulette_window = opt.guide_roulette_window;
+  ts.path.light_traced_caustics = opt.light_paths;
   return ts;
 }
 
@@ -56,10 +58,15 @@ void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vec
                                     TileCounters* counters, const std::function<void(uint64_t)>& on_tile_done) {
   std::mutex counters_mutex;
   ThreadGuideAccumulators guide_acc(settings);
+  const bool light_paths = settings.path.light_traced_caustics;
+  OrderedSplats splats(film, jobs.size());
   tbb::task_arena arena(threads_);
   arena.execute([&] {
     tbb::parallel_for(size_t(0), jobs.size(), [&](size_t i) {
-      TileCounters tc = render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]));
+      std::vector<Splat> tile_splats;
+      TileCounters tc = render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]),
+                                    light_paths ? &tile_splats : nullptr);
+      if (light_paths) splats.add(i, std::move(tile_splats), job_light_paths(settings, jobs[i]));
       {
         std::lock_guard<std::mutex> lock(counters_mutex);
         counters->add(tc);  // integer sums: order-independent
@@ -67,6 +74,7 @@ void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vec
       if (on_tile_done) on_tile_done(tc.samples);
     });
   });
+  if (light_paths) splats.finish();
   guide_acc.gather();
 }
 
@@ -97,7 +105,8 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
   std::vector<TileJob> tiles;
   const int32_t ts = std::max(1, opt.tile_size);
   for (int32_t y = 0; y < h; y += ts)
-    for (int32_t x = 0; x < w; x += ts) tiles.push_back(TileJob{x, y, std::min(x + ts, w), std::min(y + ts, h), 0, 0});
+    for (int32_t x = 0; x < w; x += ts)
+      tiles.push_back(TileJob{x, y, std::min(x + ts, w), std::min(y + ts, h), 0, 0, static_cast<uint32_t>(tiles.size())});
 
   TileSettings settings = make_tile_settings(opt, stats.specialisation, guide != nullptr);
   stats.guide_learn = opt.guide_learn;

@@ -37,6 +37,9 @@ struct RenderOptions {
   // learned, and the render goes on with the cheaper (master/guide_trial.h).
   bool guide_trial = false;
   bool progress = true;
+  // Caustics of small lights seen through specular surfaces traced from the
+  // lights (kernels/light_paths.h); scene/light_paths.h decides when.
+  bool light_paths = false;
 };
 
 // What one pass did (learning progress shows here when guiding).

@@ -70,6 +70,11 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
   j.add("rays_per_second", rays / secs);
   j.add("mean_path_length", paths > 0 ? c.path.vertices / paths : 0.0);
   j.add("medium_vertices", c.path.medium_vertices);  // scattering events in media (0 without media)
+  // Light-traced caustics (0 unless --light-paths): paths traced, pixel
+  // contributions made, and emitter hits the path tracer left to them.
+  j.add("light_paths", c.path.light_paths);
+  j.add("light_path_splats", c.path.light_splats);
+  j.add("caustic_emission_left_to_light_paths", c.path.caustic_emission_skipped);
   j.add("zero_contribution_fraction", paths > 0 ? c.zero_radiance / paths : 0.0);
   j.add("nonfinite_samples_rejected", c.rejected_nonfinite);
   j.add("negative_samples_clamped", c.rejected_negative);

@@ -315,7 +315,11 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
   } else if (d == "Integrator") {
     std::string type = read_string(tokens, pos, at);
     ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
-    if (type != "path" && type != "volpath") warn("integrator \"" + type + "\" is rendered with \"path\"");
+    scene_.integrator = type;
+    if (type == "bdpt" || type == "mlt" || type == "sppm" || type == "lighttracer")
+      warn("integrator \"" + type + "\" is rendered as \"volpath\" plus caustics traced from the lights (--light-paths)");
+    else if (type != "path" && type != "volpath")
+      warn("integrator \"" + type + "\" is rendered with \"path\"");
     scene_.max_depth = ps.get_int("maxdepth", 5);
     if (scene_.max_depth < 0) fail(at, "maxdepth must not be negative");
     if (type != "path") ps.mark_all_used();

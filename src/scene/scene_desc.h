@@ -110,6 +110,7 @@ struct SceneDesc {
   FilterDesc filter;
   int32_t spp = 16;        // pbrt-v4 default pixelsamples
   int32_t max_depth = 5;   // pbrt-v4 default maxdepth
+  std::string integrator = "volpath";  // the Integrator directive's type (scene/light_paths.h reads it)
   uint64_t seed = 0;       // Sampler "integer seed"
   // Sampler type (kernels/sampler.h): zsobol (pbrt-v4's default), paddedsobol
   // (also drawn for pbrt's global "sobol"), stratified, independent; halton

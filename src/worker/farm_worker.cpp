@@ -31,8 +31,10 @@ void render_pass_tiles(Transport& t, const SceneView& view, const EmbreeTracer& 
         TileWork& w = jobs.jobs[i];
         if (w.pixels.size() != static_cast<size_t>(w.job.x1 - w.job.x0) * (w.job.y1 - w.job.y0))
           throw std::runtime_error("malformed tile job");
-        TileCounters tc =
-            render_tile(view, tracer, guide_acc.for_this_thread(), w.job, TilePixels{w.pixels.data(), w.job.x1 - w.job.x0});
+        w.splats.clear();
+        TileCounters tc = render_tile(view, tracer, guide_acc.for_this_thread(), w.job,
+                                      TilePixels{w.pixels.data(), w.job.x1 - w.job.x0},
+                                      settings.path.light_traced_caustics ? &w.splats : nullptr);
         std::lock_guard<std::mutex> lock(mutex);
         req.counters.add(tc);
       });

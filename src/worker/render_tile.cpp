@@ -1,16 +1,38 @@
 #include "worker/render_tile.h"
 
+#include "kernels/light_paths.h"
+
 #include <array>
+#include <stdexcept>
 #include <utility>
 
 namespace tessera {
 namespace {
 
+// Light paths draw independent numbers of their own (seed, pixel, sample):
+// low discrepancy buys little for one splat per sample.
+SamplerSetup light_path_sampler(const TileSettings& settings) {
+  SamplerSetup setup;
+  setup.kind = SamplerKind::Independent;
+  setup.seed = mix_bits(settings.seed ^ 0x116847a7e5ull);
+  return setup;
+}
+
 template <uint32_t Spec>
 TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, const TileSettings& settings,
-                              const TileJob& job, TilePixels pixels) {
+                              const TileJob& job, TilePixels pixels, std::vector<Splat>* splats) {
   TileCounters tc;
   PathSettings path = settings.path;
+  const bool light_paths = path.light_traced_caustics && splats != nullptr;
+  const SamplerSetup light_sampler = light_path_sampler(settings);
+  auto add_splat = [&](uint64_t pixel, const Rgb& v) {
+    Splat sp;
+    sp.pixel = pixel;
+    sp.value[0] = v.x;
+    sp.value[1] = v.y;
+    sp.value[2] = v.z;
+    splats->push_back(sp);
+  };
   for (int32_t y = job.y0; y < job.y1; ++y) {
     for (int32_t x = job.x0; x < job.x1; ++x) {
       const uint64_t pixel_index = static_cast<uint64_t>(y) * static_cast<uint64_t>(s.camera.width) + x;
@@ -41,13 +63,22 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
         }
         ++acc.n;
         ++tc.samples;
+        if (light_paths) {
+          PixelSampler light_rng = PixelSampler::start(light_sampler, static_cast<uint32_t>(x),
+                                                       static_cast<uint32_t>(y), pixel_index, si);
+          Wavelengths light_wl;
+          if (s.spectral.enabled) light_wl = sample_wavelengths(light_rng.uniform());
+          trace_caustic_light_path<Spec>(s, tracer, light_rng, path, s.spectral.enabled ? &light_wl : nullptr, tc.path,
+                                         add_splat);
+        }
       }
     }
   }
   return tc;
 }
 
-using TileFn = TileCounters (*)(const SceneView&, const EmbreeTracer&, const TileSettings&, const TileJob&, TilePixels);
+using TileFn = TileCounters (*)(const SceneView&, const EmbreeTracer&, const TileSettings&, const TileJob&, TilePixels,
+                                std::vector<Splat>*);
 
 // Media scenes run the full surface integrator (see kSpecMedia): every
 // index with the media bit maps to one of two instantiations.
@@ -67,8 +98,10 @@ constexpr auto kTileFns = make_table(std::make_index_sequence<kSpecAll + 1>{});
 }  // namespace
 
 TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, const TileSettings& settings,
-                         const TileJob& job, TilePixels pixels) {
-  return kTileFns[settings.specialisation & kSpecAll](scene, tracer, settings, job, pixels);
+                         const TileJob& job, TilePixels pixels, std::vector<Splat>* splats) {
+  if (settings.path.light_traced_caustics && !splats)
+    throw std::logic_error("render_tile: light-traced caustics need a splat list");
+  return kTileFns[settings.specialisation & kSpecAll](scene, tracer, settings, job, pixels, splats);
 }
 
 }  // namespace tessera

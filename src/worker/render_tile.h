@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <vector>
 
 #include "kernels/integrator.h"
 #include "master/film.h"
@@ -14,6 +15,7 @@ namespace tessera {
 struct TileJob {
   int32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // [x0, x1) x [y0, y1)
   uint32_t sample_begin = 0, sample_end = 0;
+  uint32_t index = 0;  // the tile's place in the pass: light-path splats are added to the film in this order
 };
 
 // Which samples train the guide, by sample index (so it is the same on every
@@ -73,6 +75,9 @@ struct TileCounters {
     path.guided_roulette += o.path.guided_roulette;
     path.nee_skipped += o.path.nee_skipped;
     path.medium_vertices += o.path.medium_vertices;
+    path.light_paths += o.path.light_paths;
+    path.light_splats += o.path.light_splats;
+    path.caustic_emission_skipped += o.path.caustic_emission_skipped;
     samples += o.samples;
     zero_radiance += o.zero_radiance;
     rejected_nonfinite += o.rejected_nonfinite;
@@ -97,8 +102,18 @@ inline TilePixels film_tile(Film& film, const TileJob& job) { return {&film.at(j
 // Adds samples [sample_begin, sample_end) of every pixel of the job to its
 // accumulators, in sample order. Random streams depend on (seed, pixel index
 // in the whole image, sample index) only, so a tile renders the same
-// wherever it runs.
+// wherever it runs. With light-traced caustics
+// (settings.path.light_traced_caustics) each sample also traces one light
+// path, whose contributions to any pixel of the image are appended to
+// *splats in order (film_add_splats adds them, tile by tile in job order).
 TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, const TileSettings& settings,
-                         const TileJob& job, TilePixels pixels);
+                         const TileJob& job, TilePixels pixels, std::vector<Splat>* splats = nullptr);
+
+// Light paths a job traces: one per camera sample when caustics are light-traced.
+inline uint64_t job_light_paths(const TileSettings& settings, const TileJob& job) {
+  if (!settings.path.light_traced_caustics) return 0;
+  return static_cast<uint64_t>(job.x1 - job.x0) * static_cast<uint64_t>(job.y1 - job.y0) *
+         (job.sample_end - job.sample_begin);
+}
 
 }  // namespace tessera

@@ -90,6 +90,22 @@ TEST(FarmProtocol, UnguidedImageIsBitIdenticalForAnyRankCount) {
   }
 }
 
+// Light-path splats cross tile borders: the master adds each tile's list in
+// tile order, so the image is the local one whatever rank rendered a tile.
+TEST(FarmProtocol, LightPathSplatsAreBitIdenticalForAnyRankCount) {
+  SceneDesc d = load_pbrt_file(testing::source_dir() + "/tests/data/glass-caustic.pbrt");
+  FarmScene fs(std::move(d));
+  fs.opt.light_paths = true;
+  fs.opt.spp = 6;
+  RenderResult local = render(fs.scene, fs.embree, fs.opt);
+  ASSERT_FALSE(local.film.splats.empty());
+  for (int32_t ranks : {1, 2, 3}) {
+    FarmRun farm = render_farm(fs, ranks, false, true);
+    EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
+    EXPECT_EQ(farm.result.stats.counters.path.light_splats, local.stats.counters.path.light_splats);
+  }
+}
+
 TEST(FarmProtocol, SharedGuideGivesTheLocalImageAndFieldOnEveryRank) {
   FarmScene fs(door_ajar());
   auto local_guide = fs.make_guide();

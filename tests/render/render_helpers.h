@@ -34,11 +34,14 @@ inline double image_mean(const ImageRgb& img) {
   return s / img.rgb.size();
 }
 
-// Bit-for-bit equality of two films (sums, second moments, counts).
+// Bit-for-bit equality of two films (sums, second moments, counts, light-path splats).
 inline bool films_identical(const Film& a, const Film& b) {
   if (a.width != b.width || a.height != b.height || a.pixels.size() != b.pixels.size()) return false;
   for (size_t i = 0; i < a.pixels.size(); ++i)
     if (std::memcmp(&a.pixels[i], &b.pixels[i], sizeof(PixelAccum)) != 0) return false;
+  if (a.light_paths != b.light_paths || a.splats.size() != b.splats.size()) return false;
+  for (size_t i = 0; i < a.splats.size(); ++i)
+    if (std::memcmp(&a.splats[i], &b.splats[i], sizeof(SplatAccum)) != 0) return false;
   return true;
 }
 

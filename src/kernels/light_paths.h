@@ -1,0 +1,324 @@
+// Light-traced caustics: the paths a camera path cannot find.
+//
+// A path from a small light through a chain of specular surfaces (glass,
+// mirrors) to a diffuse surface or a medium that the camera sees (L S+ x E)
+// is found by the path tracer only when a direction sampled at x happens to
+// run through the chain and hit the light: for a small light almost never,
+// for a point or spot light never. Traced from the light instead, the chain
+// is deterministic and x is connected to the pinhole directly: pbrt-v4's
+// bdpt strategy t = 1 for exactly these paths.
+//
+// The two estimators split the path space between them, so no MIS is needed.
+// The light tracer takes every path that leaves an area, point or spot light
+// through at least one surface with only delta lobes, and whose first vertex
+// seen from the camera scatters non-specularly (a non-delta lobe, or a
+// medium): it walks from the light through that chain to the first vertex
+// that can scatter non-specularly, y, and on from there as a random walk,
+// connecting y and each later such vertex to the camera. The path tracer
+// skips the emission of exactly those paths (PathSettings::
+// light_traced_caustics): an emitter hit right after a delta-only vertex on a
+// path whose first vertex sampled a non-delta lobe. So light focused by glass
+// into a medium or onto a wall is traced from the light both where the camera
+// sees it directly and where it is seen after further scattering (a fog lit
+// by a caustic).
+//
+// One light path is traced per camera sample, from the sample's own random
+// numbers; its connection is spread over the pixels whose filter covers it
+// (with the density the camera samples are drawn from, so both estimate the
+// same filtered image) and each pixel's sum is divided by the number of light
+// paths traced for the whole image (Film::light_paths).
+//
+// Only a pinhole perspective camera and static scenes: the caller enables it
+// (scene/light_paths.h says when). In spectral transport the light path
+// carries its own three wavelengths, as a camera path does.
+#pragma once
+
+#include "integrator.h"
+
+namespace tessera {
+
+// A point as the pinhole sees it: its raster position, the unit direction
+// from the point to the camera, and the factor that turns radiance leaving
+// the point towards the camera into the filtered pixel value per unit area
+// (volume) of the point: J(w) / d^2, J = d(raster area) / d(solid angle).
+struct FilmProjection {
+  Vec2 raster;
+  Vec3 to_camera;
+  Float dist = 0.f;
+  Float importance = 0.f;
+};
+
+TESSERA_HOST_DEVICE inline bool project_to_film(const CameraView& c, const Vec3& p, FilmProjection* out) {
+  const Vec3 v_world = c.origin - p;
+  const Float dist2 = glm::dot(v_world, v_world);
+  if (!(dist2 > 0.f)) return false;
+  const Mat3& m = c.world_from_camera_linear;
+  const Float det = glm::determinant(m);
+  if (!(glm::abs(det) > 0.f)) return false;
+  const Vec3 q = glm::inverse(m) * (p - c.origin);  // camera space
+  if (!(q.z > 0.f)) return false;
+  const Vec3 d_cam(q.x / q.z, q.y / q.z, 1.f);  // generate_camera_ray's unnormalised direction
+  const Float span_x = c.screen_max.x - c.screen_min.x, span_y = c.screen_max.y - c.screen_min.y;
+  const Float sx = d_cam.x / c.tan_half_fov, sy = d_cam.y / c.tan_half_fov;
+  out->raster = Vec2((sx - c.screen_min.x) / span_x * c.width, (c.screen_max.y - sy) / span_y * c.height);
+  // Plane area at z = 1 per unit of raster area, and the solid angle of a
+  // patch of that plane seen through the (possibly scaled) camera transform.
+  const Float plane_per_raster = (span_x * c.tan_half_fov / c.width) * (span_y * c.tan_half_fov / c.height);
+  const Float len = glm::length(m * d_cam);
+  out->dist = glm::sqrt(dist2);
+  out->to_camera = v_world / out->dist;
+  out->importance = len * len * len / (glm::abs(det) * plane_per_raster) / dist2;
+  return out->importance > 0.f && out->importance < kInfinity;
+}
+
+// Density of the filter's offset distribution along one axis at `offset`:
+// the piecewise-constant density of sample_filter_axis's piecewise-linear
+// inverse cdf (the camera samples' own distribution, so that splats and
+// camera samples weight the image alike).
+TESSERA_HOST_DEVICE inline Float filter_axis_density(const Float* inverse_cdf, uint32_t n, Float offset) {
+  if (n < 2 || !(offset >= inverse_cdf[0]) || !(offset < inverse_cdf[n - 1])) return 0.f;
+  uint32_t lo = 0, hi = n - 1;  // inverse_cdf[lo] <= offset < inverse_cdf[hi]
+  while (hi - lo > 1) {
+    const uint32_t mid = (lo + hi) / 2;
+    if (inverse_cdf[mid] <= offset) lo = mid;
+    else hi = mid;
+  }
+  const Float width = inverse_cdf[hi] - inverse_cdf[lo];
+  return width > 0.f ? 1.f / (static_cast<Float>(n - 1) * width) : 0.f;
+}
+
+// Spreads value (already divided by nothing: a sum over light paths) over
+// the pixels whose filter reaches `raster`, calling sink(pixel index, rgb).
+template <class Sink>
+TESSERA_HOST_DEVICE inline uint32_t splat_filtered(const SceneView& s, Vec2 raster, const Rgb& value, Sink&& sink) {
+  const FilterView& f = s.filter;
+  const int32_t x0 = static_cast<int32_t>(glm::floor(raster.x - 0.5f - f.radius_x));
+  const int32_t x1 = static_cast<int32_t>(glm::floor(raster.x - 0.5f + f.radius_x));
+  const int32_t y0 = static_cast<int32_t>(glm::floor(raster.y - 0.5f - f.radius_y));
+  const int32_t y1 = static_cast<int32_t>(glm::floor(raster.y - 0.5f + f.radius_y));
+  uint32_t splats = 0;
+  for (int32_t y = glm::max(y0, 0); y <= glm::min(y1, s.camera.height - 1); ++y) {
+    const Float dy = raster.y - (y + 0.5f);
+    const Float wy = filter_axis_density(f.inverse_cdf_y, f.n, dy);
+    if (wy == 0.f) continue;
+    for (int32_t x = glm::max(x0, 0); x <= glm::min(x1, s.camera.width - 1); ++x) {
+      const Float dx = raster.x - (x + 0.5f);
+      Float w = wy * filter_axis_density(f.inverse_cdf_x, f.n, dx);
+      if (w == 0.f) continue;
+      if (f.weight_x)
+        w *= filter_axis_weight(f.weight_x, f.bins, dx, f.radius_x) * filter_axis_weight(f.weight_y, f.bins, dy, f.radius_y);
+      sink(static_cast<uint64_t>(y) * static_cast<uint64_t>(s.camera.width) + static_cast<uint64_t>(x), value * w);
+      ++splats;
+    }
+  }
+  return splats;
+}
+
+// pbrt-v4's correction for shading normals in importance transport: the
+// adjoint BSDF of a vertex with shading normal ns and geometric normal ng.
+TESSERA_HOST_DEVICE inline Float shading_normal_correction(const Vec3& wo, const Vec3& wi, const Vec3& ns,
+                                                           const Vec3& ng) {
+  const Float denom = glm::abs(glm::dot(wo, ng)) * glm::abs(glm::dot(wi, ns));
+  return denom > 0.f ? glm::abs(glm::dot(wo, ns)) * glm::abs(glm::dot(wi, ng)) / denom : 0.f;
+}
+
+// Adds a scattering point's light towards the camera (contribution: the
+// light path's weight times the BSDF or phase value and the cosine there) to
+// the pixels that see it. The segment is traced from the camera, in the
+// camera's medium and across interfaces as a camera ray would be, so that it
+// sees the media the path tracer's first segment sees even where a surface's
+// MediumInterface contradicts them.
+template <bool kMedia, class Tracer, class Sink>
+TESSERA_HOST_DEVICE inline void connect_to_camera(const SceneView& s, const Tracer& tracer, const FilmProjection& fp,
+                                                  const Rgb& contribution, const Wavelengths* wl, PathCounters& c,
+                                                  Sink&& sink) {
+  if (is_black(contribution)) return;
+  // Stops short of the point by a relative 1e-4 so as not to hit its own surface.
+  const Rgb tr = light_visibility<kMedia>(s, tracer, s.camera.origin, -fp.to_camera, fp.dist * 0.9999f,
+                                          kMedia ? s.camera_medium : -1, 0.f, c, wl);
+  if (is_black(tr)) return;
+  Rgb radiance = contribution * tr * fp.importance;
+  if (wl) radiance = spectral_to_rgb(s.spectral, *wl, radiance);
+  const Rgb value = film_pixel_value(s.camera, radiance);
+  if (!is_finite(value)) return;
+  c.light_splats += splat_filtered(s, fp.raster, value, sink);
+}
+
+// One light path for the caustic strategy (wl: its wavelengths in spectral
+// transport, else null).
+template <uint32_t Spec, class Tracer, class Sink>
+TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Tracer& tracer, PixelSampler& rng,
+                                                  const PathSettings& settings, Wavelengths* wl, PathCounters& c,
+                                                  Sink&& sink) {
+  constexpr bool kMedia = (Spec & kSpecMedia) != 0;
+  if (s.num_lights == 0) return;
+  ++c.light_paths;
+  const Float u_select = rng.uniform();
+  const Vec2 u_pos = rng.uniform2();
+  const Vec2 u_dir = rng.uniform2();
+  Float pmf = 0.f;
+  const uint32_t li = s.light_select.sample_discrete(u_select, &pmf);
+  if (!(pmf > 0.f)) return;
+  const Light& l = s.lights[li];
+  Ray ray;
+  Rgb beta(0.f);
+  int32_t medium = kMedia ? s.camera_medium : -1;
+  switch (l.type) {
+    case LightType::Area: {
+      const Vec3 b = sample_uniform_triangle(u_pos);
+      const SurfaceHit h = make_surface_hit(s, l.triangle, b.y, b.z);
+      Vec3 n = h.ng;  // the emitting side
+      Float sides = 1.f;
+      Vec2 u = u_dir;
+      if (l.two_sided) {
+        sides = 2.f;
+        if (u.x < 0.5f) {
+          n = -n;
+          u.x *= 2.f;
+        } else {
+          u.x = (u.x - 0.5f) * 2.f;
+        }
+        u.x = glm::min(u.x, 0x1.fffffep-1f);
+      }
+      const Vec3 local = sample_cosine_hemisphere(u);
+      if (!(local.z > 0.f)) return;
+      ray.d = Frame::from_z(n).to_world(local);
+      ray.o = offset_ray_origin(h, ray.d);
+      // Le cos / (pmf * (1 / area) * (cos / pi) / sides)
+      beta = light_emission(s, wl, l, l.L) * (kPi * l.area * sides / pmf);
+      if constexpr (kMedia) medium = medium_after(s, l.triangle, h.ng, ray.d, medium);
+      break;
+    }
+    case LightType::Point:
+      ray.o = l.position;
+      ray.d = sample_uniform_sphere(u_dir);
+      beta = light_emission(s, wl, l, l.L) * (4.f * kPi / pmf);
+      break;
+    case LightType::Spot: {
+      // Uniform in the cone of cos_falloff_end, weighted by the falloff.
+      const Float cos_end = glm::clamp(l.cos_falloff_end, -1.f, 1.f);
+      const Float cos_t = 1.f - u_dir.x * (1.f - cos_end);
+      const Float sin_t = glm::sqrt(glm::max(0.f, 1.f - cos_t * cos_t));
+      const Float phi = 2.f * kPi * u_dir.y;
+      ray.o = l.position;
+      ray.d = Frame::from_z(l.direction).to_world(Vec3(sin_t * glm::cos(phi), sin_t * glm::sin(phi), cos_t));
+      beta = light_emission(s, wl, l, l.L) * (spot_falloff(l, cos_t) * 2.f * kPi * (1.f - cos_end) / pmf);
+      break;
+    }
+    default:
+      return;  // distant and infinite lights: the path tracer's
+  }
+  if (is_black(beta)) return;
+
+  // The walk: first the chain of delta-only surfaces (at least one), then y,
+  // the first vertex that scatters non-specularly, then on as a random walk;
+  // y and every later vertex that can scatter non-specularly is connected to
+  // the camera, as long as the path's vertex count stays within max_depth.
+  int32_t vertices = 0;      // scattering vertices so far (pbrt-v4's depth)
+  bool past_chain = false;   // y reached
+  Float beta_at_y = 0.f;     // roulette after y compares with this
+  int32_t interface_skips = 0;
+  // Continues the walk from a scattering vertex; false ends it.
+  auto roulette = [&]() {
+    if (vertices < 3 + (past_chain ? 0 : vertices)) return true;
+    const Float survive = glm::min(1.f, max_component(beta) / beta_at_y);
+    if (survive >= 1.f) return true;
+    if (!(survive > 0.f) || rng.uniform() >= survive) return false;
+    beta /= survive;
+    return true;
+  };
+  for (;;) {
+    TraceHit hit;
+    ++c.rays;
+    const bool found = tracer.intersect(ray.o, ray.d, kInfinity, &hit, 0.f);
+    if constexpr (kMedia) {
+      if (medium >= 0) {
+        const Medium m = medium_at(s, medium, wl);
+        const Float t_max = found ? hit.t : kInfinity;
+        if (medium_absorbs_only(m)) {
+          beta *= medium_transmittance(s, m, ray.o, ray.d, t_max);
+        } else {
+          const Float u_channel = rng.uniform();
+          const Float u_dist = rng.uniform();
+          const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist);
+          beta *= seg.weight;
+          if (seg.scattered) {
+            if (!past_chain && vertices == 0) return;  // lit directly: next-event estimation's
+            if (!past_chain) beta_at_y = max_component(beta);
+            past_chain = true;
+            if (++vertices > settings.max_depth || is_black(beta)) return;
+            const Vec3 p = ray.o + seg.t * ray.d;
+            FilmProjection fp;
+            if (project_to_film(s.camera, p, &fp)) {
+              const Float phase = henyey_greenstein(glm::dot(-ray.d, fp.to_camera), m.g);
+              connect_to_camera<kMedia>(s, tracer, fp, beta * phase, wl, c, sink);
+            }
+            if (vertices == settings.max_depth || !roulette()) return;
+            Float phase_pdf = 0.f;
+            const Vec3 wi = sample_henyey_greenstein(-ray.d, m.g, rng.uniform2(), &phase_pdf);
+            if (!(phase_pdf > 0.f)) return;  // exact sampling: the weight is 1
+            ray.o = p;
+            ray.d = wi;
+            continue;
+          }
+        }
+        if (is_black(beta)) return;
+      }
+    }
+    if (!found) return;
+    const SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, 0.f);
+    const Vec3 wo = -ray.d;  // towards the light
+    BsdfParams bsdf;
+    const int32_t single_before = wl ? wl->single : -1;
+    if (!resolve_bsdf<Spec>(s, s.triangles[hit.triangle].material, h, wo, &bsdf, wl)) {
+      if (++interface_skips > 256) return;
+      if constexpr (kMedia) medium = medium_after(s, hit.triangle, h.ng, ray.d, medium);
+      ray.o = offset_ray_origin(h, ray.d);
+      continue;
+    }
+    if (wl && wl->single != single_before) beta *= dispersion_mask(wl->single);  // as trace_path
+    SurfaceHit hs = h;
+    if constexpr ((Spec & kSpecTextures) != 0) {
+      if (bsdf.bump >= 0) hs.ns = bumped_shading_normal(s, bsdf.bump, h);
+      else if (bsdf.normal_map >= 0) hs.ns = normal_mapped_shading_normal(s, bsdf.normal_map, h);
+    }
+    const Frame frame = (Spec & kSpecNonDiffuse) && bsdf.alpha_x != bsdf.alpha_y
+                            ? Frame::from_tangent(hs.ns, surface_dpdu(s, hit.triangle))
+                            : Frame::from_z(hs.ns);
+    const uint32_t lobes = (Spec & kSpecNonDiffuse) ? bsdf_lobes(bsdf) : (kLobeReflection | kLobeDiffuse);
+    if (lobes_have_non_specular(lobes)) {
+      if (!past_chain && vertices == 0) return;  // lit directly: next-event estimation's
+      if (!past_chain) beta_at_y = max_component(beta);
+      past_chain = true;
+      if (++vertices > settings.max_depth) return;
+      FilmProjection fp;
+      const Float cos_ng_l = glm::abs(glm::dot(h.ng, wo));
+      if (cos_ng_l > 0.f && project_to_film(s.camera, h.p, &fp)) {
+        // The path tracer's f(to camera, to light) |cos to light| in area measure at this vertex.
+        const Rgb f = eval_f<Spec>(bsdf, frame.to_local(fp.to_camera), frame.to_local(wo));
+        const Float cosines = glm::abs(glm::dot(hs.ns, wo)) * glm::abs(glm::dot(h.ng, fp.to_camera)) / cos_ng_l;
+        connect_to_camera<kMedia>(s, tracer, fp, beta * f * cosines, wl, c, sink);
+      }
+      if (vertices == settings.max_depth || !roulette()) return;
+    } else {
+      // Only delta lobes: a chain vertex, or one on the walk after y; a
+      // camera connection needs one more vertex.
+      if (++vertices + 1 > settings.max_depth) return;
+    }
+    const Vec3 wo_l = frame.to_local(wo);
+    BsdfSample bs;
+    if (!sample_f<Spec>(bsdf, wo_l, rng.uniform(), rng.uniform2(), &bs) || !(bs.pdf > 0.f)) return;
+    const Vec3 wi = frame.to_world(bs.wi);
+    // Importance transport: no 1/eta^2 at refraction (the BSDFs scale for
+    // radiance), and pbrt-v4's shading-normal correction.
+    Float w = abs_cos_theta(bs.wi) / bs.pdf * shading_normal_correction(wo, wi, hs.ns, h.ng);
+    if (bs.lobe & kLobeTransmission) w *= sqr(bs.eta);
+    beta *= bs.f * w;
+    if (is_black(beta) || !is_finite(beta)) return;
+    if constexpr (kMedia) medium = medium_after(s, hit.triangle, h.ng, wi, medium);
+    ray.o = offset_ray_origin(h, wi);
+    ray.d = wi;
+  }
+}
+
+}  // namespace tessera

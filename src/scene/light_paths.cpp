@@ -1,0 +1,40 @@
+#include "scene/light_paths.h"
+
+#include <stdexcept>
+
+namespace tessera {
+
+LightPathsMode light_paths_mode_named(const std::string& name) {
+  if (name == "on") return LightPathsMode::On;
+  if (name == "off") return LightPathsMode::Off;
+  if (name == "auto" || name.empty()) return LightPathsMode::Auto;
+  throw std::invalid_argument("--light-paths: expected auto, on or off, got '" + name + "'");
+}
+
+bool wants_bidirectional(const SceneDesc& desc) {
+  const std::string& i = desc.integrator;
+  return i == "bdpt" || i == "mlt" || i == "sppm" || i == "lighttracer";
+}
+
+std::string light_paths_obstacle(const SceneDesc& desc) {
+  if (desc.camera.lens_radius > 0.f) return "the camera has a lens (depth of field)";
+  if (desc.camera.world_from_camera_end != desc.camera.world_from_camera) return "the camera moves";
+  for (const MeshDesc& m : desc.meshes)
+    if (!m.p_end.empty()) return "a shape moves";
+  bool light = !desc.area_lights.empty();
+  for (const Light& l : desc.lights) light = light || l.type == LightType::Point || l.type == LightType::Spot;
+  if (!light) return "the scene has no area, point or spot light";
+  return "";
+}
+
+bool light_paths_enabled(const SceneDesc& desc, LightPathsMode mode) {
+  if (mode == LightPathsMode::Off) return false;
+  const std::string obstacle = light_paths_obstacle(desc);
+  if (mode == LightPathsMode::On) {
+    if (!obstacle.empty()) throw std::runtime_error("--light-paths on: " + obstacle);
+    return true;
+  }
+  return wants_bidirectional(desc) && obstacle.empty();
+}
+
+}  // namespace tessera
