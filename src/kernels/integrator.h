@@ -318,7 +318,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             L += beta * Le_hit;
           } else {
             Float light_pdf = light_select_pmf(s, guide, prev_cell, static_cast<uint32_t>(info.light)) *
-                              area_light_pdf_from(s, l, prev_p, h.p, cos_l);
+                              area_light_pdf(l.area, glm::length(h.p - prev_p), cos_l);
             L += beta * Le_hit * power_heuristic(prev_scatter_pdf, light_pdf);
             if constexpr (kGuide) note_mis_emission(luminance(Le_hit), light_pdf);
           }

@@ -4,7 +4,6 @@
 
 #include "equal_area.h"
 #include "sampling.h"
-#include "spherical_triangle.h"
 #include "surface.h"
 #include "texture_eval.h"
 
@@ -26,34 +25,11 @@ TESSERA_HOST_DEVICE inline Rgb environment_radiance(const SceneView& s, const Li
 }
 
 // Solid-angle pdf of sampling a point on an area light (triangle of area
-// `area`) at distance dist, seen under cos_l = dot(n_light, -w), by area.
+// `area`) at distance dist, seen under cos_l = dot(n_light, -w).
 TESSERA_HOST_DEVICE inline Float area_light_pdf(Float area, Float dist, Float cos_l) {
   Float c = fabsf(cos_l);
   if (!(area > 0.f) || !(c > 0.f)) return 0.f;
   return dist * dist / (c * area);
-}
-
-// An area light's triangle, in the positions light samples use (the start of
-// the transform interval).
-struct LightTriangle {
-  Vec3 v0, v1, v2;
-};
-TESSERA_HOST_DEVICE inline LightTriangle light_triangle(const SceneView& s, uint32_t tri) {
-  const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
-  return {s.positions[idx[0]], s.positions[idx[1]], s.positions[idx[2]]};
-}
-
-// The solid-angle pdf with which sample_light draws point p_light of area
-// light l from ref_p: uniform in the solid angle where the triangle looks
-// large enough (spherical_triangle.h), else by area. For MIS weights of
-// directions that found the light.
-TESSERA_HOST_DEVICE inline Float area_light_pdf_from(const SceneView& s, const Light& l, const Vec3& ref_p,
-                                                     const Vec3& p_light, Float cos_l) {
-  if (!(fabsf(cos_l) > 0.f)) return 0.f;
-  const LightTriangle t = light_triangle(s, l.triangle);
-  const Float omega = triangle_solid_angle(ref_p, t.v0, t.v1, t.v2);
-  if (samples_by_solid_angle(omega)) return 1.f / omega;
-  return area_light_pdf(l.area, glm::length(p_light - ref_p), cos_l);
 }
 
 TESSERA_HOST_DEVICE inline Float environment_pdf(const SceneView& s, uint32_t light_index, const Vec3& dir_world) {
@@ -77,16 +53,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_
   LightSample ls;
   switch (l.type) {
     case LightType::Area: {
-      const LightTriangle t = light_triangle(s, l.triangle);
-      const Float omega = triangle_solid_angle(ref_p, t.v0, t.v1, t.v2);
-      const bool by_solid_angle = samples_by_solid_angle(omega);
       Vec3 b = sample_uniform_triangle(u);
-      if (by_solid_angle) {
-        Vec3 w;
-        if (!sample_spherical_triangle(ref_p, t.v0, t.v1, t.v2, u, &w)) return false;
-        const Vec2 bary = triangle_barycentrics_along(ref_p, w, t.v0, t.v1, t.v2);
-        b = Vec3(1.f - bary.x - bary.y, bary.x, bary.y);
-      }
       SurfaceHit h = make_surface_hit(s, l.triangle, b.y, b.z);
       const Vec3& p = h.p;
       const Vec3& n = h.ng;  // emission side, oriented as at a hit
@@ -97,7 +64,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_
       ls.wi = d / dist;
       Float cos_l = -glm::dot(n, ls.wi);
       if (!l.two_sided && cos_l <= 0.f) return false;
-      ls.pdf = by_solid_angle ? 1.f / omega : area_light_pdf(l.area, dist, cos_l);
+      ls.pdf = area_light_pdf(l.area, dist, cos_l);
       ls.L = l.L;
       ls.p_light = offset_ray_origin(h, -ls.wi);
       break;
