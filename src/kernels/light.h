@@ -27,6 +27,7 @@ struct Light {
   // luminance(L) * blackbody_norm * B(lambda) / B(peak) instead of L's spectrum.
   Float blackbody_kelvin = 0.f;  // 0: L is an RGB (illuminant spectrum)
   Float blackbody_norm = 0.f;    // 1 / luminance of B / B(peak) (set when the scene is built)
+  int32_t medium = -1;  // Point / Spot: the medium it sits in (pbrt-v4: the outside medium where defined)
 };
 
 }  // namespace tessera

@@ -92,6 +92,10 @@ TESSERA_HOST_DEVICE inline Float filter_axis_density(const Float* inverse_cdf, u
 template <class Sink>
 TESSERA_HOST_DEVICE inline uint32_t splat_filtered(const SceneView& s, Vec2 raster, const Rgb& value, Sink&& sink) {
   const FilterView& f = s.filter;
+  // Points beyond the filter's reach of the image (also: before any int cast).
+  if (!(raster.x > -f.radius_x && raster.x < s.camera.width + f.radius_x && raster.y > -f.radius_y &&
+        raster.y < s.camera.height + f.radius_y))
+    return 0;
   const int32_t x0 = static_cast<int32_t>(glm::floor(raster.x - 0.5f - f.radius_x));
   const int32_t x1 = static_cast<int32_t>(glm::floor(raster.x - 0.5f + f.radius_x));
   const int32_t y0 = static_cast<int32_t>(glm::floor(raster.y - 0.5f - f.radius_y));
@@ -139,7 +143,10 @@ TESSERA_HOST_DEVICE inline void connect_to_camera(const SceneView& s, const Trac
   if (is_black(tr)) return;
   Rgb radiance = contribution * tr * fp.importance;
   if (wl) radiance = spectral_to_rgb(s.spectral, *wl, radiance);
-  const Rgb value = film_pixel_value(s.camera, radiance);
+  // The film's linear response only: a splat is a sum over the image's light
+  // paths, not one sample, so the per-sample maxcomponentvalue clamp does
+  // not apply to it.
+  const Rgb value = s.camera.pixel_from_radiance * radiance;
   if (!is_finite(value)) return;
   c.light_splats += splat_filtered(s, fp.raster, value, sink);
 }
@@ -162,7 +169,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
   const Light& l = s.lights[li];
   Ray ray;
   Rgb beta(0.f);
-  int32_t medium = kMedia ? s.camera_medium : -1;
+  int32_t medium = kMedia ? l.medium : -1;  // point and spot lights: where they were defined
   switch (l.type) {
     case LightType::Area: {
       const Vec3 b = sample_uniform_triangle(u_pos);
@@ -186,7 +193,13 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
       ray.o = offset_ray_origin(h, ray.d);
       // Le cos / (pmf * (1 / area) * (cos / pi) / sides)
       beta = light_emission(s, wl, l, l.L) * (kPi * l.area * sides / pmf);
-      if constexpr (kMedia) medium = medium_after(s, l.triangle, h.ng, ray.d, medium);
+      if constexpr (kMedia) {
+        // The shape's medium on the side the light leaves into.
+        if (s.triangle_media) {
+          const MediumInterface mi = s.triangle_media[l.triangle];
+          medium = is_transition(mi) ? medium_towards(mi, h.ng, ray.d) : mi.outside;
+        }
+      }
       break;
     }
     case LightType::Point:

@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 
 #include <atomic>
+#include <cstring>
 #include <chrono>
 #include <exception>
 #include <mutex>
@@ -72,11 +73,12 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
     if (m.tag != kTagRequest) throw std::runtime_error("rank " + std::to_string(m.source) + ": unexpected message");
     TileRequest req = decode<TileRequest>(m.bytes);
     for (TileWork& w : req.results) {
-      const TileJob& j = w.job;
-      if (j.x0 < 0 || j.y0 < 0 || j.x1 > film.width || j.y1 > film.height ||
-          w.pixels.size() != static_cast<size_t>(j.x1 - j.x0) * (j.y1 - j.y0) || j.index >= jobs.size() ||
+      // Only a job this pass handed out, as it was handed out.
+      if (w.job.index >= jobs.size() || std::memcmp(&w.job, &jobs[w.job.index], sizeof(TileJob)) != 0 ||
+          w.pixels.size() != static_cast<size_t>(w.job.x1 - w.job.x0) * (w.job.y1 - w.job.y0) ||
           (!light_paths && !w.splats.empty()))
         throw std::runtime_error("rank " + std::to_string(m.source) + ": malformed tile result");
+      const TileJob& j = jobs[w.job.index];
       size_t k = 0;
       for (int32_t y = j.y0; y < j.y1; ++y)
         for (int32_t x = j.x0; x < j.x1; ++x) film.at(x, y) = w.pixels[k++];

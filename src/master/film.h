@@ -24,10 +24,12 @@ struct SplatAccum {
   double sum_sq[3] = {0, 0, 0};
 };
 
-// One light path's contribution to one pixel.
+// One light path's contribution to one pixel (each path adds at most one
+// per pixel). Padded explicitly: it travels and is saved as raw bytes.
 struct Splat {
   uint64_t pixel = 0;  // y * width + x
   float value[3] = {0, 0, 0};
+  uint32_t padding = 0;
 };
 
 struct Film {

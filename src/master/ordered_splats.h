@@ -3,7 +3,7 @@
 // depend on thread timing. Each tile's list is handed in when the tile is
 // done and added in tile order (its TileJob::index): the film is the same
 // for any thread or rank count. Lists wait only until the tiles before them
-// are in, so memory stays near one tile's worth per thread.
+// are in: with tiles taken in order (as the executors do), few wait.
 #pragma once
 
 #include <cstdint>

@@ -362,6 +362,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     if (state_.ctm_end != state_.ctm) warn("a moving light is not supported; it stays where it starts");
     if (auto light = make_light(type, ps, ctm, context(at, including_dir))) {
       if (!open_instance_.empty()) warn("lights inside ObjectBegin are not instanced; added once");
+      light->medium = state_.media.outside;  // resolved with the other medium names in resolve_media()
       scene_.lights.push_back(*light);
     }
     ps.report_unused(warnings);
@@ -579,6 +580,7 @@ void PbrtParser::resolve_media() {
     m.media.outside = resolve(m.media.outside);
   }
   scene_.camera_medium = resolve(static_cast<int16_t>(scene_.camera_medium));
+  for (Light& l : scene_.lights) l.medium = resolve(static_cast<int16_t>(l.medium));
 }
 
 SceneDesc PbrtParser::finish(const std::string& file_name, int last_line) {

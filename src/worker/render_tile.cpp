@@ -2,6 +2,7 @@
 
 #include "kernels/light_paths.h"
 
+#include <algorithm>
 #include <array>
 #include <stdexcept>
 #include <utility>
@@ -16,6 +17,24 @@ SamplerSetup light_path_sampler(const TileSettings& settings) {
   setup.kind = SamplerKind::Independent;
   setup.seed = mix_bits(settings.seed ^ 0x116847a7e5ull);
   return setup;
+}
+
+// A light path connects at every vertex after its specular chain and may
+// reach a pixel more than once: its splats there become one, so that the
+// film's second moments are per path (the variance layer needs them so).
+void merge_splats_by_pixel(std::vector<Splat>& splats, size_t first) {
+  if (splats.size() - first < 2) return;
+  std::stable_sort(splats.begin() + static_cast<std::ptrdiff_t>(first), splats.end(),
+                   [](const Splat& a, const Splat& b) { return a.pixel < b.pixel; });
+  size_t out = first;
+  for (size_t i = first + 1; i < splats.size(); ++i) {
+    if (splats[i].pixel == splats[out].pixel) {
+      for (int c = 0; c < 3; ++c) splats[out].value[c] += splats[i].value[c];
+    } else {
+      splats[++out] = splats[i];
+    }
+  }
+  splats.resize(out + 1);
 }
 
 template <uint32_t Spec>
@@ -68,8 +87,10 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
                                                        static_cast<uint32_t>(y), pixel_index, si);
           Wavelengths light_wl;
           if (s.spectral.enabled) light_wl = sample_wavelengths(light_rng.uniform());
+          const size_t first = splats->size();
           trace_caustic_light_path<Spec>(s, tracer, light_rng, path, s.spectral.enabled ? &light_wl : nullptr, tc.path,
                                          add_splat);
+          merge_splats_by_pixel(*splats, first);
         }
       }
     }

@@ -60,8 +60,8 @@ TEST(LightPaths, BdptScenesGetThemUnlessTheCameraOrSceneForbids) {
 // The floor's caustic under a glass ball, found by both estimators: path
 // tracing alone and path tracing plus light paths agree within their noise,
 // and the light paths take part (splats made, emitter hits left to them).
-void expect_same_image_as_path_tracing(SceneDesc desc, double min_error_gain) {
-  desc.spp = 512;
+void expect_same_image_as_path_tracing(SceneDesc desc, double min_error_gain, int32_t spp = 512) {
+  desc.spp = spp;
   const Rendered on = render_with(desc, true), off = render_with(desc, false);
   for (int c = 0; c < 3; ++c) {
     const double sigma = std::hypot(on.sigma[c], off.sigma[c]);
@@ -69,7 +69,7 @@ void expect_same_image_as_path_tracing(SceneDesc desc, double min_error_gain) {
     EXPECT_GT(on.mean[c], 0.05);
   }
   const PathCounters& p = on.result.stats.counters.path;
-  EXPECT_EQ(p.light_paths, 32ull * 32 * 512);
+  EXPECT_EQ(p.light_paths, 32ull * 32 * static_cast<uint64_t>(spp));
   EXPECT_GT(p.light_splats, p.light_paths / 100);
   EXPECT_GT(p.caustic_emission_skipped, 0u);
   EXPECT_EQ(off.result.stats.counters.path.caustic_emission_skipped, 0u);
@@ -110,6 +110,54 @@ AttributeEnd
 )",
                                  "<fog>", ".");
   expect_same_image_as_path_tracing(d, 1.5);
+}
+
+TEST(LightPaths, LightInsideAFogBallSeenFromOutsideAgreesWithPathTracing) {
+  // The fog fills a ball (an "interface" sphere) around the scene; the camera
+  // is outside it, the light inside: light paths start in the light's medium.
+  SceneDesc d = load_pbrt_string(R"(
+Integrator "bdpt" "integer maxdepth" [ 5 ]
+Sampler "independent"
+PixelFilter "box"
+Film "rgb" "integer xresolution" [ 32 ] "integer yresolution" [ 32 ]
+LookAt 0 2.2 -2.2  0 0.3 0  0 1 0
+Camera "perspective" "float fov" [ 40 ]
+WorldBegin
+MakeNamedMedium "fog" "string type" [ "homogeneous" ] "rgb sigma_a" [ 0.1 0.1 0.1 ] "rgb sigma_s" [ 1 1 1 ]
+AttributeBegin
+  MediumInterface "fog" ""
+  Material "interface"
+  Shape "sphere" "float radius" [ 2.5 ]
+AttributeEnd
+AttributeBegin
+  MediumInterface "fog" "fog"
+  Material "diffuse" "rgb reflectance" [ 0.6 0.6 0.6 ]
+  Shape "trianglemesh" "point3 P" [ -1.7 0 -1.7  -1.7 0 1.7  1.7 0 1.7  1.7 0 -1.7 ] "integer indices" [ 0 1 2 0 2 3 ]
+  AreaLightSource "diffuse" "rgb L" [ 40 36 30 ]
+  Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+  Shape "trianglemesh" "point3 P" [ -0.2 1.8 -0.2  0.2 1.8 -0.2  0.2 1.8 0.2  -0.2 1.8 0.2 ] "integer indices" [ 0 1 2 0 2 3 ]
+AttributeEnd
+AttributeBegin
+  MediumInterface "" "fog"
+  Material "dielectric" "float eta" [ 1.5 ]
+  Translate 0 0.8 0
+  Shape "sphere" "float radius" [ 0.35 ]
+AttributeEnd
+)",
+                                 "<fog ball>", ".");
+  expect_same_image_as_path_tracing(d, 1.1, 1536);
+}
+
+// The film's per-sample maxcomponentvalue clamps camera samples; a splat is
+// a sum over all light paths (thousands of times a pixel's radiance), which
+// the clamp must leave alone.
+TEST(LightPaths, FilmClampLeavesSplatsAlone) {
+  SceneDesc d = glass_caustic();
+  d.spp = 64;
+  const Rendered free = render_with(d, true);
+  d.film.max_component_value = 1000.f;
+  const Rendered clamped = render_with(d, true);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(clamped.mean[c], free.mean[c], 0.01 * free.mean[c]) << "channel " << c;
 }
 
 // A spot light aimed at a mirror lights a floor that it cannot reach
