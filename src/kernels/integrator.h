@@ -162,6 +162,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   bool last_vertex_delta_only = false;
   Float prev_scatter_pdf = 0.f;  // pdf of the last sampled direction (the mixture's when guided)
   Vec3 prev_p(0.f);  // last scattering point: MIS on emitter hits measures from it, as NEE does
+  bool prev_in_medium = false;  // whether it was in a medium (sample_light's in_medium)
   int32_t prev_cell = -1;  // guide cell of the last scattering point (its light selection)
   Float eta_scale = 1.f;
   int32_t interface_skips = 0;
@@ -235,7 +236,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
               Float pmf = 0.f;
               const uint32_t li = select_light(s, guide, -1, u_select, &pmf);
               LightSample ls;
-              if (pmf > 0.f && sample_light(s, li, p, u_light, &ls)) {
+              if (pmf > 0.f && sample_light(s, li, p, u_light, &ls, true)) {
                 ls.L = light_emission(s, wl, s.lights[li], ls.L);
                 const Float phase = henyey_greenstein(glm::dot(wo, ls.wi), m.g);
                 const Float tmax = ls.infinite ? kInfinity : glm::length(ls.p_light - p) * 0.9999f;
@@ -261,6 +262,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             prev_scatter_pdf = phase_pdf;
             prev_cell = -1;
             prev_p = p;
+            prev_in_medium = true;
             specular_bounce = false;
             ray.o = p;
             ray.d = wi;
@@ -318,7 +320,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             L += beta * Le_hit;
           } else {
             Float light_pdf = light_select_pmf(s, guide, prev_cell, static_cast<uint32_t>(info.light)) *
-                              area_light_pdf(l.area, glm::length(h.p - prev_p), cos_l);
+                              area_light_pdf_from(s, l, prev_p, h.p, cos_l, prev_in_medium);
             L += beta * Le_hit * power_heuristic(prev_scatter_pdf, light_pdf);
             if constexpr (kGuide) note_mis_emission(luminance(Le_hit), light_pdf);
           }
@@ -537,6 +539,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     ray.o = offset_ray_origin(h, wi);
     ray.d = wi;
     prev_p = h.p;
+    prev_in_medium = false;
     if constexpr (kMedia) medium = medium_after(s, hit.triangle, h.ng, wi, medium);
 
     // Russian roulette after the second bounce: pbrt-v4's rule, on throughput

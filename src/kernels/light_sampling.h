@@ -4,6 +4,7 @@
 
 #include "equal_area.h"
 #include "sampling.h"
+#include "spherical_triangle.h"
 #include "surface.h"
 #include "texture_eval.h"
 
@@ -32,6 +33,32 @@ TESSERA_HOST_DEVICE inline Float area_light_pdf(Float area, Float dist, Float co
   return dist * dist / (c * area);
 }
 
+// An area light's triangle, in the positions light samples use (the start of
+// the transform interval).
+struct LightTriangle {
+  Vec3 v0, v1, v2;
+};
+TESSERA_HOST_DEVICE inline LightTriangle light_triangle(const SceneView& s, uint32_t tri) {
+  const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
+  return {s.positions[idx[0]], s.positions[idx[1]], s.positions[idx[2]]};
+}
+
+// The solid-angle pdf with which sample_light draws point p_light of area
+// light l from ref_p (with the same in_medium): uniform in solid angle from
+// points in media where the triangle looks large enough
+// (spherical_triangle.h), else by area. For the MIS weights of directions
+// that found the light.
+TESSERA_HOST_DEVICE inline Float area_light_pdf_from(const SceneView& s, const Light& l, const Vec3& ref_p,
+                                                     const Vec3& p_light, Float cos_l, bool in_medium) {
+  if (!(fabsf(cos_l) > 0.f)) return 0.f;
+  if (in_medium) {
+    const LightTriangle t = light_triangle(s, l.triangle);
+    const Float omega = triangle_solid_angle(ref_p, t.v0, t.v1, t.v2);
+    if (samples_by_solid_angle(omega)) return 1.f / omega;
+  }
+  return area_light_pdf(l.area, glm::length(p_light - ref_p), cos_l);
+}
+
 TESSERA_HOST_DEVICE inline Float environment_pdf(const SceneView& s, uint32_t light_index, const Vec3& dir_world) {
   const Light& l = s.lights[light_index];
   if (l.image < 0) return kUniformSpherePdf;
@@ -47,13 +74,28 @@ TESSERA_HOST_DEVICE inline Float spot_falloff(const Light& l, Float cos_theta) {
   return t * t * (3.f - 2.f * t);
 }
 
+// in_medium: ref_p is a scattering point in a medium (area lights are then
+// sampled by solid angle where they look large: area_light_pdf_from).
 TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_t light_index, const Vec3& ref_p, Vec2 u,
-                                             LightSample* out) {
+                                             LightSample* out, bool in_medium = false) {
   const Light& l = s.lights[light_index];
   LightSample ls;
   switch (l.type) {
     case LightType::Area: {
       Vec3 b = sample_uniform_triangle(u);
+      Float omega = 0.f;
+      if (in_medium) {
+        const LightTriangle t = light_triangle(s, l.triangle);
+        omega = triangle_solid_angle(ref_p, t.v0, t.v1, t.v2);
+        if (samples_by_solid_angle(omega)) {
+          Vec3 w;
+          if (!sample_spherical_triangle(ref_p, t.v0, t.v1, t.v2, u, &w)) return false;
+          const Vec2 bary = triangle_barycentrics_along(ref_p, w, t.v0, t.v1, t.v2);
+          b = Vec3(1.f - bary.x - bary.y, bary.x, bary.y);
+        } else {
+          omega = 0.f;
+        }
+      }
       SurfaceHit h = make_surface_hit(s, l.triangle, b.y, b.z);
       const Vec3& p = h.p;
       const Vec3& n = h.ng;  // emission side, oriented as at a hit
@@ -64,7 +106,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_
       ls.wi = d / dist;
       Float cos_l = -glm::dot(n, ls.wi);
       if (!l.two_sided && cos_l <= 0.f) return false;
-      ls.pdf = area_light_pdf(l.area, dist, cos_l);
+      ls.pdf = omega > 0.f ? 1.f / omega : area_light_pdf(l.area, dist, cos_l);
       ls.L = l.L;
       ls.p_light = offset_ray_origin(h, -ls.wi);
       break;
