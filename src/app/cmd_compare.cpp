@@ -21,6 +21,10 @@ double own_estimate(const std::string& path, const ImageRgb& mean) {
   if (!var) return -1.0;
   try {
     ErrorEstimate e = estimate_rel_mse(mean, *var);
+    if (e.unusable_pixels > 0)
+      std::fprintf(stderr, "tessera: %s: no error estimate: the variance layer is saturated or not finite in %llu of %llu pixels\n",
+                   path.c_str(), static_cast<unsigned long long>(e.unusable_pixels),
+                   static_cast<unsigned long long>(static_cast<uint64_t>(mean.width) * mean.height));
     return e.valid ? e.rel_mse : -1.0;
   } catch (const std::invalid_argument& ex) {
     throw std::runtime_error(path + ": " + ex.what());

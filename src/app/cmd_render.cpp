@@ -277,6 +277,13 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
   ImageRgb mean = film_mean(r.film), var = film_variance_of_mean(r.film);
   ExrMetadata meta = base_metadata(m, spec);
   add_render_metadata(&meta, r.stats);
+  if (const uint64_t saturated = variance_saturated_pixels(var)) {
+    meta.numbers["variance_saturated_pixels"] = static_cast<double>(saturated);
+    std::fprintf(stderr,
+                 "tessera: warning: the variance layer exceeds the float range in %llu pixels (radiance near 1e19 or "
+                 "more): stored as the largest float; the stats' estimated relMSE (in double) stays valid\n",
+                 static_cast<unsigned long long>(saturated));
+  }
   write_atomically(m.out.exr, [&](const std::string& p) { write_exr(p, mean, &var, meta); });
   std::printf("wrote %s\n", m.out.exr.c_str());
   if (!m.out.preview.empty()) {

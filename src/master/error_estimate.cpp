@@ -46,14 +46,19 @@ ErrorEstimate estimate_rel_mse(const ImageRgb& mean, const ImageRgb& var) {
   for (size_t i = 0; i < n; ++i) {
     const float* m = &mean.rgb[3 * i];
     const float* v = &var.rgb[3 * i];
-    bool finite = true;
-    for (int c = 0; c < 3; ++c) finite = finite && std::isfinite(m[c]) && std::isfinite(v[c]) && v[c] >= 0;
-    if (!finite) continue;
+    bool usable = true;
+    for (int c = 0; c < 3; ++c)
+      usable = usable && std::isfinite(m[c]) && v[c] >= 0 && v[c] < kVarianceSaturated;  // NaN fails too
+    if (!usable) {
+      ++e.unusable_pixels;
+      continue;
+    }
     for (int c = 0; c < 3; ++c) sum += rel_mse_term(m[c], v[c]);
     ++counted;
   }
-  e.valid = counted > 0;
-  e.rel_mse = counted > 0 ? sum / (3.0 * static_cast<double>(counted)) : 0.0;
+  // An estimate that leaves pixels out would pass for a low one: none then.
+  e.valid = counted > 0 && e.unusable_pixels == 0;
+  e.rel_mse = e.valid ? sum / (3.0 * static_cast<double>(counted)) : 0.0;
   return e;
 }
 

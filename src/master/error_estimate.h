@@ -15,8 +15,11 @@ namespace tessera {
 constexpr uint64_t kMinSppForErrorEstimate = 4;
 
 struct ErrorEstimate {
-  bool valid = false;    // false below kMinSppForErrorEstimate samples in some pixel
+  bool valid = false;    // false below kMinSppForErrorEstimate samples in some pixel, or with unusable pixels
   double rel_mse = 0.0;  // estimated relMSE of film_mean(film) (the metric of compare_images)
+  // From images: pixels whose mean is not finite or whose variance is
+  // negative, NaN or saturated (film_variance_of_mean); any makes it invalid.
+  uint64_t unusable_pixels = 0;
 };
 
 // relMSE = mean over pixels and channels of Var[mean] / (F^2 + eps), with

@@ -49,9 +49,22 @@ ImageRgb film_variance_of_mean(const Film& film) {
   ImageRgb img{film.width, film.height, std::vector<float>(film.pixels.size() * 3, 0.f)};
   for (size_t i = 0; i < film.pixels.size(); ++i) {
     if (film.pixels[i].n < 2) continue;
-    for (int c = 0; c < 3; ++c) img.rgb[3 * i + c] = static_cast<float>(pixel_estimate(film, i, c).var_of_mean);
+    for (int c = 0; c < 3; ++c) {
+      // A variance beyond float's range (radiance ~1e20 and up) is stored as
+      // the largest float: saturated, not infinite (variance_saturated()).
+      const double v = pixel_estimate(film, i, c).var_of_mean;
+      img.rgb[3 * i + c] = v < kVarianceSaturated ? static_cast<float>(v) : kVarianceSaturated;
+    }
   }
   return img;
+}
+
+uint64_t variance_saturated_pixels(const ImageRgb& variance) {
+  uint64_t n = 0;
+  for (size_t i = 0; i + 2 < variance.rgb.size(); i += 3)
+    n += !(variance.rgb[i] < kVarianceSaturated && variance.rgb[i + 1] < kVarianceSaturated &&
+           variance.rgb[i + 2] < kVarianceSaturated);
+  return n;
 }
 
 }  // namespace tessera

@@ -65,6 +65,11 @@ struct PixelEstimate {
 PixelEstimate pixel_estimate(const Film& film, size_t i, int c);
 
 ImageRgb film_mean(const Film& film);
+// Variances beyond float's range are stored as kVarianceSaturated.
 ImageRgb film_variance_of_mean(const Film& film);
+
+constexpr float kVarianceSaturated = 3.40282347e+38f;  // the largest float
+// Pixels with a channel whose variance is saturated (or not a number).
+uint64_t variance_saturated_pixels(const ImageRgb& variance);
 
 }  // namespace tessera

@@ -255,6 +255,33 @@ TEST_F(ErrorEstimateCli, CompareReportsEachImagesOwnEstimate) {
   EXPECT_NE(text.output.find("reference noise:"), std::string::npos) << text.output;
 }
 
+// Radiance 1e30: the variance of a pixel's mean (~1e59) does not fit a
+// float. The EXR stores it saturated (the largest float, never Inf) and says
+// how many pixels are; compare then gives no estimate instead of one made
+// from the few pixels left (it said 0 before); the render's own estimate,
+// computed in double, stands.
+TEST_F(ErrorEstimateCli, HugeRadianceSaturatesTheVarianceLayer) {
+  const std::string scene = path("bright.pbrt"), out = path("bright.exr"), stats = path("bright.json");
+  std::ofstream(scene) << "LookAt 0 0 -4  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 40 ]\n"
+                          "Film \"rgb\" \"integer xresolution\" [ 16 ] \"integer yresolution\" [ 16 ]\n"
+                          "Sampler \"independent\" \"integer pixelsamples\" [ 16 ]\nWorldBegin\n"
+                          "LightSource \"infinite\" \"rgb L\" [ 1e30 1e30 1e30 ]\n"
+                          "Material \"diffuse\" \"rgb reflectance\" [ 0.5 0.5 0.5 ]\nShape \"sphere\" \"float radius\" [ 1 ]\n";
+  RunResult r = run("render --guide none --no-preview -o " + out + " --stats " + stats + " " + scene);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("variance layer exceeds the float range"), std::string::npos) << r.output;
+  const std::vector<float> px = exr_channels(out);
+  for (float v : px) ASSERT_TRUE(std::isfinite(v));
+  const double saturated = exr_number(out, "variance_saturated_pixels");
+  EXPECT_GT(saturated, 16.0);
+  EXPECT_LT(saturated, 256.0);  // the background's variance is 0
+  EXPECT_GT(json_number(read_text(stats), "estimated_relmse"), 0.0);
+  RunResult c = run("compare --json " + out + " " + out);
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  EXPECT_EQ(json_number(c.output, "estimated_relmse"), -1.0) << c.output;
+  EXPECT_NE(c.output.find("no error estimate"), std::string::npos) << c.output;
+}
+
 TEST_F(ErrorEstimateCli, CompareSizeMismatch) {
   const std::string a = path("a.exr"), c = path("c.exr");
   ASSERT_EQ(run("render -q --res 24x16 --spp 4 --no-preview -o " + a).exit_code, 0);
