@@ -129,24 +129,27 @@ TEST(ErrorEstimate, ImageOverloadAgreesWithFilm) {
   EXPECT_NEAR(from_image.rel_mse, from_film.rel_mse, 1e-5 * from_film.rel_mse);
 }
 
-TEST(ErrorEstimate, ImageOverloadSkipsNonFinitePixelsAndChecksSizes) {
-  // 2 pixels: pixel 0 mean 2, Var[mean] 0.5 (term 0.5 / (4 - 0.5 + eps));
-  // pixel 1 is NaN in the mean, then Inf in the variance, then negative
-  // variance: each time it is skipped, so the estimate is pixel 0's.
+TEST(ErrorEstimate, ImageOverloadRefusesUnusablePixelsAndChecksSizes) {
+  // 2 pixels: pixel 0 mean 2, Var[mean] 0.5 (term 0.5 / (4 - 0.5 + eps)).
+  // Pixel 1 is then NaN in the mean, Inf, saturated or negative in the
+  // variance: an estimate from pixel 0 alone would pass for the image's, so
+  // there is none, and the pixel is counted.
   ImageRgb mean{2, 1, {2, 2, 2, 1, 1, 1}}, var{2, 1, {0.5f, 0.5f, 0.5f, 0.1f, 0.1f, 0.1f}};
   const double pixel0 = 0.5 / (4.0 - 0.5 + kRelMseEpsilon);
   const double both = (pixel0 + 0.1 / (1.0 - double(0.1f) + kRelMseEpsilon)) / 2.0;
   ErrorEstimate e = estimate_rel_mse(mean, var);
   ASSERT_TRUE(e.valid);
+  EXPECT_EQ(e.unusable_pixels, 0u);
   EXPECT_NEAR(e.rel_mse, both, 1e-7 * both);
-  for (int bad = 0; bad < 3; ++bad) {
+  for (int bad = 0; bad < 4; ++bad) {
     ImageRgb m = mean, v = var;
     if (bad == 0) m.rgb[4] = std::numeric_limits<float>::quiet_NaN();
     if (bad == 1) v.rgb[5] = std::numeric_limits<float>::infinity();
     if (bad == 2) v.rgb[3] = -0.1f;
+    if (bad == 3) v.rgb[4] = kVarianceSaturated;
     e = estimate_rel_mse(m, v);
-    ASSERT_TRUE(e.valid) << bad;
-    EXPECT_NEAR(e.rel_mse, pixel0, 1e-7 * pixel0) << bad;
+    EXPECT_FALSE(e.valid) << bad;
+    EXPECT_EQ(e.unusable_pixels, 1u) << bad;
   }
   // Nothing finite: no estimate.
   ImageRgb nan_mean{1, 1, {std::numeric_limits<float>::quiet_NaN(), 0, 0}};
