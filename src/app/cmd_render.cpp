@@ -23,6 +23,7 @@
 #include "master/stats_json.h"
 #include "scene/sampler_setup.h"
 #include "scene/scene_effects.h"
+#include "app/memory_check.h"
 #include "scene/light_paths.h"
 #include "scene/spectral_choice.h"
 #include "worker/cpu_affinity.h"
@@ -159,6 +160,7 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   check_writable(a.stats, "--stats");
   check_writable(a.checkpoint, "--checkpoint");
   check_writable(a.guide.out, "--guide-out");
+  check_film_memory(desc.film.xres, desc.film.yres, m.opt.light_paths, !a.checkpoint.empty());
   if (!a.snapshot_every.empty()) m.snapshots = parse_snapshot_policy(a.snapshot_every);
   if (scene_bytes) *scene_bytes = encode_scene(desc);
   m.scene = std::make_unique<SceneData>(std::move(desc));

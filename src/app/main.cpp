@@ -1,5 +1,6 @@
 // tessera: physically based rendering with learned path guiding.
 #include <cstdio>
+#include <new>
 #include <exception>
 #include <map>
 
@@ -34,6 +35,9 @@ int main(int argc, char** argv) {
   } catch (const tessera::SceneError& e) {
     std::fprintf(stderr, "tessera: error: %s\n", e.what());
     return 2;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "tessera: error: out of memory (a smaller --res, fewer --threads or a smaller scene may fit)\n");
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tessera: error: %s\n", e.what());
     return 1;

@@ -81,6 +81,23 @@ TEST_F(CliTest, UnwritableOutputsFailBeforeRendering) {
   EXPECT_FALSE(fs::exists(good));
 }
 
+// A film that cannot fit in memory is refused before rendering, naming the
+// resolution and what it needs (it used to render, then die of
+// std::bad_alloc writing the images). The address-space limit stands in for
+// a small machine.
+TEST_F(CliTest, FilmTooLargeForMemoryFailsBeforeRendering) {
+  const std::string out = (dir_ / "big.exr").string();
+  const RunResult r = testing::run_shell("ulimit -v 3000000; " + std::string(TESSERA_BINARY) +
+                                         " render -q --spp 1000000 --res 16384x8192 -o " + out);
+  expect_one_line_error(r, "16384x8192 needs about 10.4 GB for its film (7.0 GB)");
+  EXPECT_NE(r.output.find("of memory is available"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  // The same limit leaves room for an ordinary image.
+  const RunResult ok = testing::run_shell("ulimit -v 3000000; " + std::string(TESSERA_BINARY) +
+                                          " render -q --spp 1 --res 64x64 -o " + out);
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+}
+
 TEST_F(CliTest, BadNumber) {
   auto f = write("bad_number.pbrt", std::string(kHeader) + "Shape \"sphere\" \"float radius\" [ 1.2.3 ]\n");
   expect_one_line_error(run("render -q " + f + " -o " + (dir_ / "x.exr").string()), "bad_number.pbrt:6");
