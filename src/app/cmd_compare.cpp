@@ -22,7 +22,7 @@ double own_estimate(const std::string& path, const ImageRgb& mean) {
   try {
     ErrorEstimate e = estimate_rel_mse(mean, *var);
     if (e.unusable_pixels > 0)
-      std::fprintf(stderr, "tessera: %s: no error estimate: the variance layer is saturated or not finite in %llu of %llu pixels\n",
+      std::fprintf(stderr, "tessera: %s: no error estimate: %llu of %llu pixels have a mean that is not finite or a variance that is negative, saturated or not finite\n",
                    path.c_str(), static_cast<unsigned long long>(e.unusable_pixels),
                    static_cast<unsigned long long>(static_cast<uint64_t>(mean.width) * mean.height));
     return e.valid ? e.rel_mse : -1.0;

@@ -138,6 +138,11 @@ std::unique_ptr<GuideField> guide_from_bytes(const Bytes& bytes, const SceneData
   return std::make_unique<GuideField>(GuideField::load(s, scene.fingerprint()));
 }
 
+// An exception's message for the one-line error ("std::bad_alloc" says little).
+const char* error_text(const std::exception& e) {
+  return dynamic_cast<const std::bad_alloc*>(&e) ? "out of memory" : e.what();
+}
+
 // Everything rank 0 (or a local run) decides before rendering.
 struct MasterSetup {
   std::unique_ptr<SceneData> scene;
@@ -160,7 +165,9 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   check_writable(a.stats, "--stats");
   check_writable(a.checkpoint, "--checkpoint");
   check_writable(a.guide.out, "--guide-out");
-  check_film_memory(desc.film.xres, desc.film.yres, m.opt.light_paths, !a.checkpoint.empty());
+  // A resume holds the checkpoint's film twice more; --guide auto's trial one more.
+  check_film_memory(desc.film.xres, desc.film.yres, m.opt.light_paths, !a.checkpoint.empty(),
+                    (a.resume.empty() ? 0u : 2u) + (a.guide.mode == "auto" ? 1u : 0u));
   if (!a.snapshot_every.empty()) m.snapshots = parse_snapshot_policy(a.snapshot_every);
   if (scene_bytes) *scene_bytes = encode_scene(desc);
   m.scene = std::make_unique<SceneData>(std::move(desc));
@@ -388,7 +395,7 @@ int run_render_farm(const RenderArgs& a) {
     } catch (const std::exception& e) {
       // Printed before the workers hear of it: mpirun may end the job as
       // soon as they exit.
-      std::fprintf(stderr, "tessera: error: %s\n", e.what());
+      std::fprintf(stderr, "tessera: error: %s\n", error_text(e));
       std::fflush(stderr);
       setup = FarmSetup{e.what(), {}, {}};
       Bytes b = encode(setup);
@@ -433,7 +440,7 @@ int run_render_farm(const RenderArgs& a) {
     return 0;
   } catch (const std::exception& e) {
     // A rank that fails mid-render cannot be waited for: end the whole job.
-    std::fprintf(stderr, "tessera: error: rank %d: %s\n", t->rank(), e.what());
+    std::fprintf(stderr, "tessera: error: rank %d: %s\n", t->rank(), error_text(e));
     std::fflush(stderr);
     MpiSession::abort(1);
   }

@@ -1,6 +1,7 @@
 #include "app/memory_check.h"
 
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
@@ -12,13 +13,13 @@
 namespace tessera {
 namespace {
 
-std::optional<uint64_t> mem_available_from_proc() {
+// A /proc/meminfo field in bytes.
+std::optional<uint64_t> meminfo(const std::string& field) {
   std::ifstream f("/proc/meminfo");
-  std::string key;
+  std::string key, unit;
   uint64_t kb = 0;
-  std::string unit;
   while (f >> key >> kb >> unit)
-    if (key == "MemAvailable:") return kb * 1024ull;
+    if (key == field + ":") return kb * 1024ull;
   return std::nullopt;
 }
 
@@ -27,26 +28,36 @@ std::optional<uint64_t> address_space_in_use() {
   std::ifstream f("/proc/self/statm");
   uint64_t pages = 0;
   if (!(f >> pages)) return std::nullopt;
-  return pages * 4096ull;
+  return pages * static_cast<uint64_t>(sysconf(_SC_PAGESIZE));
+}
+
+// What the address-space limit (ulimit -v) leaves; nullopt without one.
+std::optional<uint64_t> address_space_left() {
+  rlimit lim{};
+  if (getrlimit(RLIMIT_AS, &lim) != 0 || lim.rlim_cur == RLIM_INFINITY) return std::nullopt;
+  const uint64_t used = address_space_in_use().value_or(0);
+  return lim.rlim_cur > used ? lim.rlim_cur - used : 0;
+}
+
+std::optional<uint64_t> min_of(std::optional<uint64_t> a, std::optional<uint64_t> b) {
+  if (a && b) return std::min(*a, *b);
+  return a ? a : b;
 }
 
 }  // namespace
 
-std::optional<uint64_t> available_memory_bytes() {
-  std::optional<uint64_t> avail = mem_available_from_proc();
-  rlimit lim{};
-  if (getrlimit(RLIMIT_AS, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY) {
-    const uint64_t used = address_space_in_use().value_or(0);
-    const uint64_t left = lim.rlim_cur > used ? lim.rlim_cur - used : 0;
-    avail = avail ? std::min(*avail, left) : left;
-  }
-  return avail;
+std::optional<uint64_t> available_memory_bytes() { return min_of(meminfo("MemAvailable"), address_space_left()); }
+
+std::optional<uint64_t> memory_limit_bytes() {
+  std::optional<uint64_t> total = meminfo("MemTotal");
+  if (total) *total += meminfo("SwapTotal").value_or(0);
+  return min_of(total, address_space_left());
 }
 
-FilmMemory film_memory(int64_t width, int64_t height, bool light_paths, bool checkpoints) {
+FilmMemory film_memory(int64_t width, int64_t height, bool light_paths, bool checkpoints, uint32_t extra_films) {
   const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
   FilmMemory m;
-  m.film = pixels * (sizeof(PixelAccum) + (light_paths ? sizeof(SplatAccum) : 0));
+  m.film = pixels * (sizeof(PixelAccum) + (light_paths ? sizeof(SplatAccum) : 0)) * (1 + extra_films);
   // Mean and variance images (3 floats each) and the 8-bit preview.
   m.outputs = pixels * (2 * 3 * sizeof(float) + 3);
   // A checkpoint serialises the film into one buffer, then writes it.
@@ -61,15 +72,20 @@ std::string format_bytes(uint64_t bytes) {
   return b;
 }
 
-void check_film_memory(int64_t width, int64_t height, bool light_paths, bool checkpoints) {
-  const std::optional<uint64_t> avail = available_memory_bytes();
-  if (!avail) return;
-  const FilmMemory need = film_memory(width, height, light_paths, checkpoints);
-  if (need.total() <= *avail / 10 * 9) return;
-  throw std::runtime_error(std::to_string(width) + "x" + std::to_string(height) + " needs about " +
+void check_film_memory(int64_t width, int64_t height, bool light_paths, bool checkpoints, uint32_t extra_films) {
+  const FilmMemory need = film_memory(width, height, light_paths, checkpoints, extra_films);
+  const std::string what = std::to_string(width) + "x" + std::to_string(height) + " needs about " +
                            format_bytes(need.total()) + " for its film (" + format_bytes(need.film) +
-                           ") and output images (" + format_bytes(need.outputs) + "), but only " +
-                           format_bytes(*avail) + " of memory is available: lower --res");
+                           ") and output images (" + format_bytes(need.outputs) + ")";
+  // Beyond all the memory there is (swap and ulimit -v included): refused.
+  const std::optional<uint64_t> limit = memory_limit_bytes();
+  if (limit && need.total() > *limit / 10 * 9)
+    throw std::runtime_error(what + ", more than the " + format_bytes(*limit) + " of memory this process may use: lower --res");
+  // Beyond what is free now: it may still fit once caches are dropped or
+  // memory is swapped out, so only a warning.
+  const std::optional<uint64_t> avail = available_memory_bytes();
+  if (avail && need.total() > *avail)
+    std::fprintf(stderr, "tessera: warning: %s, more than the %s of memory available now\n", what.c_str(),
+                 format_bytes(*avail).c_str());
 }
-
 }  // namespace tessera

@@ -51,7 +51,7 @@ ImageRgb film_variance_of_mean(const Film& film) {
     if (film.pixels[i].n < 2) continue;
     for (int c = 0; c < 3; ++c) {
       // A variance beyond float's range (radiance ~1e20 and up) is stored as
-      // the largest float: saturated, not infinite (variance_saturated()).
+      // the largest float: saturated, not infinite (variance_saturated_pixels()).
       const double v = pixel_estimate(film, i, c).var_of_mean;
       img.rgb[3 * i + c] = v < kVarianceSaturated ? static_cast<float>(v) : kVarianceSaturated;
     }

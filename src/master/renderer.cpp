@@ -63,19 +63,26 @@ void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vec
   // Threads take tiles in order, so that light-path splats wait for few
   // earlier tiles (OrderedSplats).
   std::atomic<size_t> next{0};
+  std::atomic<bool> failed{false};  // a tile threw: the others stop taking tiles
+  auto render_one = [&](size_t i) {
+    std::vector<Splat> tile_splats;
+    TileCounters tc = render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]),
+                                  light_paths ? &tile_splats : nullptr);
+    if (light_paths) splats.add(i, std::move(tile_splats), job_light_paths(settings, jobs[i]));
+    {
+      std::lock_guard<std::mutex> lock(counters_mutex);
+      counters->add(tc);  // integer sums: order-independent
+    }
+    if (on_tile_done) on_tile_done(tc.samples);
+  };
   tbb::task_arena arena(threads_);
   arena.execute([&] {
     tbb::parallel_for(0, threads_, [&](int32_t) {
-      for (size_t i = next.fetch_add(1); i < jobs.size(); i = next.fetch_add(1)) {
-        std::vector<Splat> tile_splats;
-        TileCounters tc = render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]),
-                                      light_paths ? &tile_splats : nullptr);
-        if (light_paths) splats.add(i, std::move(tile_splats), job_light_paths(settings, jobs[i]));
-        {
-          std::lock_guard<std::mutex> lock(counters_mutex);
-          counters->add(tc);  // integer sums: order-independent
-        }
-        if (on_tile_done) on_tile_done(tc.samples);
+      try {
+        for (size_t i = next.fetch_add(1); i < jobs.size() && !failed; i = next.fetch_add(1)) render_one(i);
+      } catch (...) {
+        failed = true;
+        throw;
       }
     });
   });

@@ -312,6 +312,7 @@ uint64_t SceneData::fingerprint() const {
     f.add_vector(triangle_media_);
     f.add_vector(desc_.media);
     f.add(&desc_.camera_medium, sizeof desc_.camera_medium);
+    for (const Light& l : lights_) f.add(&l.medium, sizeof l.medium);
     for (const GridDesc& g : desc_.grids) {
       f.add_vector(g.density);
       f.add(&g.medium_from_world, sizeof g.medium_from_world);
