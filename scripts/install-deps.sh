@@ -13,6 +13,7 @@ PACKAGES=(
   libtbb-dev                      # CPU parallelism
   libgtest-dev                    # tests
   libcli11-dev                    # command line
+  nlohmann-json3-dev              # stats and compare JSON
   zlib1g-dev                      # .ply.gz meshes
   libopenimageio-dev              # texture and environment images (EXR, PFM, PNG, TGA, HDR...)
   libstb-dev                      # PNG/JPEG read, PNG write

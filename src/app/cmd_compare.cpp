@@ -2,6 +2,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
+
 #include "app/commands.h"
 #include "master/error_estimate.h"
 #include "master/image_metrics.h"
@@ -44,20 +46,27 @@ int run_compare(const std::string& image, const std::string& reference, bool jso
   // From the variance layers: the error the image expects of itself, and the
   // reference's own noise, which the measured relMSE includes (about additively).
   const double image_est = own_estimate(image, a), reference_est = own_estimate(reference, f);
-  // JSON has no NaN: null says no block was bright enough to judge.
-  char worst[32] = "null";
-  if (b.judged_blocks > 0) std::snprintf(worst, sizeof worst, "%.6g", b.worst_ratio);
   if (json) {
-    std::printf("{\"relmse\": %.9g, \"mape\": %.9g, \"rmse\": %.9g, \"estimated_relmse\": %.9g, "
-                "\"reference_estimated_relmse\": %.9g, \"nonfinite_pixels\": %llu, "
-                "\"reference_nonfinite_pixels\": %llu, \"pixels\": %llu, \"mean_rgb\": [%.6g, %.6g, %.6g], "
-                "\"reference_mean_rgb\": [%.6g, %.6g, %.6g], \"block\": %d, \"blocks_judged\": %llu, "
-                "\"worst_block_ratio\": %s, \"worst_block_x\": %d, \"worst_block_y\": %d, \"blocks_off_fraction\": %.6g}\n",
-                e.rel_mse, e.mape, e.rmse, image_est, reference_est, static_cast<unsigned long long>(e.nonfinite_pixels),
-                static_cast<unsigned long long>(e.reference_nonfinite_pixels), static_cast<unsigned long long>(e.pixels),
-                e.mean_image[0], e.mean_image[1], e.mean_image[2], e.mean_reference[0], e.mean_reference[1],
-                e.mean_reference[2], b.block, static_cast<unsigned long long>(b.judged_blocks), worst, b.worst_x,
-                b.worst_y, b.fraction_off);
+    // nlohmann-json writes a number that is not finite as null; a worst
+    // block ratio of null says no block was bright enough to judge.
+    nlohmann::ordered_json j;
+    j["relmse"] = e.rel_mse;
+    j["mape"] = e.mape;
+    j["rmse"] = e.rmse;
+    j["estimated_relmse"] = image_est;
+    j["reference_estimated_relmse"] = reference_est;
+    j["nonfinite_pixels"] = e.nonfinite_pixels;
+    j["reference_nonfinite_pixels"] = e.reference_nonfinite_pixels;
+    j["pixels"] = e.pixels;
+    j["mean_rgb"] = {e.mean_image[0], e.mean_image[1], e.mean_image[2]};
+    j["reference_mean_rgb"] = {e.mean_reference[0], e.mean_reference[1], e.mean_reference[2]};
+    j["block"] = b.block;
+    j["blocks_judged"] = b.judged_blocks;
+    j["worst_block_ratio"] = b.judged_blocks > 0 ? nlohmann::ordered_json(b.worst_ratio) : nlohmann::ordered_json();
+    j["worst_block_x"] = b.worst_x;
+    j["worst_block_y"] = b.worst_y;
+    j["blocks_off_fraction"] = b.fraction_off;
+    std::printf("%s\n", j.dump().c_str());
   } else {
     std::printf("relMSE:           %.6g\n", e.rel_mse);
     std::printf("MAPE:             %.6g\n", e.mape);
