@@ -28,6 +28,11 @@ void add_render_metadata(ExrMetadata* meta, const RenderStats& s) {
   meta->strings["guide"] = s.guide_mode;
 }
 
+void add_variance_metadata(ExrMetadata* meta, const ImageRgb& variance) {
+  if (const uint64_t saturated = variance_saturated_pixels(variance))
+    meta->numbers["variance_saturated_pixels"] = static_cast<double>(saturated);
+}
+
 void write_exr(const std::string& path, const ImageRgb& mean, const ImageRgb* variance, const ExrMetadata& meta) {
   try {
     Imf::Header header(mean.width, mean.height);

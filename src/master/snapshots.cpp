@@ -68,6 +68,7 @@ void SnapshotWriter::on_pass_end(const RenderResult& so_far) {
   add_render_metadata(&meta, s);
   meta.numbers["render_seconds"] = r.render_seconds;
   const ImageRgb mean = film_mean(so_far.film), var = film_variance_of_mean(so_far.film);
+  add_variance_metadata(&meta, var);
   write_exr(r.file, mean, &var, meta);
 
   const std::string csv = (std::filesystem::path(dir_) / "snapshots.csv").string();

@@ -267,7 +267,7 @@ TEST_F(ErrorEstimateCli, HugeRadianceSaturatesTheVarianceLayer) {
                           "Sampler \"independent\" \"integer pixelsamples\" [ 16 ]\nWorldBegin\n"
                           "LightSource \"infinite\" \"rgb L\" [ 1e30 1e30 1e30 ]\n"
                           "Material \"diffuse\" \"rgb reflectance\" [ 0.5 0.5 0.5 ]\nShape \"sphere\" \"float radius\" [ 1 ]\n";
-  RunResult r = run("render --guide none --no-preview -o " + out + " --stats " + stats + " " + scene);
+  RunResult r = run("render --guide none --no-preview --snapshot-every doubling -o " + out + " --stats " + stats + " " + scene);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("variance layer exceeds the float range"), std::string::npos) << r.output;
   const std::vector<float> px = exr_channels(out);
@@ -275,6 +275,8 @@ TEST_F(ErrorEstimateCli, HugeRadianceSaturatesTheVarianceLayer) {
   const double saturated = exr_number(out, "variance_saturated_pixels");
   EXPECT_GT(saturated, 16.0);
   EXPECT_LT(saturated, 256.0);  // the background's variance is 0
+  // Snapshots say so too.
+  EXPECT_EQ(exr_number(path("bright-snapshots/bright-000016spp.exr"), "variance_saturated_pixels"), saturated);
   EXPECT_GT(json_number(read_text(stats), "estimated_relmse"), 0.0);
   RunResult c = run("compare --json " + out + " " + out);
   ASSERT_EQ(c.exit_code, 0) << c.output;
