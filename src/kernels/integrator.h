@@ -100,6 +100,24 @@ TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, const Vec3& wo, Fl
   }
 }
 
+// The shading frame at a hit: the material's bump or normal map applied to
+// h.ns first (kSpecTextures). Anisotropic BSDFs need pbrt's orientation (x
+// along dp/du); any frame around the normal serves the isotropic ones.
+template <uint32_t Spec>
+TESSERA_HOST_DEVICE inline Frame shading_frame(const SceneView& s, const BsdfParams& bsdf, SurfaceHit& h) {
+  if constexpr ((Spec & kSpecTextures) != 0) {
+    if (bsdf.bump >= 0) h.ns = bumped_shading_normal(s, bsdf.bump, h);
+    else if (bsdf.normal_map >= 0) h.ns = normal_mapped_shading_normal(s, bsdf.normal_map, h);
+  }
+  return (Spec & kSpecNonDiffuse) && bsdf.alpha_x != bsdf.alpha_y ? Frame::from_tangent(h.ns, surface_dpdu(s, h.triangle))
+                                                                  : Frame::from_z(h.ns);
+}
+
+template <uint32_t Spec>
+TESSERA_HOST_DEVICE inline uint32_t lobes_of(const BsdfParams& b) {
+  return (Spec & kSpecNonDiffuse) ? bsdf_lobes(b) : (kLobeReflection | kLobeDiffuse);
+}
+
 // Radiance arriving along the ray; consumes random numbers from rng in a fixed order.
 //
 // With kSpecMedia the path also scatters in participating media (pbrt-v4's
@@ -346,18 +364,9 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       rr_beta *= mask;
     }
 
-    if constexpr ((Spec & kSpecTextures) != 0) {
-      if (bsdf.bump >= 0) h.ns = bumped_shading_normal(s, bsdf.bump, h);
-      else if (bsdf.normal_map >= 0) h.ns = normal_mapped_shading_normal(s, bsdf.normal_map, h);
-    }
-
-    // Anisotropic BSDFs need pbrt's orientation (x along dp/du); any frame
-    // around the normal serves the isotropic ones.
-    Frame frame = (Spec & kSpecNonDiffuse) && bsdf.alpha_x != bsdf.alpha_y
-                      ? Frame::from_tangent(h.ns, surface_dpdu(s, hit.triangle))
-                      : Frame::from_z(h.ns);
+    const Frame frame = shading_frame<Spec>(s, bsdf, h);
     Vec3 wo_l = frame.to_local(wo);
-    uint32_t lobes = (Spec & kSpecNonDiffuse) ? bsdf_lobes(bsdf) : (kLobeReflection | kLobeDiffuse);
+    const uint32_t lobes = lobes_of<Spec>(bsdf);
     const bool delta_lobe = (lobes & kLobeSpecular) != 0;
 
     int32_t cell = -1;

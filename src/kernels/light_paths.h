@@ -87,7 +87,8 @@ TESSERA_HOST_DEVICE inline Float filter_axis_density(const Float* inverse_cdf, u
   return width > 0.f ? 1.f / (static_cast<Float>(n - 1) * width) : 0.f;
 }
 
-// Spreads value (already divided by nothing: a sum over light paths) over
+// Spreads value (one light path's contribution, before the division by the
+// image's light-path count) over
 // the pixels whose filter reaches `raster`, calling sink(pixel index, rgb).
 template <class Sink>
 TESSERA_HOST_DEVICE inline uint32_t splat_filtered(const SceneView& s, Vec2 raster, const Rgb& value, Sink&& sink) {
@@ -231,9 +232,20 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
   bool past_chain = false;   // y reached
   Float beta_at_y = 0.f;     // roulette after y compares with this
   int32_t interface_skips = 0;
-  // Continues the walk from a scattering vertex; false ends it.
+  // A vertex that can scatter non-specularly: y if none came before (one
+  // reached straight from the light is next-event estimation's), counted
+  // against max_depth. False ends the walk.
+  auto reach_scattering_vertex = [&]() {
+    if (!past_chain) {
+      if (vertices == 0) return false;
+      beta_at_y = max_component(beta);
+      past_chain = true;
+    }
+    return ++vertices <= settings.max_depth;
+  };
+  // Continues the walk from a scattering vertex past y; false ends it.
   auto roulette = [&]() {
-    if (vertices < 3 + (past_chain ? 0 : vertices)) return true;
+    if (vertices < 3) return true;
     const Float survive = glm::min(1.f, max_component(beta) / beta_at_y);
     if (survive >= 1.f) return true;
     if (!(survive > 0.f) || rng.uniform() >= survive) return false;
@@ -256,10 +268,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
           const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist);
           beta *= seg.weight;
           if (seg.scattered) {
-            if (!past_chain && vertices == 0) return;  // lit directly: next-event estimation's
-            if (!past_chain) beta_at_y = max_component(beta);
-            past_chain = true;
-            if (++vertices > settings.max_depth || is_black(beta)) return;
+            if (!reach_scattering_vertex() || is_black(beta)) return;
             const Vec3 p = ray.o + seg.t * ray.d;
             FilmProjection fp;
             if (project_to_film(s.camera, p, &fp)) {
@@ -279,7 +288,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
       }
     }
     if (!found) return;
-    const SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, 0.f);
+    SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, 0.f);
     const Vec3 wo = -ray.d;  // towards the light
     BsdfParams bsdf;
     const int32_t single_before = wl ? wl->single : -1;
@@ -290,26 +299,15 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
       continue;
     }
     if (wl && wl->single != single_before) beta *= dispersion_mask(wl->single);  // as trace_path
-    SurfaceHit hs = h;
-    if constexpr ((Spec & kSpecTextures) != 0) {
-      if (bsdf.bump >= 0) hs.ns = bumped_shading_normal(s, bsdf.bump, h);
-      else if (bsdf.normal_map >= 0) hs.ns = normal_mapped_shading_normal(s, bsdf.normal_map, h);
-    }
-    const Frame frame = (Spec & kSpecNonDiffuse) && bsdf.alpha_x != bsdf.alpha_y
-                            ? Frame::from_tangent(hs.ns, surface_dpdu(s, hit.triangle))
-                            : Frame::from_z(hs.ns);
-    const uint32_t lobes = (Spec & kSpecNonDiffuse) ? bsdf_lobes(bsdf) : (kLobeReflection | kLobeDiffuse);
-    if (lobes_have_non_specular(lobes)) {
-      if (!past_chain && vertices == 0) return;  // lit directly: next-event estimation's
-      if (!past_chain) beta_at_y = max_component(beta);
-      past_chain = true;
-      if (++vertices > settings.max_depth) return;
+    const Frame frame = shading_frame<Spec>(s, bsdf, h);
+    if (lobes_have_non_specular(lobes_of<Spec>(bsdf))) {
+      if (!reach_scattering_vertex()) return;
       FilmProjection fp;
       const Float cos_ng_l = glm::abs(glm::dot(h.ng, wo));
       if (cos_ng_l > 0.f && project_to_film(s.camera, h.p, &fp)) {
         // The path tracer's f(to camera, to light) |cos to light| in area measure at this vertex.
         const Rgb f = eval_f<Spec>(bsdf, frame.to_local(fp.to_camera), frame.to_local(wo));
-        const Float cosines = glm::abs(glm::dot(hs.ns, wo)) * glm::abs(glm::dot(h.ng, fp.to_camera)) / cos_ng_l;
+        const Float cosines = glm::abs(glm::dot(h.ns, wo)) * glm::abs(glm::dot(h.ng, fp.to_camera)) / cos_ng_l;
         connect_to_camera<kMedia>(s, tracer, fp, beta * f * cosines, wl, c, sink);
       }
       if (vertices == settings.max_depth || !roulette()) return;
@@ -324,7 +322,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
     const Vec3 wi = frame.to_world(bs.wi);
     // Importance transport: no 1/eta^2 at refraction (the BSDFs scale for
     // radiance), and pbrt-v4's shading-normal correction.
-    Float w = abs_cos_theta(bs.wi) / bs.pdf * shading_normal_correction(wo, wi, hs.ns, h.ng);
+    Float w = abs_cos_theta(bs.wi) / bs.pdf * shading_normal_correction(wo, wi, h.ns, h.ng);
     if (bs.lobe & kLobeTransmission) w *= sqr(bs.eta);
     beta *= bs.f * w;
     if (is_black(beta) || !is_finite(beta)) return;
