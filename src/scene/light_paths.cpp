@@ -11,10 +11,11 @@ LightPathsMode light_paths_mode_named(const std::string& name) {
   throw std::invalid_argument("--light-paths: expected auto, on or off, got '" + name + "'");
 }
 
-bool wants_bidirectional(const SceneDesc& desc) {
-  const std::string& i = desc.integrator;
-  return i == "bdpt" || i == "mlt" || i == "sppm" || i == "lighttracer";
+bool bidirectional_integrator(const std::string& type) {
+  return type == "bdpt" || type == "mlt" || type == "sppm" || type == "lighttracer";
 }
+
+bool wants_bidirectional(const SceneDesc& desc) { return bidirectional_integrator(desc.integrator); }
 
 std::string light_paths_obstacle(const SceneDesc& desc) {
   if (desc.camera.lens_radius > 0.f) return "the camera has a lens (depth of field)";

@@ -23,7 +23,9 @@ std::string light_paths_obstacle(const SceneDesc& desc);
 // Whether to trace light paths. Throws for On when light_paths_obstacle says no.
 bool light_paths_enabled(const SceneDesc& desc, LightPathsMode mode);
 
-// Whether the scene's Integrator directive asks for a bidirectional method.
+// Whether an Integrator type is a bidirectional method (bdpt, mlt, sppm, lighttracer).
+bool bidirectional_integrator(const std::string& type);
+// Whether the scene's Integrator directive asks for one.
 bool wants_bidirectional(const SceneDesc& desc);
 
 }  // namespace tessera

@@ -8,6 +8,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "scene/light_paths.h"
 #include "scene/pbrt_film.h"
 #include "scene/pbrt_lights.h"
 #include "scene/pbrt_materials.h"
@@ -316,7 +317,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     std::string type = read_string(tokens, pos, at);
     ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
     scene_.integrator = type;
-    if (type == "bdpt" || type == "mlt" || type == "sppm" || type == "lighttracer")
+    if (bidirectional_integrator(type))
       warn("integrator \"" + type + "\" is rendered as \"volpath\" plus caustics traced from the lights (--light-paths)");
     else if (type != "path" && type != "volpath")
       warn("integrator \"" + type + "\" is rendered with \"path\"");
