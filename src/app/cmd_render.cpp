@@ -286,8 +286,7 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
   ImageRgb mean = film_mean(r.film), var = film_variance_of_mean(r.film);
   ExrMetadata meta = base_metadata(m, spec);
   add_render_metadata(&meta, r.stats);
-  add_variance_metadata(&meta, var);
-  if (const uint64_t saturated = variance_saturated_pixels(var)) {
+  if (const uint64_t saturated = add_variance_metadata(&meta, var)) {
     std::fprintf(stderr,
                  "tessera: warning: the variance layer exceeds the float range in %llu pixels (radiance near 1e19 or "
                  "more): stored as the largest float; the stats' estimated relMSE (in double) stays valid\n",

@@ -28,9 +28,10 @@ void add_render_metadata(ExrMetadata* meta, const RenderStats& s) {
   meta->strings["guide"] = s.guide_mode;
 }
 
-void add_variance_metadata(ExrMetadata* meta, const ImageRgb& variance) {
-  if (const uint64_t saturated = variance_saturated_pixels(variance))
-    meta->numbers["variance_saturated_pixels"] = static_cast<double>(saturated);
+uint64_t add_variance_metadata(ExrMetadata* meta, const ImageRgb& variance) {
+  const uint64_t saturated = variance_saturated_pixels(variance);
+  if (saturated) meta->numbers["variance_saturated_pixels"] = static_cast<double>(saturated);
+  return saturated;
 }
 
 void write_exr(const std::string& path, const ImageRgb& mean, const ImageRgb* variance, const ExrMetadata& meta) {

@@ -20,8 +20,9 @@ struct ExrMetadata {
 // What a render's image records about how it was made: samples, time,
 // stop reason, estimated relMSE (and the target asked for), guide mode.
 void add_render_metadata(ExrMetadata* meta, const RenderStats& stats);
-// variance_saturated_pixels, where the variance layer has any (film.h).
-void add_variance_metadata(ExrMetadata* meta, const ImageRgb& variance);
+// variance_saturated_pixels, where the variance layer has any (film.h);
+// returns their number.
+uint64_t add_variance_metadata(ExrMetadata* meta, const ImageRgb& variance);
 
 // Channels R, G, B (the mean) and, when variance is given, variance.R/G/B
 // (variance of the pixel mean). Throws std::runtime_error naming the path.
