@@ -79,15 +79,33 @@ void expect_same_image_as_path_tracing(SceneDesc desc, double min_error_gain, in
 
 TEST(LightPaths, CausticOnAFloorAgreesWithPathTracing) { expect_same_image_as_path_tracing(glass_caustic(), 4.0); }
 
-TEST(LightPaths, CausticInFogAgreesWithPathTracing) {
-  // The same ball in a thin fog filling the space: light focused into the
-  // medium, scattered there and seen after further bounces.
-  SceneDesc d = load_pbrt_string(R"(
+// The fog scenes' shared parts: the view, the lamp (inside an
+// AttributeBegin of the caller's) and the glass ball in the fog.
+constexpr const char* kFogView = R"(
 Integrator "bdpt" "integer maxdepth" [ 5 ]
 Sampler "independent"
 PixelFilter "box"
 Film "rgb" "integer xresolution" [ 32 ] "integer yresolution" [ 32 ]
 LookAt 0 2.2 -2.2  0 0.3 0  0 1 0
+)";
+constexpr const char* kLamp = R"(
+  AreaLightSource "diffuse" "rgb L" [ 40 36 30 ]
+  Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+  Shape "trianglemesh" "point3 P" [ -0.2 1.8 -0.2  0.2 1.8 -0.2  0.2 1.8 0.2  -0.2 1.8 0.2 ] "integer indices" [ 0 1 2 0 2 3 ]
+)";
+constexpr const char* kBallInFog = R"(
+AttributeBegin
+  MediumInterface "" "fog"
+  Material "dielectric" "float eta" [ 1.5 ]
+  Translate 0 0.8 0
+  Shape "sphere" "float radius" [ 0.35 ]
+AttributeEnd
+)";
+
+TEST(LightPaths, CausticInFogAgreesWithPathTracing) {
+  // The same ball in a thin fog filling the space: light focused into the
+  // medium, scattered there and seen after further bounces.
+  SceneDesc d = load_pbrt_string(std::string(kFogView) + R"(
 MakeNamedMedium "fog" "string type" [ "homogeneous" ] "rgb sigma_a" [ 0.05 0.05 0.05 ] "rgb sigma_s" [ 0.3 0.3 0.3 ]
 MediumInterface "" "fog"
 Camera "perspective" "float fov" [ 40 ]
@@ -96,18 +114,7 @@ Material "diffuse" "rgb reflectance" [ 0.6 0.6 0.6 ]
 # Every surface faces the fog with its outside (pbrt's MediumInterface
 # convention): the floor's normal points up, the light's down.
 Shape "trianglemesh" "point3 P" [ -3 0 -3  -3 0 3  3 0 3  3 0 -3 ] "integer indices" [ 0 1 2 0 2 3 ]
-AttributeBegin
-  AreaLightSource "diffuse" "rgb L" [ 40 36 30 ]
-  Material "diffuse" "rgb reflectance" [ 0 0 0 ]
-  Shape "trianglemesh" "point3 P" [ -0.2 1.8 -0.2  0.2 1.8 -0.2  0.2 1.8 0.2  -0.2 1.8 0.2 ] "integer indices" [ 0 1 2 0 2 3 ]
-AttributeEnd
-AttributeBegin
-  MediumInterface "" "fog"
-  Material "dielectric" "float eta" [ 1.5 ]
-  Translate 0 0.8 0
-  Shape "sphere" "float radius" [ 0.35 ]
-AttributeEnd
-)",
+AttributeBegin)" + kLamp + "AttributeEnd\n" + kBallInFog,
                                  "<fog>", ".");
   expect_same_image_as_path_tracing(d, 1.5);
 }
@@ -115,12 +122,7 @@ AttributeEnd
 TEST(LightPaths, LightInsideAFogBallSeenFromOutsideAgreesWithPathTracing) {
   // The fog fills a ball (an "interface" sphere) around the scene; the camera
   // is outside it, the light inside: light paths start in the light's medium.
-  SceneDesc d = load_pbrt_string(R"(
-Integrator "bdpt" "integer maxdepth" [ 5 ]
-Sampler "independent"
-PixelFilter "box"
-Film "rgb" "integer xresolution" [ 32 ] "integer yresolution" [ 32 ]
-LookAt 0 2.2 -2.2  0 0.3 0  0 1 0
+  SceneDesc d = load_pbrt_string(std::string(kFogView) + R"(
 Camera "perspective" "float fov" [ 40 ]
 WorldBegin
 MakeNamedMedium "fog" "string type" [ "homogeneous" ] "rgb sigma_a" [ 0.1 0.1 0.1 ] "rgb sigma_s" [ 1 1 1 ]
@@ -132,18 +134,8 @@ AttributeEnd
 AttributeBegin
   MediumInterface "fog" "fog"
   Material "diffuse" "rgb reflectance" [ 0.6 0.6 0.6 ]
-  Shape "trianglemesh" "point3 P" [ -1.7 0 -1.7  -1.7 0 1.7  1.7 0 1.7  1.7 0 -1.7 ] "integer indices" [ 0 1 2 0 2 3 ]
-  AreaLightSource "diffuse" "rgb L" [ 40 36 30 ]
-  Material "diffuse" "rgb reflectance" [ 0 0 0 ]
-  Shape "trianglemesh" "point3 P" [ -0.2 1.8 -0.2  0.2 1.8 -0.2  0.2 1.8 0.2  -0.2 1.8 0.2 ] "integer indices" [ 0 1 2 0 2 3 ]
-AttributeEnd
-AttributeBegin
-  MediumInterface "" "fog"
-  Material "dielectric" "float eta" [ 1.5 ]
-  Translate 0 0.8 0
-  Shape "sphere" "float radius" [ 0.35 ]
-AttributeEnd
-)",
+  Shape "trianglemesh" "point3 P" [ -1.7 0 -1.7  -1.7 0 1.7  1.7 0 1.7  1.7 0 -1.7 ] "integer indices" [ 0 1 2 0 2 3 ])" +
+                                     kLamp + "AttributeEnd\n" + kBallInFog,
                                  "<fog ball>", ".");
   expect_same_image_as_path_tracing(d, 1.1, 1536);
 }
