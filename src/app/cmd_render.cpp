@@ -471,8 +471,8 @@ CommandRunner add_render_command(CLI::App& app) {
   c->add_option("--max-depth", a->max_depth, "Maximum path depth, counted as pbrt-v4 does (overrides the Integrator)")->check(CLI::Range(0, 1 << 20));
   c->add_option("--seed", a->seed, "Random seed (same seed -> bit-identical image)")->check(CLI::NonNegativeNumber);
   c->add_option("--sampler", a->sampler,
-                "zsobol | paddedsobol | sobol | stratified | independent (pbrt-v4's samplers; sobol is drawn as paddedsobol); default: the scene's Sampler")
-      ->check(CLI::IsMember({"zsobol", "paddedsobol", "sobol", "stratified", "independent"}));
+                "zsobol | paddedsobol | sobol | stratified | independent | halton (pbrt-v4's samplers; sobol is drawn as paddedsobol); default: the scene's Sampler")
+      ->check(CLI::IsMember({"zsobol", "paddedsobol", "sobol", "stratified", "independent", "halton"}));
   c->add_option("--spectral", a->spectral,
                 "on: paths carry sampled wavelengths and colours become pbrt-v4's spectra; off: paths carry RGB; "
                 "auto (default): spectral where it changes the picture (measured spectra, strongly coloured lights)")

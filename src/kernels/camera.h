@@ -96,7 +96,7 @@ struct CameraSample {
 };
 
 TESSERA_HOST_DEVICE inline CameraSample sample_camera_ray(const SceneView& s, int32_t x, int32_t y, PixelSampler& sampler) {
-  const FilterSample fs = sample_filter(s.filter, sampler.uniform2());
+  const FilterSample fs = sample_filter(s.filter, sampler.pixel2());
   const Vec2 p_film(x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y);
   const Vec2 u_lens = s.camera.lens_radius > 0.f ? sampler.uniform2() : Vec2(0.f);
   // Motion blur: a time in the shutter interval, as a fraction of the

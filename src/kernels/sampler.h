@@ -17,15 +17,19 @@
 //   every 1D one, the strata of each dimension visited in a random order
 //   (pbrt-v4's StratifiedSampler); past sx * sy samples the next round uses
 //   fresh orders.
+// * Halton: pbrt-v4's HaltonSampler layout, one global sequence whose bases 2
+//   and 3 pick the pixel and the point inside it (pixel2()), digits of the
+//   other dimensions randomised per dimension (halton.h).
 #pragma once
 
+#include "halton.h"
 #include "rng.h"
 #include "sobol_points.h"
 #include "zsobol_index.h"
 
 namespace tessera {
 
-enum class SamplerKind : uint32_t { Independent = 0, Sobol = 1, ZSobol = 2, Stratified = 3 };
+enum class SamplerKind : uint32_t { Independent = 0, Sobol = 1, ZSobol = 2, Stratified = 3, Halton = 4 };
 
 // What a render's sampler needs beside the pixel and sample: one per render.
 struct SamplerSetup {
@@ -35,6 +39,7 @@ struct SamplerSetup {
   uint32_t strata_x = 4;   // Stratified: strata per pixel along x and y
   uint32_t strata_y = 4;
   bool jitter = true;      // Stratified: a random point in each stratum (else its centre)
+  HaltonLayout halton;     // Halton: the image's pixel layout (halton_layout of the film's full resolution)
 };
 
 // The smallest L with 2^L >= spp, at most 26: the Sobol points use 32 bits
@@ -86,6 +91,8 @@ struct PixelSampler {
   Rng rng;                 // Independent
   uint64_t stream = 0;     // Sobol, Stratified: hash of (seed, pixel); ZSobol: hash of the seed
   uint64_t morton = 0;     // ZSobol: the pixel's Morton code
+  uint64_t halton_index = 0;  // Halton: the sample's index in the global sequence
+  uint32_t halton_exponent2 = 0, halton_scale3 = 1;  // Halton: the layout's 2^a and 3^b (pixel2)
   uint32_t index = 0;      // sample index within the pixel (ZSobol, Stratified: within its epoch)
   uint32_t epoch = 0;      // ZSobol, Stratified: which round of 2^L (sx * sy) samples
   uint32_t dimension = 0;
@@ -122,6 +129,14 @@ struct PixelSampler {
         s.epoch = static_cast<uint32_t>(sample / n);
         break;
       }
+      case SamplerKind::Halton:
+        s.stream = mix_bits(setup.seed ^ 0x4a1709ull);
+        s.halton_exponent2 = setup.halton.exponent[0];
+        s.halton_scale3 = setup.halton.scale[1];
+        s.halton_index = halton_pixel_index(setup.halton, x, y) +
+                         sample * (static_cast<uint64_t>(setup.halton.scale[0]) * setup.halton.scale[1]);
+        s.dimension = 2;  // 0 and 1 are the pixel's (pixel2)
+        break;
     }
     return s;
   }
@@ -150,6 +165,9 @@ struct PixelSampler {
         const uint32_t stratum = permutation_element(index, n, key);
         return glm::min((static_cast<Float>(stratum) + jitter_value(key, 0)) / static_cast<Float>(n), 0x1.fffffep-1f);
       }
+      case SamplerKind::Halton:
+        if (dimension >= halton_detail::kPrimeCount) dimension = 2;
+        return halton_dimension(dimension++);
     }
     return 0.f;
   }
@@ -176,8 +194,23 @@ struct PixelSampler {
         return Vec2(glm::min((sx + jitter_value(key, 0)) / static_cast<Float>(strata_x), 0x1.fffffep-1f),
                     glm::min((sy + jitter_value(key, 1)) / static_cast<Float>(strata_y), 0x1.fffffep-1f));
       }
+      case SamplerKind::Halton: {
+        if (dimension + 1 >= halton_detail::kPrimeCount) dimension = 2;
+        const uint32_t d = dimension;
+        dimension += 2;
+        return Vec2(halton_dimension(d), halton_dimension(d + 1));
+      }
     }
     return Vec2(0.f);
+  }
+
+  // The point inside the pixel (the filter's sample): for Halton the
+  // sequence's first two dimensions, whose leading digits chose the pixel
+  // (pbrt-v4's GetPixel2D); for the other kinds the next 2D request.
+  TESSERA_HOST_DEVICE Vec2 pixel2() {
+    if (kind != SamplerKind::Halton) return uniform2();
+    return Vec2(halton_detail::radical_inverse(2u, halton_index >> halton_exponent2),
+                halton_detail::radical_inverse(3u, halton_index / halton_scale3));
   }
 
  private:
@@ -185,6 +218,12 @@ struct PixelSampler {
   TESSERA_HOST_DEVICE uint64_t dimension_hash() {
     const uint64_t d = static_cast<uint64_t>(dimension++) | (static_cast<uint64_t>(epoch) << 32);
     return mix_bits(stream ^ (d * 0x9e3779b97f4a7c15ull));
+  }
+  // Halton: dimension d's randomised radical inverse, the same digit
+  // permutations for every pixel (they randomise the one global sequence).
+  TESSERA_HOST_DEVICE Float halton_dimension(uint32_t d) const {
+    return halton_detail::scrambled_radical_inverse(halton_detail::prime(d), halton_index,
+                                                    mix_bits(stream ^ (static_cast<uint64_t>(d) * 0x9e3779b97f4a7c15ull)));
   }
   // Stratified: the jitter of coordinate c within the sample's stratum.
   TESSERA_HOST_DEVICE Float jitter_value(uint64_t key, uint32_t c) const {

@@ -294,7 +294,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
              "in expectation, not pbrt-v4's global Sobol ordering of the pixels");
     } else {
       scene_.sampler = SamplerKind::ZSobol;
-      if (type == "halton" || type == "pmj02bn")
+      if (type == "pmj02bn")
         warn("sampler \"" + type + "\": drawn as \"zsobol\"; the same image in expectation, not pbrt-v4's own point set");
       else
         warn("sampler \"" + type + "\" is unknown; using \"zsobol\"");

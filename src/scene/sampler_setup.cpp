@@ -9,6 +9,7 @@ std::optional<SamplerKind> sampler_kind_named(const std::string& name) {
   if (name == "paddedsobol" || name == "sobol") return SamplerKind::Sobol;
   if (name == "stratified") return SamplerKind::Stratified;
   if (name == "independent") return SamplerKind::Independent;
+  if (name == "halton") return SamplerKind::Halton;
   return std::nullopt;
 }
 
@@ -18,6 +19,7 @@ const char* sampler_name(SamplerKind kind) {
     case SamplerKind::Sobol: return "paddedsobol";
     case SamplerKind::Stratified: return "stratified";
     case SamplerKind::Independent: return "independent";
+    case SamplerKind::Halton: return "halton";
   }
   return "?";
 }
@@ -30,6 +32,7 @@ SamplerSetup sampler_setup(const SceneDesc& desc) {
   s.jitter = desc.sampler_jitter;
   s.strata_x = static_cast<uint32_t>(std::max(1, desc.strata_x));
   s.strata_y = static_cast<uint32_t>(std::max(1, desc.strata_y));
+  s.halton = halton_layout(static_cast<uint32_t>(std::max(1, desc.film.xres)), static_cast<uint32_t>(std::max(1, desc.film.yres)));
   return s;
 }
 

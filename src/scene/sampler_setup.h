@@ -11,7 +11,7 @@
 namespace tessera {
 
 // "zsobol", "paddedsobol", "sobol" (drawn as paddedsobol), "stratified",
-// "independent"; nothing for any other name.
+// "independent", "halton"; nothing for any other name.
 std::optional<SamplerKind> sampler_kind_named(const std::string& name);
 const char* sampler_name(SamplerKind kind);
 
@@ -19,7 +19,8 @@ const char* sampler_name(SamplerKind kind);
 // is the scene's own sample count rounded up to a power of two, and the
 // strata are the scene's: --spp changes neither (pbrt-v4 re-splits its
 // strata for --spp), so that a checkpoint resumes with any --spp; samples
-// past one epoch or round start the next.
+// past one epoch or round start the next. Halton's pixel layout follows the
+// film's resolution, as pbrt-v4's does.
 SamplerSetup sampler_setup(const SceneDesc& desc);
 
 }  // namespace tessera

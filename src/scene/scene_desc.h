@@ -113,8 +113,8 @@ struct SceneDesc {
   std::string integrator = "volpath";  // the Integrator directive's type (scene/light_paths.h reads it)
   uint64_t seed = 0;       // Sampler "integer seed"
   // Sampler type (kernels/sampler.h): zsobol (pbrt-v4's default), paddedsobol
-  // (also drawn for pbrt's global "sobol"), stratified, independent; halton
-  // and pmj02bn are drawn as zsobol (a warning says so).
+  // (also drawn for pbrt's global "sobol"), stratified, independent, halton;
+  // pmj02bn is drawn as zsobol (a warning says so).
   SamplerKind sampler = SamplerKind::ZSobol;
   int32_t strata_x = 4, strata_y = 4;  // stratified: "xsamples", "ysamples" (spp = their product)
   // The scene's own sample count (pixelsamples, or xsamples * ysamples), which

@@ -23,7 +23,7 @@ namespace {
 
 constexpr int kSide = 16;            // pixels per side of the sampled window
 constexpr int kSamples = 64;         // samples per pixel
-constexpr int kDims = 12;            // numbers per sample: 6 uniform(), 3 uniform2()
+constexpr int kDims = 12;            // numbers per sample: 6 uniform(), pixel2(), 2 uniform2()
 constexpr int kBsdfCases = 1 << 16;  // (wo, uc, u) triples per BSDF
 
 struct BsdfResult {
@@ -41,7 +41,7 @@ TESSERA_HOST_DEVICE void draw_sample_numbers(const SamplerSetup& setup, int i, F
   for (int d = 0; d < 3; ++d) {
     o[4 * d] = s.uniform();
     o[4 * d + 1] = s.uniform();
-    const Vec2 u = s.uniform2();
+    const Vec2 u = d == 0 ? s.pixel2() : s.uniform2();
     o[4 * d + 2] = u.x;
     o[4 * d + 3] = u.y;
   }
@@ -188,6 +188,9 @@ int main() {
   setup.strata_x = 3;
   setup.strata_y = 5;
   pass &= check_sampler("stratified", setup);
+  setup.kind = SamplerKind::Halton;
+  setup.halton = halton_layout(16, 16);
+  pass &= check_sampler("halton", setup);
 
   BsdfParams b;
   b.reflectance = Rgb(0.7f, 0.5f, 0.3f);

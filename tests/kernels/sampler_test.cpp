@@ -1,7 +1,9 @@
 // Pixel samplers: Owen-scrambled Sobol points (padded and z-ordered) are
 // stratified in every 1D and 2D request for every power-of-two prefix of a
 // pixel's samples; z-ordered ones also across aligned blocks of pixels;
-// stratified ones put one sample in every stratum per round; all are
+// stratified ones put one sample in every stratum per round; Halton's
+// leading digits pick the pixel and its randomised dimensions are stratified
+// in every base-power prefix; all are
 // decorrelated between requests and pixels, uniform on average, and pure
 // functions of (seed, pixel, sample, dimension).
 #include <gtest/gtest.h>
@@ -22,6 +24,7 @@ SamplerSetup setup_of(SamplerKind kind, uint64_t seed, uint32_t log2_spp = 8) {
   s.log2_spp = log2_spp;
   s.strata_x = 8;
   s.strata_y = 4;
+  s.halton = halton_layout(1000, 1000);  // start() below lays pixels out on a 1000-wide image
   return s;
 }
 
@@ -168,6 +171,72 @@ TEST(Sampler, StratifiedRoundsFillEveryStratumOnce) {
   EXPECT_FLOAT_EQ(c.y * 4 - std::floor(c.y * 4), 0.5f);
 }
 
+// pbrt-v4's Halton layout: the leading digits of pixel (x, y)'s indices, in
+// bases 2 and 3, are x and y (modulo 128), so the global sequence's first two
+// dimensions scaled by 2^a x 3^b land in the pixel: the radical inverse of
+// the index times base^digits, in integers, is the pixel's coordinate.
+TEST(Sampler, HaltonIndicesLandInTheirPixel) {
+  auto scaled_radical_inverse = [](uint64_t a, uint32_t base, uint32_t digits) {
+    uint64_t v = 0;
+    for (uint32_t k = 0; k < digits; ++k, a /= base) v = v * base + a % base;
+    return static_cast<uint32_t>(v);
+  };
+  const HaltonLayout l = halton_layout(300, 200);
+  EXPECT_EQ(l.scale[0], 128u);
+  EXPECT_EQ(l.scale[1], 243u);
+  const HaltonLayout small = halton_layout(20, 7);
+  EXPECT_EQ(small.scale[0], 32u);
+  EXPECT_EQ(small.scale[1], 9u);
+  for (const HaltonLayout& layout : {l, small}) {
+    const uint64_t stride = static_cast<uint64_t>(layout.scale[0]) * layout.scale[1];
+    const uint32_t w = layout.scale[0] < 128u ? 20u : 300u, h = layout.scale[1] < 27u ? 7u : 200u;
+    for (uint32_t y = 0; y < h; ++y)
+      for (uint32_t x = 0; x < w; ++x)
+        for (uint64_t sample : {0ull, 1ull, 37ull}) {
+          const uint64_t index = halton_pixel_index(layout, x, y) + sample * stride;
+          ASSERT_EQ(scaled_radical_inverse(index, 2, layout.exponent[0]), x % 128u) << x << ',' << y;
+          ASSERT_EQ(scaled_radical_inverse(index, 3, layout.exponent[1]), y % 128u) << x << ',' << y;
+        }
+  }
+}
+
+// A pixel's Halton samples: the point in the pixel is stratified in x over
+// 2^k samples and in y over 3^k; a 1D request in base p over p^k samples and
+// a 2D request in bases p, q over (p q)^k samples put one point in every
+// cell (the sample stride 2^a 3^b is coprime to the other primes).
+TEST(Sampler, HaltonPrefixesAreStratified) {
+  const SamplerSetup setup = setup_of(SamplerKind::Halton, 3);
+  auto cells = [&](uint32_t n, auto&& cell_of) {
+    std::set<uint32_t> seen;
+    for (uint32_t i = 0; i < n; ++i) {
+      PixelSampler s = start(setup, 123457, i);
+      seen.insert(cell_of(s));
+    }
+    return static_cast<uint32_t>(seen.size());
+  };
+  EXPECT_EQ(cells(64, [](PixelSampler& s) { return static_cast<uint32_t>(s.pixel2().x * 64); }), 64u);
+  EXPECT_EQ(cells(81, [](PixelSampler& s) { return static_cast<uint32_t>(s.pixel2().y * 81); }), 81u);
+  // Dimension 2 (base 5), then dimensions 3 and 4 (bases 7 and 11).
+  EXPECT_EQ(cells(125, [](PixelSampler& s) { return static_cast<uint32_t>(s.uniform() * 125); }), 125u);
+  EXPECT_EQ(cells(77, [](PixelSampler& s) {
+              s.uniform();
+              const Vec2 p = s.uniform2();
+              return static_cast<uint32_t>(p.y * 11) * 7 + static_cast<uint32_t>(p.x * 7);
+            }),
+            77u);
+  // The first 2D request is dimensions 2 and 3: 25 x 49 cells by 1225 samples.
+  EXPECT_EQ(cells(1225, [](PixelSampler& s) {
+              const Vec2 p = s.uniform2();
+              return static_cast<uint32_t>(p.y * 49) * 25 + static_cast<uint32_t>(p.x * 25);
+            }),
+            1225u);
+  // Past the 1000th prime the dimensions start again at 2, as pbrt-v4's do.
+  PixelSampler a = start(setup, 9, 5), b = start(setup, 9, 5);
+  const Float first = a.uniform();
+  for (int i = 0; i < 998; ++i) b.uniform();  // dimensions 2..999
+  EXPECT_EQ(b.uniform(), first);
+}
+
 TEST(Sampler, PermutationElementIsAPermutation) {
   for (uint32_t n : {1u, 2u, 3u, 7u, 32u, 100u, 1000u}) {
     for (uint64_t key : {0ull, 1ull, 0x123456789abcdefull}) {
@@ -194,12 +263,16 @@ TEST(Sampler, RequestsAndPixelsAreDecorrelated) {
     }
     return (sab / n - sa / n * sb / n) / std::sqrt((saa / n - sa * sa / (n * n)) * (sbb / n - sb * sb / (n * n)));
   };
-  for (SamplerKind kind : {SamplerKind::Sobol, SamplerKind::ZSobol, SamplerKind::Stratified}) {
+  for (SamplerKind kind : {SamplerKind::Sobol, SamplerKind::ZSobol, SamplerKind::Stratified, SamplerKind::Halton}) {
     SCOPED_TRACE(static_cast<int>(kind));
     const auto r0 = points2d(1, 5, 0, 1024, 0, kind), r1 = points2d(1, 5, 1, 1024, 0, kind);
     const auto other_pixel = points2d(1, 6, 0, 1024, 0, kind);
     EXPECT_LT(std::abs(correlation(r0, r1)), 0.1);
-    EXPECT_LT(std::abs(correlation(r0, other_pixel)), 0.1);
+    // Halton's pixels are residues of one sequence, as pbrt-v4's are: their
+    // leading digits differ by a constant, so neighbours are not decorrelated.
+    if (kind != SamplerKind::Halton) {
+      EXPECT_LT(std::abs(correlation(r0, other_pixel)), 0.1);
+    }
     // Same arguments, same numbers; another seed, other numbers.
     EXPECT_EQ(points2d(1, 5, 2, 8, 0, kind), points2d(1, 5, 2, 8, 0, kind));
     EXPECT_NE(points2d(1, 5, 2, 8, 0, kind), points2d(2, 5, 2, 8, 0, kind));
@@ -208,7 +281,7 @@ TEST(Sampler, RequestsAndPixelsAreDecorrelated) {
 
 TEST(Sampler, PointsAreUniformOnAverage) {
   // Over many pixels the mean of each coordinate is 1/2 and of its square 1/3.
-  for (SamplerKind kind : {SamplerKind::Sobol, SamplerKind::ZSobol, SamplerKind::Stratified}) {
+  for (SamplerKind kind : {SamplerKind::Sobol, SamplerKind::ZSobol, SamplerKind::Stratified, SamplerKind::Halton}) {
     double sx = 0, sxx = 0, sy = 0;
     const int pixels = 2000, n = 16;
     for (int p = 0; p < pixels; ++p)

@@ -34,7 +34,7 @@ TEST(Determinism, BitIdenticalAcrossThreadCountsAndTiles) {
 }
 
 TEST(Determinism, EverySamplerIsBitIdenticalAcrossThreadCountsAndTiles) {
-  for (SamplerKind kind : {SamplerKind::Sobol, SamplerKind::ZSobol, SamplerKind::Stratified}) {
+  for (SamplerKind kind : {SamplerKind::Sobol, SamplerKind::ZSobol, SamplerKind::Stratified, SamplerKind::Halton}) {
     RenderResult one = render_cornell(1, 16, 42, kind);
     RenderResult four = render_cornell(4, 7, 42, kind);
     EXPECT_TRUE(testing::films_identical(one.film, four.film)) << static_cast<int>(kind);
@@ -76,16 +76,18 @@ Shape "trianglemesh" "point3 P" [ -5 0 -5  5 0 -5  5 0 5  -5 0 5 ] "integer indi
     for (size_t i = 0; i < img.rgb.size(); ++i) s += (img.rgb[i] - truth.rgb[i]) * (img.rgb[i] - truth.rgb[i]);
     return s / img.rgb.size();
   };
-  double independent = 0, padded = 0, zsobol = 0, stratified = 0;
+  double independent = 0, padded = 0, zsobol = 0, stratified = 0, halton = 0;
   for (uint64_t seed = 1; seed <= 4; ++seed) {
     independent += mse(render_with(SamplerKind::Independent, 16, seed));
     padded += mse(render_with(SamplerKind::Sobol, 16, seed));
     zsobol += mse(render_with(SamplerKind::ZSobol, 16, seed));
     stratified += mse(render_with(SamplerKind::Stratified, 16, seed));
+    halton += mse(render_with(SamplerKind::Halton, 16, seed));
   }
   EXPECT_LT(padded * 1.5, independent) << "paddedsobol " << padded << " independent " << independent;
   EXPECT_LT(zsobol * 1.5, independent) << "zsobol " << zsobol << " independent " << independent;
   EXPECT_LT(stratified * 1.5, independent) << "stratified " << stratified << " independent " << independent;
+  EXPECT_LT(halton * 1.5, independent) << "halton " << halton << " independent " << independent;
 }
 
 TEST(Determinism, SeedChangesTheImage) {
