@@ -27,10 +27,11 @@ struct VizArgs {
   GuideArgs guide;
 };
 
-void write_distribution(const VizArgs& a, const GuideField& field) {
+void write_distribution(const VizArgs& a, const GuideField& field, const Vec3& render_origin) {
   if (a.point.size() != 3 || a.normal.size() != 3)
     throw std::runtime_error("guide-viz: --distribution needs --point X Y Z and --normal X Y Z");
-  const Vec3 p(a.point[0], a.point[1], a.point[2]);
+  // The point is in the scene file's world; the guide lives in render space (camera at the origin).
+  const Vec3 p(a.point[0] - render_origin.x, a.point[1] - render_origin.y, a.point[2] - render_origin.z);
   Vec3 n(a.normal[0], a.normal[1], a.normal[2]);
   if (!(glm::length(n) > 0.f)) throw std::runtime_error("guide-viz: --normal must not be zero");
   n = glm::normalize(n);
@@ -107,7 +108,7 @@ int run_guide_viz(VizArgs a) {
     render(scene, embree, opt, field.get());
     std::printf("trained the guide with %lld spp (%u cells)\n", static_cast<long long>(a.train_spp), field->num_cells());
   }
-  if (!a.distribution.empty()) write_distribution(a, *field);
+  if (!a.distribution.empty()) write_distribution(a, *field, scene.desc().render_origin);
   if (!a.diagnostic.empty()) write_diagnostic(a, scene, embree, *field);
   return 0;
 }

@@ -37,8 +37,11 @@ int run_info(const std::string& path) {
     std::printf("media:          %zu homogeneous%s\n", scene.desc().media.size(),
                 scene.desc().camera_medium >= 0 ? ", the camera in one" : "");
   const Bounds& b = scene.bounds();
+  // Bounds in the scene file's world (render space plus its origin, in double).
+  const Vec3 o = scene.desc().render_origin;
   if (scene.num_triangles() > 0)
-    std::printf("bounds:         (%g, %g, %g) - (%g, %g, %g)\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+    std::printf("bounds:         (%g, %g, %g) - (%g, %g, %g)\n", double(o.x) + b.lo.x, double(o.y) + b.lo.y,
+                double(o.z) + b.lo.z, double(o.x) + b.hi.x, double(o.y) + b.hi.y, double(o.z) + b.hi.z);
   std::printf("effects:        %s\n", describe_effects(scene.effects()).c_str());
   std::printf("specialisation: %s\n", describe_specialisation(specialisation_for(scene.effects())).c_str());
   const std::string why = spectral_reason(scene.desc());

@@ -32,10 +32,12 @@ bool representable(const Vec3& p) {
   return std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate && std::abs(p.z) <= kMaxCoordinate;
 }
 
-std::string describe_far(const Vec3& p) {
+// `p` in render space, reported in the scene file's world (render space's origin added).
+std::string describe_far(const Vec3& p, const Vec3& origin = Vec3(0.f)) {
   char buf[160];
   std::snprintf(buf, sizeof buf, "at (%g, %g, %g): beyond +-%g (or not finite), where single-precision ray tracing cannot go",
-                p.x + 0.f, p.y + 0.f, p.z + 0.f, kMaxCoordinate);  // + 0: no "-0"
+                double(p.x) + origin.x + 0.0, double(p.y) + origin.y + 0.0, double(p.z) + origin.z + 0.0,
+                kMaxCoordinate);  // + 0: no "-0"
   return buf;
 }
 
@@ -230,19 +232,30 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     std::vector<Float> v = read_numbers(tokens, pos, 16, at);
     Mat4 m = glm::make_mat4(v.data());
     if (d == "ConcatTransform") post_multiply(m);
+    else if (world_begun_) set_active(render_from_world_ * m, render_from_world_ * m);  // m is world-space
     else set_active(m, m);
   } else if (d == "Identity") {
-    set_active(Mat4(1.f), Mat4(1.f));
+    const Mat4 identity = world_begun_ ? render_from_world_ : Mat4(1.f);
+    set_active(identity, identity);
   } else if (d == "CoordinateSystem") {
-    coordinate_systems_[read_string(tokens, pos, at)] = {state_.ctm, state_.ctm_end};
+    coordinate_systems_[read_string(tokens, pos, at)] = {state_.ctm, state_.ctm_end, world_begun_};
   } else if (d == "CoordSysTransform") {
     std::string name = read_string(tokens, pos, at);
     auto it = coordinate_systems_.find(name);
     if (it == coordinate_systems_.end()) {
       warn("unknown coordinate system \"" + name + "\"; ignored");
     } else {
-      state_.ctm = it->second.first;
-      state_.ctm_end = it->second.second;
+      // The CTM is world-space before WorldBegin and render-space after it.
+      Mat4 start = it->second.start, end = it->second.end;
+      if (world_begun_ && !it->second.render_space) {
+        start = render_from_world_ * start;
+        end = render_from_world_ * end;
+      } else if (!world_begun_ && it->second.render_space) {
+        start = world_from_render_ * start;
+        end = world_from_render_ * end;
+      }
+      state_.ctm = start;
+      state_.ctm_end = end;
     }
   } else if (d == "ReverseOrientation") {
     state_.reverse_orientation = !state_.reverse_orientation;
@@ -268,9 +281,9 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
   } else if (d == "WorldBegin") {
     if (world_begun_) fail(at, "WorldBegin appears twice");
     world_begun_ = true;
-    state_.ctm = state_.ctm_end = Mat4(1.f);
+    state_.ctm = state_.ctm_end = render_from_world_;
     state_.active_start = state_.active_end = true;
-    coordinate_systems_["world"] = {state_.ctm, state_.ctm_end};
+    coordinate_systems_["world"] = {state_.ctm, state_.ctm_end, true};
   } else if (d == "WorldEnd") {
     warn("WorldEnd is pbrt-v3 syntax; ignored");
   } else if (d == "Camera") {
@@ -469,21 +482,28 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
 void PbrtParser::check_coordinates(const MeshDesc& mesh, const Token& at) const {
   for (const std::vector<Vec3>* points : {&mesh.p, &mesh.p_end})
     for (const Vec3& p : *points)
-      if (!representable(p)) fail(at, "a vertex of the shape is " + describe_far(p));
+      if (!representable(p)) fail(at, "a vertex of the shape is " + describe_far(p, scene_.render_origin));
 }
 
 void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet& params) {
   std::vector<std::string>& warnings = scene_.warnings;
   if (type != "perspective") warnings.push_back(at.where() + ": camera \"" + type + "\" treated as \"perspective\"");
   if (glm::determinant(state_.ctm) == 0.f) fail(at, "camera transform is singular");
-  scene_.camera.world_from_camera = glm::inverse(state_.ctm);
-  if (!representable(Vec3(scene_.camera.world_from_camera[3])))
-    fail(at, "the camera is " + describe_far(Vec3(scene_.camera.world_from_camera[3])));
-  scene_.camera.world_from_camera_end = scene_.camera.world_from_camera;
+  const Mat4 world_from_camera = glm::inverse(state_.ctm);
+  const Vec3 eye(world_from_camera[3]);
+  if (!representable(eye)) fail(at, "the camera is " + describe_far(eye));
+  Mat4 world_from_camera_end = world_from_camera;
   if (state_.ctm_end != state_.ctm) {
     if (glm::determinant(state_.ctm_end) == 0.f) fail(at, "camera end transform is singular");
-    scene_.camera.world_from_camera_end = glm::inverse(state_.ctm_end);
+    world_from_camera_end = glm::inverse(state_.ctm_end);
   }
+  // Render space: the world translated so that the camera (at its start
+  // time) is at the origin.
+  render_from_world_ = glm::translate(Mat4(1.f), -eye);
+  world_from_render_ = glm::translate(Mat4(1.f), eye);
+  scene_.render_origin = eye;
+  scene_.camera.world_from_camera = render_from_world_ * world_from_camera;
+  scene_.camera.world_from_camera_end = render_from_world_ * world_from_camera_end;
   scene_.camera.fov_degrees = params.get_float("fov", 90.f);
   // pbrt-v4 swaps reversed shutter times and refuses a shutter that never opens.
   Float open = params.get_float("shutteropen", 0.f), close = params.get_float("shutterclose", 1.f);
@@ -498,7 +518,7 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   scene_.camera.shutter_close = close;
   scene_.camera.where = at.where();
   scene_.camera_medium = state_.media.outside;  // pbrt-v4: the camera sits in the current outside medium
-  coordinate_systems_["camera"] = {scene_.camera.world_from_camera, scene_.camera.world_from_camera_end};
+  coordinate_systems_["camera"] = {scene_.camera.world_from_camera, scene_.camera.world_from_camera_end, true};
   scene_.camera.lens_radius = params.get_float("lensradius", 0.f);
   scene_.camera.focal_distance = params.get_float("focaldistance", 1e6f);
   if (!(scene_.camera.lens_radius >= 0.f) || !std::isfinite(scene_.camera.lens_radius))

@@ -57,7 +57,17 @@ class PbrtParser {
   std::string search_dir_;
   GraphicsState state_;
   std::vector<StackEntry> stack_;
-  std::map<std::string, std::pair<Mat4, Mat4>> coordinate_systems_;  // start and end transforms
+  struct CoordinateSystem {
+    Mat4 start, end;     // the transforms at the start and end of the transform interval
+    bool render_space;   // saved after WorldBegin (or the camera's): relative to render space, not world
+  };
+  std::map<std::string, CoordinateSystem> coordinate_systems_;
+  // pbrt-v4's render space ("cameraworld"): the world translated so that the
+  // camera sits at the origin. Everything after WorldBegin is placed there,
+  // so a scene far from the world's origin keeps float precision near the
+  // camera; SceneDesc::render_origin says where that origin is in the world.
+  Mat4 render_from_world_{1.f};
+  Mat4 world_from_render_{1.f};
   std::map<std::string, std::vector<MeshDesc>> instances_;
   std::string open_instance_;  // non-empty between ObjectBegin and ObjectEnd
   struct MediumRef {

@@ -62,6 +62,8 @@ struct GridDesc {
   Float max_density = 0.f;
 };
 
+// "World" in a SceneDesc is pbrt-v4's render space: the scene's world
+// translated so that the camera is at the origin (render_origin).
 struct CameraDesc {
   Mat4 world_from_camera{1.f};  // pbrt camera space: x right, y up, z forward (left-handed)
   Float fov_degrees = 90.f;     // pbrt-v4: angle spanned by the shorter image axis
@@ -106,6 +108,11 @@ struct FilterDesc {
 
 struct SceneDesc {
   CameraDesc camera;
+  // Where render space's origin (the camera) is in the scene file's world:
+  // every position in this SceneDesc is relative to it (pbrt-v4's
+  // "cameraworld" rendering space), which keeps float precision near the
+  // camera in scenes far from the world's origin.
+  Vec3 render_origin{0.f};
   FilmDesc film;
   FilterDesc filter;
   int32_t spp = 16;        // pbrt-v4 default pixelsamples

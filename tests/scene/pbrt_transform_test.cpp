@@ -41,7 +41,8 @@ TEST(PbrtTransform, LookAtGivesWorldFromCamera) {
                                      std::string(kTriangle),
                                  "t.pbrt", ".");
   const Mat4& m = s.camera.world_from_camera;
-  EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 0, 0, 1)), Vec3(0, 0, 5), 1e-5f);
+  EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 0, 0, 1)) + s.render_origin, Vec3(0, 0, 5), 1e-5f);
+  EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 0, 0, 1)), Vec3(0.f), 1e-6f);  // render space: the camera at the origin
   EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 0, 1, 0)), Vec3(0, 0, -1), 1e-6f);  // forward
   EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 1, 0, 0)), Vec3(0, 1, 0), 1e-6f);   // up
   EXPECT_VEC3_NEAR(Vec3(m * Vec4(1, 0, 0, 0)), Vec3(-1, 0, 0), 1e-6f);  // right = up x forward
@@ -104,8 +105,9 @@ TEST(PbrtTransform, NamedCoordinateSystems) {
       "Identity\nCoordSysTransform \"camera\"\n" + std::string(kTriangle) + "CoordSysTransform \"seven\"\n" + kTriangle,
       "t.pbrt", ".");
   ASSERT_EQ(s.meshes.size(), 2u);
-  EXPECT_VEC3_NEAR(s.meshes[0].p[0], Vec3(1, 2, 3), 1e-5f);  // camera origin
-  EXPECT_VEC3_NEAR(s.meshes[1].p[0], Vec3(7, 0, 0), 1e-6f);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[0] + s.render_origin, Vec3(1, 2, 3), 1e-5f);  // camera origin
+  EXPECT_VEC3_NEAR(s.meshes[1].p[0] + s.render_origin, Vec3(7, 0, 0), 1e-6f);
+  EXPECT_VEC3_NEAR(s.render_origin, Vec3(1, 2, 3), 1e-6f);
 }
 
 TEST(PbrtTransform, IncludeIsRelativeToIncludingFileAndKeepsState) {
