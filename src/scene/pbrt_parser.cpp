@@ -121,19 +121,19 @@ ParamSet read_params(const std::vector<Token>& tokens, size_t& pos, std::string 
   return ps;
 }
 
-// pbrt-v4 LookAt: the camera-from-world transform of a camera at `eye`.
-Mat4 look_at(Vec3 eye, Vec3 target, Vec3 up, const Token& at, std::vector<std::string>& warnings) {
-  Vec3 dir = target - eye;
-  if (glm::length(dir) == 0.f) fail(at, "LookAt eye and target coincide");
+// pbrt-v4 LookAt: the camera-from-world transform of a camera at `eye` (in double, see GraphicsState).
+glm::dmat4 look_at(glm::dvec3 eye, glm::dvec3 target, glm::dvec3 up, const Token& at, std::vector<std::string>& warnings) {
+  glm::dvec3 dir = target - eye;
+  if (glm::length(dir) == 0.0) fail(at, "LookAt eye and target coincide");
   dir = glm::normalize(dir);
-  Vec3 right = glm::cross(glm::normalize(up), dir);
-  if (!(glm::length(right) > 0.f)) {
+  glm::dvec3 right = glm::cross(glm::normalize(up), dir);
+  if (!(glm::length(right) > 0.0)) {
     warnings.push_back(at.where() + ": LookAt up vector is parallel to the view direction; ignored");
-    return Mat4(1.f);
+    return glm::dmat4(1.0);
   }
   right = glm::normalize(right);
-  Vec3 new_up = glm::cross(dir, right);
-  Mat4 world_from_camera(Vec4(right, 0.f), Vec4(new_up, 0.f), Vec4(dir, 0.f), Vec4(eye, 1.f));
+  glm::dvec3 new_up = glm::cross(dir, right);
+  glm::dmat4 world_from_camera(glm::dvec4(right, 0.0), glm::dvec4(new_up, 0.0), glm::dvec4(dir, 0.0), glm::dvec4(eye, 1.0));
   return glm::inverse(world_from_camera);
 }
 
@@ -203,39 +203,40 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
   if (is_options_directive(d)) require_world(at, false);
   std::vector<std::string>& warnings = scene_.warnings;
   auto warn = [&](const std::string& m) { warnings.push_back(at.where() + ": " + m); };
-  const Mat4& ctm = state_.ctm;
+  const Mat4 ctm(state_.ctm);  // rounded to float where it places things
   // Transform directives change the active transforms (ActiveTransform): the
   // start one, the end one, or both.
-  auto set_active = [&](const Mat4& start, const Mat4& end) {
+  auto set_active = [&](const DMat4& start, const DMat4& end) {
     if (state_.active_start) state_.ctm = start;
     if (state_.active_end) state_.ctm_end = end;
   };
-  auto post_multiply = [&](const Mat4& m) { set_active(state_.ctm * m, state_.ctm_end * m); };
+  auto post_multiply = [&](const DMat4& m) { set_active(state_.ctm * m, state_.ctm_end * m); };
 
   if (d == "Translate") {
     std::vector<Float> v = read_numbers(tokens, pos, 3, at);
-    post_multiply(glm::translate(Mat4(1.f), Vec3(v[0], v[1], v[2])));
+    post_multiply(glm::translate(DMat4(1.0), glm::dvec3(v[0], v[1], v[2])));
   } else if (d == "Scale") {
     std::vector<Float> v = read_numbers(tokens, pos, 3, at);
-    post_multiply(glm::scale(Mat4(1.f), Vec3(v[0], v[1], v[2])));
+    post_multiply(glm::scale(DMat4(1.0), glm::dvec3(v[0], v[1], v[2])));
   } else if (d == "Rotate") {
     std::vector<Float> v = read_numbers(tokens, pos, 4, at);
     Vec3 axis(v[1], v[2], v[3]);
     if (glm::length(axis) == 0.f) fail(at, "Rotate axis is zero");
-    post_multiply(glm::rotate(Mat4(1.f), v[0] * kPi / 180.f, glm::normalize(axis)));
+    post_multiply(glm::rotate(DMat4(1.0), double(v[0]) * 3.14159265358979323846 / 180.0, glm::normalize(glm::dvec3(axis))));
   } else if (d == "LookAt") {
     std::vector<Float> v = read_numbers(tokens, pos, 9, at);
-    post_multiply(look_at(Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5]), Vec3(v[6], v[7], v[8]), at, warnings));
+    post_multiply(look_at(glm::dvec3(v[0], v[1], v[2]), glm::dvec3(v[3], v[4], v[5]), glm::dvec3(v[6], v[7], v[8]), at,
+                          warnings));
   } else if (d == "Transform" || d == "ConcatTransform") {
     // pbrt-v4 reads the 16 numbers row-major and transposes: they are the
     // matrix's columns, exactly glm's storage order.
     std::vector<Float> v = read_numbers(tokens, pos, 16, at);
-    Mat4 m = glm::make_mat4(v.data());
+    const DMat4 m(glm::make_mat4(v.data()));
     if (d == "ConcatTransform") post_multiply(m);
     else if (world_begun_) set_active(render_from_world_ * m, render_from_world_ * m);  // m is world-space
     else set_active(m, m);
   } else if (d == "Identity") {
-    const Mat4 identity = world_begun_ ? render_from_world_ : Mat4(1.f);
+    const DMat4 identity = world_begun_ ? render_from_world_ : DMat4(1.0);
     set_active(identity, identity);
   } else if (d == "CoordinateSystem") {
     coordinate_systems_[read_string(tokens, pos, at)] = {state_.ctm, state_.ctm_end, world_begun_};
@@ -246,7 +247,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
       warn("unknown coordinate system \"" + name + "\"; ignored");
     } else {
       // The CTM is world-space before WorldBegin and render-space after it.
-      Mat4 start = it->second.start, end = it->second.end;
+      DMat4 start = it->second.start, end = it->second.end;
       if (world_begun_ && !it->second.render_space) {
         start = render_from_world_ * start;
         end = render_from_world_ * end;
@@ -414,7 +415,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
       if (moves && copy.area_light < 0) {  // the instance moves: its end is the definition under the end transform
         MeshDesc end = def;
         if (end.p_end.empty()) end.p_end = end.p, end.n_end = end.n;
-        transform_mesh(end, state_.ctm_end);
+        transform_mesh(end, Mat4(state_.ctm_end));
         copy.p_end = std::move(end.p_end);
         copy.n_end = std::move(end.n_end);
       }
@@ -488,22 +489,22 @@ void PbrtParser::check_coordinates(const MeshDesc& mesh, const Token& at) const 
 void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet& params) {
   std::vector<std::string>& warnings = scene_.warnings;
   if (type != "perspective") warnings.push_back(at.where() + ": camera \"" + type + "\" treated as \"perspective\"");
-  if (glm::determinant(state_.ctm) == 0.f) fail(at, "camera transform is singular");
-  const Mat4 world_from_camera = glm::inverse(state_.ctm);
-  const Vec3 eye(world_from_camera[3]);
-  if (!representable(eye)) fail(at, "the camera is " + describe_far(eye));
-  Mat4 world_from_camera_end = world_from_camera;
+  if (glm::determinant(state_.ctm) == 0.0) fail(at, "camera transform is singular");
+  const DMat4 world_from_camera = glm::inverse(state_.ctm);
+  const glm::dvec3 eye(world_from_camera[3]);
+  if (!representable(Vec3(eye))) fail(at, "the camera is " + describe_far(Vec3(eye)));
+  DMat4 world_from_camera_end = world_from_camera;
   if (state_.ctm_end != state_.ctm) {
-    if (glm::determinant(state_.ctm_end) == 0.f) fail(at, "camera end transform is singular");
+    if (glm::determinant(state_.ctm_end) == 0.0) fail(at, "camera end transform is singular");
     world_from_camera_end = glm::inverse(state_.ctm_end);
   }
   // Render space: the world translated so that the camera (at its start
   // time) is at the origin.
-  render_from_world_ = glm::translate(Mat4(1.f), -eye);
-  world_from_render_ = glm::translate(Mat4(1.f), eye);
-  scene_.render_origin = eye;
-  scene_.camera.world_from_camera = render_from_world_ * world_from_camera;
-  scene_.camera.world_from_camera_end = render_from_world_ * world_from_camera_end;
+  render_from_world_ = glm::translate(DMat4(1.0), -eye);
+  world_from_render_ = glm::translate(DMat4(1.0), eye);
+  scene_.render_origin = Vec3(eye);
+  scene_.camera.world_from_camera = Mat4(render_from_world_ * world_from_camera);
+  scene_.camera.world_from_camera_end = Mat4(render_from_world_ * world_from_camera_end);
   scene_.camera.fov_degrees = params.get_float("fov", 90.f);
   // pbrt-v4 swaps reversed shutter times and refuses a shutter that never opens.
   Float open = params.get_float("shutteropen", 0.f), close = params.get_float("shutterclose", 1.f);
@@ -518,7 +519,7 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   scene_.camera.shutter_close = close;
   scene_.camera.where = at.where();
   scene_.camera_medium = state_.media.outside;  // pbrt-v4: the camera sits in the current outside medium
-  coordinate_systems_["camera"] = {scene_.camera.world_from_camera, scene_.camera.world_from_camera_end, true};
+  coordinate_systems_["camera"] = {render_from_world_ * world_from_camera, render_from_world_ * world_from_camera_end, true};
   scene_.camera.lens_radius = params.get_float("lensradius", 0.f);
   scene_.camera.focal_distance = params.get_float("focaldistance", 1e6f);
   if (!(scene_.camera.lens_radius >= 0.f) || !std::isfinite(scene_.camera.lens_radius))
@@ -531,7 +532,7 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
 
 void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet& params,
                        const std::string& including_dir) {
-  ShapeContext ctx{at.where(), including_dir, search_dir_, state_.ctm, state_.reverse_orientation, &scene_.warnings, {}};
+  ShapeContext ctx{at.where(), including_dir, search_dir_, Mat4(state_.ctm), state_.reverse_orientation, &scene_.warnings, {}};
   ctx.float_texture = [this, &at](const std::string& name) -> DisplacementFn {
     auto it = names_.float_textures.find(name);
     if (it == names_.float_textures.end()) fail(at, "unknown float texture \"" + name + "\" for \"displacement\"");
@@ -555,10 +556,10 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
   if (state_.ctm_end != state_.ctm) {
     if (mesh->area_light >= 0) {
       scene_.warnings.push_back(at.where() + ": a moving area light is not supported; it stays where it starts");
-    } else if (glm::determinant(state_.ctm) == 0.f) {
+    } else if (glm::determinant(state_.ctm) == 0.0) {
       scene_.warnings.push_back(at.where() + ": the shape's start transform is singular; it does not move");
     } else {
-      const Mat4 end_from_start = state_.ctm_end * glm::inverse(state_.ctm);
+      const Mat4 end_from_start(state_.ctm_end * glm::inverse(state_.ctm));
       add_motion(*mesh, end_from_start);
       // Vertices move on straight lines: exact for translation and scale, a
       // chord instead of pbrt-v4's arc for a rotation.

@@ -24,9 +24,13 @@ class PbrtParser {
   SceneDesc finish(const std::string& file_name, int last_line);
 
  private:
+  // Transforms are composed in double: a scene placed far from the origin
+  // (Translate 1e6 ...) then cancels exactly against render space's
+  // translation, and only the result is rounded to float.
+  using DMat4 = glm::dmat4;
   struct GraphicsState {
-    Mat4 ctm{1.f};      // at the start of the transform interval (TransformTimes)
-    Mat4 ctm_end{1.f};  // at its end: differs for moving shapes (motion blur)
+    DMat4 ctm{1.0};      // at the start of the transform interval (TransformTimes)
+    DMat4 ctm_end{1.0};  // at its end: differs for moving shapes (motion blur)
     bool active_start = true, active_end = true;  // ActiveTransform
     bool reverse_orientation = false;
     int32_t material = 0;
@@ -58,7 +62,7 @@ class PbrtParser {
   GraphicsState state_;
   std::vector<StackEntry> stack_;
   struct CoordinateSystem {
-    Mat4 start, end;     // the transforms at the start and end of the transform interval
+    DMat4 start, end;    // the transforms at the start and end of the transform interval
     bool render_space;   // saved after WorldBegin (or the camera's): relative to render space, not world
   };
   std::map<std::string, CoordinateSystem> coordinate_systems_;
@@ -66,8 +70,8 @@ class PbrtParser {
   // camera sits at the origin. Everything after WorldBegin is placed there,
   // so a scene far from the world's origin keeps float precision near the
   // camera; SceneDesc::render_origin says where that origin is in the world.
-  Mat4 render_from_world_{1.f};
-  Mat4 world_from_render_{1.f};
+  DMat4 render_from_world_{1.0};
+  DMat4 world_from_render_{1.0};
   std::map<std::string, std::vector<MeshDesc>> instances_;
   std::string open_instance_;  // non-empty between ObjectBegin and ObjectEnd
   struct MediumRef {
