@@ -27,7 +27,7 @@ struct VizArgs {
   GuideArgs guide;
 };
 
-void write_distribution(const VizArgs& a, const GuideField& field, const Vec3& render_origin) {
+void write_distribution(const VizArgs& a, const GuideField& field, const glm::dvec3& render_origin) {
   if (a.point.size() != 3 || a.normal.size() != 3)
     throw std::runtime_error("guide-viz: --distribution needs --point X Y Z and --normal X Y Z");
   // The point is in the scene file's world; the guide lives in render space (camera at the origin).

@@ -38,10 +38,10 @@ int run_info(const std::string& path) {
                 scene.desc().camera_medium >= 0 ? ", the camera in one" : "");
   const Bounds& b = scene.bounds();
   // Bounds in the scene file's world (render space plus its origin, in double).
-  const Vec3 o = scene.desc().render_origin;
+  const glm::dvec3 o = scene.desc().render_origin;
   if (scene.num_triangles() > 0)
-    std::printf("bounds:         (%g, %g, %g) - (%g, %g, %g)\n", double(o.x) + b.lo.x, double(o.y) + b.lo.y,
-                double(o.z) + b.lo.z, double(o.x) + b.hi.x, double(o.y) + b.hi.y, double(o.z) + b.hi.z);
+    std::printf("bounds:         (%g, %g, %g) - (%g, %g, %g)\n", o.x + b.lo.x, o.y + b.lo.y, o.z + b.lo.z,
+                o.x + b.hi.x, o.y + b.hi.y, o.z + b.hi.z);
   std::printf("effects:        %s\n", describe_effects(scene.effects()).c_str());
   std::printf("specialisation: %s\n", describe_specialisation(specialisation_for(scene.effects())).c_str());
   const std::string why = spectral_reason(scene.desc());

@@ -33,7 +33,7 @@ bool representable(const Vec3& p) {
 }
 
 // `p` in render space, reported in the scene file's world (render space's origin added).
-std::string describe_far(const Vec3& p, const Vec3& origin = Vec3(0.f)) {
+std::string describe_far(const Vec3& p, const glm::dvec3& origin = glm::dvec3(0.0)) {
   char buf[160];
   std::snprintf(buf, sizeof buf, "at (%g, %g, %g): beyond +-%g (or not finite), where single-precision ray tracing cannot go",
                 double(p.x) + origin.x + 0.0, double(p.y) + origin.y + 0.0, double(p.z) + origin.z + 0.0,
@@ -411,11 +411,14 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     const bool moves = state_.ctm_end != state_.ctm;
     for (const MeshDesc& def : it->second) {
       MeshDesc copy = def;
-      transform_mesh(copy, ctm);  // definitions are stored in world space of the definition
+      // Definitions are stored in render space; the instance's transform is
+      // world-space, so it acts between world_from_render and render_from_world
+      // (pbrt-v4: RenderFromObject() * worldFromRender).
+      transform_mesh(copy, Mat4(state_.ctm * world_from_render_));
       if (moves && copy.area_light < 0) {  // the instance moves: its end is the definition under the end transform
         MeshDesc end = def;
         if (end.p_end.empty()) end.p_end = end.p, end.n_end = end.n;
-        transform_mesh(end, Mat4(state_.ctm_end));
+        transform_mesh(end, Mat4(state_.ctm_end * world_from_render_));
         copy.p_end = std::move(end.p_end);
         copy.n_end = std::move(end.n_end);
       }
@@ -443,7 +446,9 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     if (type.empty()) fail(at, "MakeNamedMedium \"" + name + "\" needs \"string type\"");
     if (names_.media.count(name)) warn("named medium \"" + name + "\" redefined");
     if (state_.ctm_end != state_.ctm) warn("a moving medium is not supported; it stays where it starts");
-    if (std::optional<Medium> m = make_medium(type, ps, ctm, context(at, including_dir))) {
+    // Before WorldBegin the CTM is world-space: place the medium in render space too.
+    const Mat4 render_from_medium(world_begun_ ? state_.ctm : render_from_world_ * state_.ctm);
+    if (std::optional<Medium> m = make_medium(type, ps, render_from_medium, context(at, including_dir))) {
       if (scene_.media.size() >= static_cast<size_t>(INT16_MAX)) fail(at, "too many media (at most 32767)");
       scene_.media.push_back(*m);
       names_.media[name] = static_cast<int32_t>(scene_.media.size() - 1);
@@ -502,7 +507,7 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   // time) is at the origin.
   render_from_world_ = glm::translate(DMat4(1.0), -eye);
   world_from_render_ = glm::translate(DMat4(1.0), eye);
-  scene_.render_origin = Vec3(eye);
+  scene_.render_origin = eye;
   scene_.camera.world_from_camera = Mat4(render_from_world_ * world_from_camera);
   scene_.camera.world_from_camera_end = Mat4(render_from_world_ * world_from_camera_end);
   scene_.camera.fov_degrees = params.get_float("fov", 90.f);

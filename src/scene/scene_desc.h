@@ -112,7 +112,7 @@ struct SceneDesc {
   // every position in this SceneDesc is relative to it (pbrt-v4's
   // "cameraworld" rendering space), which keeps float precision near the
   // camera in scenes far from the world's origin.
-  Vec3 render_origin{0.f};
+  glm::dvec3 render_origin{0.0};
   FilmDesc film;
   FilterDesc filter;
   int32_t spp = 16;        // pbrt-v4 default pixelsamples

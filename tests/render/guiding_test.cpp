@@ -494,7 +494,7 @@ AttributeEnd
   ASSERT_EQ(v.num_lights, 6u);
   // One-sided emitters 1 cm from a wall must face the room, not the wall.
   for (uint32_t l = 0; l < v.num_lights; ++l) {
-    const Vec3 p = s.scene.positions()[s.scene.indices()[3 * v.lights[l].triangle]] + s.scene.desc().render_origin;
+    const Vec3 p = s.scene.positions()[s.scene.indices()[3 * v.lights[l].triangle]] + Vec3(s.scene.desc().render_origin);
     EXPECT_GT(glm::dot(v.face_normals[v.lights[l].triangle], Vec3(0.f, 1.f, -1.f) - p), 0.f) << "light " << l;
   }
   const ChannelStats mu = channel_stats(s.run(nullptr, seeded(1)).film);

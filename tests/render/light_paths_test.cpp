@@ -188,7 +188,7 @@ Shape "trianglemesh" "point3 P" [ 2 0 -5  2 5 -5  2 5 5  2 0 5 ] "integer indice
   for (int32_t y = 0; y < cam.height; ++y)
     for (int32_t x = 0; x < cam.width; ++x) {
       Ray r = generate_camera_ray(cam, Vec2(x + 0.5f, y + 0.5f));
-      r.o += d.render_origin;  // rendering happens with the camera at the origin; the floor is at world y = 0
+      r.o += Vec3(d.render_origin);  // rendering happens with the camera at the origin; the floor is at world y = 0
       const Vec3 p = r.o + (-r.o.y / r.d.y) * r.d;  // on the floor
       const Vec3 v = mirrored_light - p;
       const double dist = glm::length(v);

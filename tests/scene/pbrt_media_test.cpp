@@ -83,7 +83,7 @@ MakeNamedMedium "wisps" "string type" "cloud"
   EXPECT_FLOAT_EQ(g.max_density, 3.f);
   EXPECT_EQ(g.p0, Vec3(-1.f));
   // The box sits where the CTM put it: world (10, 0, 0) is the medium's origin.
-  EXPECT_EQ(Vec3(g.medium_from_world * Vec4(Vec3(10.f, 0.f, 0.f) - d.render_origin, 1.f)), Vec3(0.f));
+  EXPECT_EQ(Vec3(g.medium_from_world * Vec4(Vec3(10.f, 0.f, 0.f) - Vec3(d.render_origin), 1.f)), Vec3(0.f));
   EXPECT_EQ(d.meshes[0].media.inside, 0);
   bool warned = false;
   for (const std::string& w : d.warnings) warned |= w.find("cloud") != std::string::npos;

@@ -30,7 +30,7 @@ TEST(PbrtReferenceScenes, CornellBox) {
   EXPECT_LT(glm::determinant(s.camera.world_from_camera), 0.f);
   // Render space: the camera at the origin, which is (278, 273, -800) in the file's world.
   EXPECT_VEC3_NEAR(Vec3(s.camera.world_from_camera * Vec4(0, 0, 0, 1)), Vec3(0.f), 1e-3f);
-  EXPECT_VEC3_NEAR(s.render_origin, Vec3(278, 273, -800), 1e-3f);
+  EXPECT_VEC3_NEAR(Vec3(s.render_origin), Vec3(278, 273, -800), 1e-3f);
   // The light faces down into the box.
   EXPECT_LT(test::geometric_normal(s.meshes.back(), 0).y, -0.99f);
 }

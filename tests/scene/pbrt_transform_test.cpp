@@ -41,7 +41,7 @@ TEST(PbrtTransform, LookAtGivesWorldFromCamera) {
                                      std::string(kTriangle),
                                  "t.pbrt", ".");
   const Mat4& m = s.camera.world_from_camera;
-  EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 0, 0, 1)) + s.render_origin, Vec3(0, 0, 5), 1e-5f);
+  EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 0, 0, 1)) + Vec3(s.render_origin), Vec3(0, 0, 5), 1e-5f);
   EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 0, 0, 1)), Vec3(0.f), 1e-6f);  // render space: the camera at the origin
   EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 0, 1, 0)), Vec3(0, 0, -1), 1e-6f);  // forward
   EXPECT_VEC3_NEAR(Vec3(m * Vec4(0, 1, 0, 0)), Vec3(0, 1, 0), 1e-6f);   // up
@@ -105,9 +105,9 @@ TEST(PbrtTransform, NamedCoordinateSystems) {
       "Identity\nCoordSysTransform \"camera\"\n" + std::string(kTriangle) + "CoordSysTransform \"seven\"\n" + kTriangle,
       "t.pbrt", ".");
   ASSERT_EQ(s.meshes.size(), 2u);
-  EXPECT_VEC3_NEAR(s.meshes[0].p[0] + s.render_origin, Vec3(1, 2, 3), 1e-5f);  // camera origin
-  EXPECT_VEC3_NEAR(s.meshes[1].p[0] + s.render_origin, Vec3(7, 0, 0), 1e-6f);
-  EXPECT_VEC3_NEAR(s.render_origin, Vec3(1, 2, 3), 1e-6f);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[0] + Vec3(s.render_origin), Vec3(1, 2, 3), 1e-5f);  // camera origin
+  EXPECT_VEC3_NEAR(s.meshes[1].p[0] + Vec3(s.render_origin), Vec3(7, 0, 0), 1e-6f);
+  EXPECT_VEC3_NEAR(Vec3(s.render_origin), Vec3(1, 2, 3), 1e-6f);
 }
 
 TEST(PbrtTransform, IncludeIsRelativeToIncludingFileAndKeepsState) {
@@ -130,6 +130,24 @@ TEST(PbrtTransform, ObjectInstanceCopiesWithInstanceTransform) {
   EXPECT_VEC3_NEAR(s.meshes[1].p[1], Vec3(9, 0, 1), 1e-6f);
   EXPECT_TRUE(s.meshes[1].flip_normals);
   EXPECT_EQ(s.meshes[1].where, "test.pbrt:9");
+}
+
+// With the camera away from the origin (render space moves the world), an
+// instance, an absolute Transform and the "world" coordinate system still
+// land where the file puts them in its world.
+TEST(PbrtTransform, RenderSpaceKeepsWorldPlacement) {
+  SceneDesc s = load_pbrt_string(std::string("LookAt 3 4 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n"
+                                             "ObjectBegin \"tri\"\nTranslate 0 0 1\n") +
+                                     kTriangle + "ObjectEnd\nTranslate 10 0 0\nObjectInstance \"tri\"\n" +
+                                     "Transform [ 1 0 0 0  0 1 0 0  0 0 1 0  0 7 0 1 ]\n" + kTriangle +
+                                     "CoordSysTransform \"world\"\n" + kTriangle,
+                                 "t.pbrt", ".");
+  ASSERT_EQ(s.meshes.size(), 3u);
+  const Vec3 origin(s.render_origin);
+  EXPECT_VEC3_NEAR(origin, Vec3(3, 4, 5), 1e-5f);
+  EXPECT_VEC3_NEAR(s.meshes[0].p[1] + origin, Vec3(11, 0, 1), 1e-5f);  // instance: Translate 10, then its own 0 0 1
+  EXPECT_VEC3_NEAR(s.meshes[1].p[0] + origin, Vec3(0, 7, 0), 1e-5f);   // absolute Transform in world space
+  EXPECT_VEC3_NEAR(s.meshes[2].p[0] + origin, Vec3(0, 0, 0), 1e-5f);   // the world's own frame
 }
 
 }  // namespace
