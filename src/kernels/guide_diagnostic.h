@@ -25,7 +25,8 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g
         Le += environment_radiance(s, s.lights[s.infinite_lights[k]], ray.d);
       return beta * Le;
     }
-    SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2);
+    const RayPoint from_ray{ray.o, ray.d, hit.t};
+    SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, 0.f, &from_ray);
     Vec3 wo = -ray.d;
     const TriangleInfo& info = s.triangles[hit.triangle];
     if (info.light >= 0) {

@@ -321,7 +321,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       break;
     }
     ++c.vertices;
-    SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, ray.time);
+    const RayPoint from_ray{ray.o, ray.d, hit.t};
+    SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, ray.time, &from_ray);
     Vec3 wo = -ray.d;
     const TriangleInfo& info = s.triangles[hit.triangle];
 

@@ -30,9 +30,44 @@ TESSERA_HOST_DEVICE inline Vec2 triangle_uv(const SceneView& s, uint32_t tri, Fl
   return (1.f - b1 - b2) * s.uvs[idx[0]] + b1 * s.uvs[idx[1]] + b2 * s.uvs[idx[2]];
 }
 
-// b1, b2: barycentrics of vertices 1 and 2 (Embree's u, v); time: the ray's (Ray::time).
+// The ray that found a hit: its point o + t d is the alternative to the
+// barycentric one (see refine_huge_triangle_hit).
+struct RayPoint {
+  Vec3 o, d;
+  Float t;
+};
+
+// A hit on a triangle much larger than its distance from the origin (a
+// ground plane 1e8 across seen from a camera at render space's origin): the
+// barycentric point sums terms the size of the triangle, so its error is
+// that size times float epsilon, metres for 1e8. The ray's point o + t d is
+// then far more precise along the plane, and its error across the plane
+// (t's rounding) is removed by projecting onto the plane, computed in
+// double from the vertices (their differences and cross product are exact
+// enough there). Leaves the hit alone unless that gains a factor of 16, so
+// ordinary triangles never pay for the double arithmetic.
+TESSERA_HOST_DEVICE inline void refine_huge_triangle_hit(SurfaceHit& h, const Vec3& p0, const Vec3& p1, const Vec3& p2,
+                                                         const RayPoint& r) {
+  constexpr Float kGamma7 = 7.f * 0x1p-24f / (1.f - 7.f * 0x1p-24f);
+  const Vec3 p_ray = r.o + r.t * r.d;
+  const Vec3 ray_error = kGamma7 * (abs3(r.o) + abs3(r.t * r.d));
+  const Float bary = glm::max(h.p_error.x, glm::max(h.p_error.y, h.p_error.z));
+  const Float ray = glm::max(ray_error.x, glm::max(ray_error.y, ray_error.z));
+  if (!(bary > 16.f * ray) || !(r.t < kInfinity)) return;
+  const glm::dvec3 q0(p0), n = glm::cross(glm::dvec3(p1) - q0, glm::dvec3(p2) - q0);
+  const double len = glm::length(n);
+  if (!(len > 0.0)) return;
+  glm::dvec3 x(p_ray);
+  x -= (glm::dot(n, x - q0) / (len * len)) * n;
+  h.p = Vec3(x);
+  h.p_error = kGamma7 * abs3(h.p) + ray_error;
+}
+
+// b1, b2: barycentrics of vertices 1 and 2 (Embree's u, v); time: the ray's
+// (Ray::time); ray: the ray that found the hit, if a ray did (huge
+// triangles take their point from it).
 TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& s, uint32_t tri, Float b1, Float b2,
-                                                               Float time = 0.f) {
+                                                               Float time = 0.f, const RayPoint* ray = nullptr) {
   const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
   const TriangleInfo& info = s.triangles[tri];
   Float b0 = 1.f - b1 - b2;
@@ -50,6 +85,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& 
   // pbrt-v4: gamma(7) * sum |b_i p_i| bounds the rounding error of h.p.
   constexpr Float kGamma7 = 7.f * 0x1p-24f / (1.f - 7.f * 0x1p-24f);
   h.p_error = kGamma7 * (abs3(b0 * p0) + abs3(b1 * p1) + abs3(b2 * p2));
+  if (ray) refine_huge_triangle_hit(h, p0, p1, p2, *ray);
   h.ng = s.face_normals[tri];
   if (moving) {
     const Vec3 n = glm::cross(p0 - p2, p1 - p2);
