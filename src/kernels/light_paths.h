@@ -320,7 +320,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
     const Vec3 wo_l = frame.to_local(wo);
     BsdfSample bs;
     if (!sample_f<Spec>(bsdf, wo_l, rng.uniform(), rng.uniform2(), &bs) || !(bs.pdf > 0.f)) return;
-    const Vec3 wi = frame.to_world(bs.wi);
+    const Vec3 wi = keep_on_lobe_side(frame.to_world(bs.wi), wo, h.ng, (bs.lobe & kLobeTransmission) != 0);
     // Importance transport: no 1/eta^2 at refraction (the BSDFs scale for
     // radiance), and pbrt-v4's shading-normal correction.
     Float w = abs_cos_theta(bs.wi) / bs.pdf * shading_normal_correction(wo, wi, h.ns, h.ng);

@@ -46,6 +46,19 @@ TEST(Furnace, HighAlbedoDeepPaths) {
 // A reflectance above 1 is an albedo clamped to 1 (as pbrt-v4's albedo
 // spectra are), in RGB and spectral transport alike: never a surface that
 // creates light.
+// Albedo 1 at depth 1000: every path must stay inside the tessellated
+// sphere for all 1000 bounces. Directions sampled around the shading normal
+// near a facet's horizon used to leave through the facet and escape: 7 % of
+// the light was lost (932 of 1001), and paths averaged 932 vertices.
+TEST(Furnace, AlbedoOneAtDepthThousandLosesNothing) {
+  RenderResult r = testing::render_text(furnace_scene(1.0, 1000, 8, 8));
+  const double mean = testing::image_mean(film_mean(r.film));
+  EXPECT_NEAR(mean, 1001.0, 0.002 * 1001.0);
+  const double vertices_per_path =
+      static_cast<double>(r.stats.counters.path.vertices) / static_cast<double>(r.stats.counters.samples);
+  EXPECT_GT(vertices_per_path, 999.0);
+}
+
 TEST(Furnace, ReflectanceAboveOneIsClampedToOne) {
   for (bool spectral : {false, true}) {
     SceneDesc d = load_pbrt_string(furnace_scene(1.5, 3), "<test>", ".");
