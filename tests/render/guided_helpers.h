@@ -46,15 +46,17 @@ struct ChannelStats {
   double se[3] = {0, 0, 0};
 };
 
+// In double from the film's sums: the float images saturate variances
+// beyond float's range (radiance ~1e20 and up), which would understate them.
 inline ChannelStats channel_stats(const Film& film) {
-  const ImageRgb m = film_mean(film), v = film_variance_of_mean(film);
   const double n = static_cast<double>(film.pixels.size());
   ChannelStats s;
   for (int c = 0; c < 3; ++c) {
     double sum = 0, var = 0;
     for (size_t i = 0; i < film.pixels.size(); ++i) {
-      sum += m.rgb[3 * i + c];
-      var += v.rgb[3 * i + c];
+      const PixelEstimate e = pixel_estimate(film, i, c);
+      sum += e.mean;
+      var += e.var_of_mean;
     }
     s.mean[c] = sum / n;
     s.se[c] = std::sqrt(var) / n;
