@@ -35,6 +35,17 @@ bool is_pbrt_directive_name(const std::string& word) {
 
 std::vector<Token> tokenize_pbrt(const std::string& text, const std::string& file) {
   std::vector<Token> tokens;
+  // Room for every run of non-blanks and bracket up front: a mesh of
+  // millions of numbers otherwise peaks at twice its tokens while the vector
+  // grows.
+  size_t estimate = 0;
+  bool blank = true;
+  for (const char ch : text) {
+    const bool b = std::isspace(static_cast<unsigned char>(ch)) != 0;
+    estimate += (blank && !b) + (ch == '[' || ch == ']');
+    blank = b;
+  }
+  tokens.reserve(estimate);
   int line = 1;
   size_t i = 0;
   const size_t n = text.size();
@@ -51,7 +62,7 @@ std::vector<Token> tokenize_pbrt(const std::string& text, const std::string& fil
     } else if (c == '#') {
       while (i < n && text[i] != '\n') ++i;
     } else if (c == '[' || c == ']') {
-      tokens.push_back({c == '[' ? TokenKind::OpenBracket : TokenKind::CloseBracket, std::string(1, c), 0., file, line});
+      tokens.push_back({c == '[' ? TokenKind::OpenBracket : TokenKind::CloseBracket, std::string(1, c), 0., &file, line});
       ++i;
     } else if (c == '"') {
       const int start_line = line;
@@ -78,7 +89,7 @@ std::vector<Token> tokenize_pbrt(const std::string& text, const std::string& fil
         s += d;
       }
       if (!closed) fail(start_line, "unterminated string");
-      tokens.push_back({TokenKind::String, std::move(s), 0., file, start_line});
+      tokens.push_back({TokenKind::String, std::move(s), 0., &file, start_line});
     } else {
       size_t start = i;
       while (i < n && !is_delimiter(text[i])) ++i;
@@ -91,9 +102,9 @@ std::vector<Token> tokenize_pbrt(const std::string& text, const std::string& fil
         // Scene values end up as floats: anything beyond float range is an overflow.
         if (!std::isfinite(v) || std::fabs(v) > std::numeric_limits<float>::max())
           fail(line, "number out of range '" + word + "'");
-        tokens.push_back({TokenKind::Number, std::move(word), v, file, line});
+        tokens.push_back({TokenKind::Number, std::move(word), v, &file, line});
       } else {
-        tokens.push_back({TokenKind::Word, std::move(word), 0., file, line});
+        tokens.push_back({TokenKind::Word, std::move(word), 0., &file, line});
       }
     }
   }

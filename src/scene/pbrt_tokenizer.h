@@ -13,13 +13,15 @@ struct Token {
   TokenKind kind = TokenKind::Word;
   std::string text;    // String: without the quotes; others: as written
   double number = 0.;  // Number only
-  std::string file;
+  // The file's name, shared by all its tokens (a big mesh is millions of
+  // tokens: a copy of the name in each was half their memory).
+  const std::string* file = nullptr;
   int line = 0;
 
-  std::string where() const { return file + ":" + std::to_string(line); }
+  std::string where() const { return (file ? *file : std::string("?")) + ":" + std::to_string(line); }
 };
 
-// Throws SceneError for an unterminated string or a malformed/non-finite
+// The tokens point at `file`, which must outlive them. Throws SceneError for an unterminated string or a malformed/non-finite
 // number ("1.2.3", "1e999"). Words that are not directives (e.g. "nan") are
 // left to the parser, which knows whether a number was expected.
 std::vector<Token> tokenize_pbrt(const std::string& text, const std::string& file);
