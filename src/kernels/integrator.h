@@ -546,7 +546,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     if (depth == 1) first_vertex_connectable = settings.light_traced_caustics && !specular_bounce;
     last_vertex_delta_only = !lobes_have_non_specular(lobes);
     if (bs.lobe & kLobeTransmission) eta_scale *= sqr(bs.eta);
-    wi = keep_on_lobe_side(wi, wo, h.ng, (bs.lobe & kLobeTransmission) != 0);
+    if (!(bs.lobe & kLobeSpecular)) wi = keep_on_lobe_side(wi, wo, h.ng, (bs.lobe & kLobeTransmission) != 0);
     ray.o = offset_ray_origin(h, wi);
     ray.d = wi;
     prev_p = h.p;

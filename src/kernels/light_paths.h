@@ -320,13 +320,15 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
     const Vec3 wo_l = frame.to_local(wo);
     BsdfSample bs;
     if (!sample_f<Spec>(bsdf, wo_l, rng.uniform(), rng.uniform2(), &bs) || !(bs.pdf > 0.f)) return;
-    const Vec3 wi = keep_on_lobe_side(frame.to_world(bs.wi), wo, h.ng, (bs.lobe & kLobeTransmission) != 0);
+    Vec3 wi = frame.to_world(bs.wi);
     // Importance transport: no 1/eta^2 at refraction (the BSDFs scale for
     // radiance), and pbrt-v4's shading-normal correction.
     Float w = abs_cos_theta(bs.wi) / bs.pdf * shading_normal_correction(wo, wi, h.ns, h.ng);
     if (bs.lobe & kLobeTransmission) w *= sqr(bs.eta);
     beta *= bs.f * w;
     if (is_black(beta) || !is_finite(beta)) return;
+    // The weight above is the sampled direction's; only the ray is kept on its lobe's side (as trace_path).
+    if (!(bs.lobe & kLobeSpecular)) wi = keep_on_lobe_side(wi, wo, h.ng, (bs.lobe & kLobeTransmission) != 0);
     if constexpr (kMedia) medium = medium_after(s, hit.triangle, h.ng, wi, medium);
     ray.o = offset_ray_origin(h, wi);
     ray.d = wi;

@@ -39,9 +39,14 @@ std::vector<Token> tokenize_pbrt(const std::string& text, const std::string& fil
   // millions of numbers otherwise peaks at twice its tokens while the vector
   // grows.
   size_t estimate = 0;
-  bool blank = true;
+  bool blank = true, comment = false;
   for (const char ch : text) {
-    const bool b = std::isspace(static_cast<unsigned char>(ch)) != 0;
+    if (comment) {
+      comment = ch != '\n';
+      continue;
+    }
+    comment = ch == '#';
+    const bool b = comment || std::isspace(static_cast<unsigned char>(ch)) != 0;
     estimate += (blank && !b) + (ch == '[' || ch == ']');
     blank = b;
   }

@@ -43,9 +43,6 @@ TEST(Furnace, HighAlbedoDeepPaths) {
   EXPECT_NEAR(mean, expected_furnace(0.9, 40), 0.02 * expected_furnace(0.9, 40));
 }
 
-// A reflectance above 1 is an albedo clamped to 1 (as pbrt-v4's albedo
-// spectra are), in RGB and spectral transport alike: never a surface that
-// creates light.
 // Albedo 1 at depth 1000: every path must stay inside the tessellated
 // sphere for all 1000 bounces. Directions sampled around the shading normal
 // near a facet's horizon used to leave through the facet and escape: 7 % of
@@ -59,6 +56,9 @@ TEST(Furnace, AlbedoOneAtDepthThousandLosesNothing) {
   EXPECT_GT(vertices_per_path, 999.0);
 }
 
+// A reflectance above 1 is an albedo clamped to 1 (as pbrt-v4's albedo
+// spectra are), in RGB and spectral transport alike: never a surface that
+// creates light.
 TEST(Furnace, ReflectanceAboveOneIsClampedToOne) {
   for (bool spectral : {false, true}) {
     SceneDesc d = load_pbrt_string(furnace_scene(1.5, 3), "<test>", ".");
