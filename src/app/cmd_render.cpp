@@ -193,7 +193,7 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   return m;
 }
 
-void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks) {
+void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks, int32_t machines) {
   const SceneData& scene = *m.scene;
   std::fprintf(stderr, "tessera: %s: %zu triangles, %u lights, %dx%d, %s, max depth %d\n",
                scene.desc().source.c_str(), scene.num_triangles(), scene.view().num_lights, scene.view().camera.width,
@@ -233,7 +233,9 @@ void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks) {
     std::fprintf(stderr, "tessera: stops at estimated relMSE <= %g%s, whichever comes first%s\n", m.opt.target_error,
                  limits.c_str(), limits.empty() ? " (no --time or --spp limit: runs until then)" : "");
   }
-  if (ranks > 1) std::fprintf(stderr, "tessera: farm: %d ranks (rank 0 schedules and renders)\n", ranks);
+  if (ranks > 1)
+    std::fprintf(stderr, "tessera: farm: %d ranks on %d machine%s (rank 0 schedules and renders)\n", ranks, machines,
+                 machines == 1 ? "" : "s");
   if (m.resume)
     std::fprintf(stderr, "tessera: resuming at %u spp (%u passes) from checkpoint\n", m.resume->so_far.stats.spp,
                  m.resume->so_far.stats.passes);
@@ -339,7 +341,7 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
 RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, const EmbreeScene& embree, PassExecutor* executor,
                               const std::function<void(RenderStats&)>& add_stats = {}) {
   const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide != nullptr);
-  log_setup(m, spec, executor ? executor->ranks() : 1);
+  log_setup(m, spec, executor ? executor->ranks() : 1, executor ? executor->machines() : 1);
   double last_checkpoint = m.resume ? m.resume->so_far.stats.seconds : 0.0;
   uint32_t checkpointed_spp = ~0u;  // spp of the last checkpoint this run wrote (none yet)
   std::optional<SnapshotWriter> snapshots;

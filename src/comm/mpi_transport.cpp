@@ -29,6 +29,11 @@ class MpiTransport : public Transport {
     MPI_Comm local;
     MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &local);
     MPI_Comm_size(local, &local_size_);
+    // One leader per machine: their count is the number of machines.
+    int local_rank = 0, leader = 0;
+    MPI_Comm_rank(local, &local_rank);
+    leader = local_rank == 0 ? 1 : 0;
+    MPI_Allreduce(&leader, &machines_, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
     MPI_Comm_free(&local);
   }
   ~MpiTransport() override {
@@ -39,6 +44,7 @@ class MpiTransport : public Transport {
   int32_t rank() const override { return rank_; }
   int32_t size() const override { return size_; }
   int32_t ranks_on_this_machine() const override { return local_size_; }
+  int32_t machines() const override { return machines_; }
 
   void send(int32_t dest, int32_t tag, Bytes bytes) override {
     if (bytes.size() > static_cast<size_t>(INT_MAX)) throw std::runtime_error("MPI: message larger than 2 GB");
@@ -118,7 +124,7 @@ class MpiTransport : public Transport {
     }
   }
 
-  int rank_ = 0, size_ = 1, local_size_ = 1;
+  int rank_ = 0, size_ = 1, local_size_ = 1, machines_ = 1;
   std::list<Pending> pending_;
 };
 

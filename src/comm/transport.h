@@ -29,6 +29,8 @@ class Transport {
   virtual int32_t size() const = 0;
   // Ranks sharing this rank's machine (to share its cores out).
   virtual int32_t ranks_on_this_machine() const { return 1; }
+  // Machines the ranks run on (hosts; shared-memory nodes to MPI).
+  virtual int32_t machines() const { return 1; }
   // Queues a message; never waits for the receiver (no deadlock when two
   // ranks send to each other at once).
   virtual void send(int32_t dest, int32_t tag, Bytes bytes) = 0;

@@ -21,6 +21,7 @@ class FarmMaster : public PassExecutor {
                    const std::function<void(uint64_t)>& on_tile_done) override;
   void reduce_guide(GuideField& guide) override;
   int32_t ranks() const override { return transport_.size(); }
+  int32_t machines() const override { return transport_.machines(); }
   int32_t total_threads() const override { return total_threads_; }
   // Tells the workers the render is over.
   void stop();

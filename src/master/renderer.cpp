@@ -113,6 +113,7 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
   }
   stats.threads = executor->total_threads();
   stats.ranks = executor->ranks();
+  stats.machines = executor->machines();
 
   std::vector<TileJob> tiles;
   const int32_t ts = std::max(1, opt.tile_size);

@@ -64,6 +64,7 @@ struct RenderStats {
   bool spectral = false;            // spectral transport (else RGB)
   int32_t threads = 0;              // all ranks together
   int32_t ranks = 1;                // processes that rendered (farm)
+  int32_t machines = 1;             // the machines (hosts) they ran on
   uint32_t resumed_at_spp = 0;      // > 0: continued from a checkpoint at this many spp
   std::string stop_reason;         // spp | time | target-error | interrupted (SIGINT/SIGTERM)
   double target_error = 0.0;       // the --target-error asked for (0 = none)
@@ -118,6 +119,7 @@ class PassExecutor {
   virtual void reduce_guide(GuideField& guide) {}
   // How many processes render (1 locally).
   virtual int32_t ranks() const { return 1; }
+  virtual int32_t machines() const { return 1; }
   virtual int32_t total_threads() const = 0;
 };
 

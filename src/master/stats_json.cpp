@@ -25,6 +25,7 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
   j["seed"] = (seed);
   j["threads"] = (uint64_t(s.threads));
   j["ranks"] = (uint64_t(s.ranks));
+  j["machines"] = (uint64_t(s.machines));
   if (s.resumed_at_spp > 0) j["resumed_at_spp"] = (uint64_t(s.resumed_at_spp));
   j["spp"] = (uint64_t(s.spp));
   j["passes"] = (uint64_t(s.passes));
