@@ -30,6 +30,9 @@ TESSERA_HOST_DEVICE inline Vec2 triangle_uv(const SceneView& s, uint32_t tri, Fl
   return (1.f - b1 - b2) * s.uvs[idx[0]] + b1 * s.uvs[idx[1]] + b2 * s.uvs[idx[2]];
 }
 
+// pbrt-v4's gamma(7): the relative rounding bound of a 7-operation float expression.
+constexpr Float kGamma7 = 7.f * 0x1p-24f / (1.f - 7.f * 0x1p-24f);
+
 // The ray that found a hit: its point o + t d is the alternative to the
 // barycentric one (see refine_huge_triangle_hit).
 struct RayPoint {
@@ -48,7 +51,6 @@ struct RayPoint {
 // ordinary triangles never pay for the double arithmetic.
 TESSERA_HOST_DEVICE inline void refine_huge_triangle_hit(SurfaceHit& h, const Vec3& p0, const Vec3& p1, const Vec3& p2,
                                                          const RayPoint& r) {
-  constexpr Float kGamma7 = 7.f * 0x1p-24f / (1.f - 7.f * 0x1p-24f);
   const Vec3 p_ray = r.o + r.t * r.d;
   const Vec3 ray_error = kGamma7 * (abs3(r.o) + abs3(r.t * r.d));
   const Float bary = glm::max(h.p_error.x, glm::max(h.p_error.y, h.p_error.z));
@@ -83,7 +85,6 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& 
   h.triangle = tri;
   h.p = b0 * p0 + b1 * p1 + b2 * p2;
   // pbrt-v4: gamma(7) * sum |b_i p_i| bounds the rounding error of h.p.
-  constexpr Float kGamma7 = 7.f * 0x1p-24f / (1.f - 7.f * 0x1p-24f);
   h.p_error = kGamma7 * (abs3(b0 * p0) + abs3(b1 * p1) + abs3(b2 * p2));
   if (ray) refine_huge_triangle_hit(h, p0, p1, p2, *ray);
   h.ng = s.face_normals[tri];
