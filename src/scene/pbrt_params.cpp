@@ -33,10 +33,10 @@ bool is_string_type(const std::string& t) { return t == "string" || t == "textur
 
 }  // namespace
 
-std::vector<Param> parse_param_list(const std::vector<Token>& tokens, size_t& pos) {
+std::vector<Param> parse_param_list(TokenStream& tokens, size_t& pos) {
   std::vector<Param> params;
-  while (pos < tokens.size() && tokens[pos].kind == TokenKind::String) {
-    const Token& decl = tokens[pos++];
+  while (tokens.has(pos) && tokens[pos].kind == TokenKind::String) {
+    const Token decl = tokens[pos++];  // a copy: the array below releases tokens as it reads them
     Param p;
     p.where = decl.where();
     {
@@ -51,13 +51,33 @@ std::vector<Param> parse_param_list(const std::vector<Token>& tokens, size_t& po
     if (!numeric && !is_string_type(p.type) && p.type != "bool" && p.type != "spectrum")
       fail(p.where, "unknown parameter type '" + p.type + "' in \"" + decl.text + "\"");
 
-    // The value: one token, or a bracketed array of them.
-    std::vector<const Token*> values;
-    if (pos >= tokens.size()) fail(p.where, "missing value for parameter \"" + decl.text + "\"");
+    // Each value as it is read: one token, or a bracketed array of them,
+    // released as it goes (a mesh's array is millions of tokens).
+    auto take = [&](const Token& v) {
+      if (p.type == "bool") {
+        if (v.text == "true") p.bools.push_back(true);
+        else if (v.text == "false") p.bools.push_back(false);
+        else fail(v.where(), "expected true or false for \"" + decl.text + "\", got '" + v.text + "'");
+      } else if (is_string_type(p.type)) {
+        if (v.kind != TokenKind::String) fail(v.where(), "expected a quoted string for \"" + decl.text + "\"");
+        p.strings.push_back(v.text);
+      } else if (p.type == "spectrum" && v.kind == TokenKind::String) {
+        p.strings.push_back(v.text);
+      } else {
+        if (v.kind != TokenKind::Number) fail(v.where(), "malformed number '" + v.text + "' for \"" + decl.text + "\"");
+        if (p.type == "integer" && v.number != std::floor(v.number))
+          fail(v.where(), "non-integer value '" + v.text + "' for \"" + decl.text + "\"");
+        // Integers are read as int: a value beyond its range would convert with undefined behaviour.
+        if (p.type == "integer" && !(std::abs(v.number) <= 2147483647.0))
+          fail(v.where(), "integer '" + v.text + "' for \"" + decl.text + "\" is out of range");
+        p.numbers.push_back(v.number);
+      }
+    };
+    if (!tokens.has(pos)) fail(p.where, "missing value for parameter \"" + decl.text + "\"");
     if (tokens[pos].kind == TokenKind::OpenBracket) {
-      const Token& open = tokens[pos++];
+      const Token open = tokens[pos++];
       bool closed = false;
-      while (pos < tokens.size()) {
+      while (tokens.has(pos)) {
         const Token& t = tokens[pos];
         if (t.kind == TokenKind::CloseBracket) {
           closed = true;
@@ -65,35 +85,15 @@ std::vector<Param> parse_param_list(const std::vector<Token>& tokens, size_t& po
           break;
         }
         if (t.kind == TokenKind::OpenBracket || (t.kind == TokenKind::Word && is_pbrt_directive_name(t.text))) break;
-        values.push_back(&t);
+        take(t);
         ++pos;
+        if ((pos & 4095u) == 0) tokens.release_before(pos);
       }
       if (!closed) fail(open.where(), "unterminated array for parameter \"" + decl.text + "\"");
     } else if (tokens[pos].kind == TokenKind::CloseBracket) {
       fail(tokens[pos].where(), "unexpected ']'");
     } else {
-      values.push_back(&tokens[pos++]);
-    }
-
-    for (const Token* v : values) {
-      if (p.type == "bool") {
-        if (v->text == "true") p.bools.push_back(true);
-        else if (v->text == "false") p.bools.push_back(false);
-        else fail(v->where(), "expected true or false for \"" + decl.text + "\", got '" + v->text + "'");
-      } else if (is_string_type(p.type)) {
-        if (v->kind != TokenKind::String) fail(v->where(), "expected a quoted string for \"" + decl.text + "\"");
-        p.strings.push_back(v->text);
-      } else if (p.type == "spectrum" && v->kind == TokenKind::String) {
-        p.strings.push_back(v->text);
-      } else {
-        if (v->kind != TokenKind::Number) fail(v->where(), "malformed number '" + v->text + "' for \"" + decl.text + "\"");
-        if (p.type == "integer" && v->number != std::floor(v->number))
-          fail(v->where(), "non-integer value '" + v->text + "' for \"" + decl.text + "\"");
-        // Integers are read as int: a value beyond its range would convert with undefined behaviour.
-        if (p.type == "integer" && !(std::abs(v->number) <= 2147483647.0))
-          fail(v->where(), "integer '" + v->text + "' for \"" + decl.text + "\" is out of range");
-        p.numbers.push_back(v->number);
-      }
+      take(tokens[pos++]);
     }
 
     if (numeric && p.numbers.size() % width != 0)

@@ -68,6 +68,6 @@ class ParamSet {
 // Parses the parameter list starting at tokens[pos], advancing pos past it.
 // Throws SceneError for malformed declarations, unterminated arrays, values
 // of the wrong kind or count.
-std::vector<Param> parse_param_list(const std::vector<Token>& tokens, size_t& pos);
+std::vector<Param> parse_param_list(TokenStream& tokens, size_t& pos);
 
 }  // namespace tessera

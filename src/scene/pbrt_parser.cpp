@@ -45,24 +45,24 @@ constexpr int kMaxIncludeDepth = 32;
 
 [[noreturn]] void fail(const Token& at, const std::string& problem) { throw SceneError(at.where() + ": " + problem); }
 
-const Token& next_token(const std::vector<Token>& tokens, size_t& pos, const Token& at, const char* what) {
-  if (pos >= tokens.size()) fail(at, std::string("missing ") + what + " after " + at.text);
+const Token& next_token(TokenStream& tokens, size_t& pos, const Token& at, const char* what) {
+  if (!tokens.has(pos)) fail(at, std::string("missing ") + what + " after " + at.text);
   return tokens[pos++];
 }
 
-std::string read_string(const std::vector<Token>& tokens, size_t& pos, const Token& at) {
+std::string read_string(TokenStream& tokens, size_t& pos, const Token& at) {
   const Token& t = next_token(tokens, pos, at, "a quoted string");
   if (t.kind != TokenKind::String) fail(t, "expected a quoted string after " + at.text + ", got '" + t.text + "'");
   return t.text;
 }
 
 // `count` numbers, optionally bracketed (Transform [ ... ] and Transform ... are both seen).
-std::vector<Float> read_numbers(const std::vector<Token>& tokens, size_t& pos, size_t count, const Token& at) {
-  bool bracketed = pos < tokens.size() && tokens[pos].kind == TokenKind::OpenBracket;
+std::vector<Float> read_numbers(TokenStream& tokens, size_t& pos, size_t count, const Token& at) {
+  bool bracketed = tokens.has(pos) && tokens[pos].kind == TokenKind::OpenBracket;
   if (bracketed) ++pos;
   std::vector<Float> out;
   while (out.size() < count) {
-    if (pos >= tokens.size() || (tokens[pos].kind == TokenKind::Word && is_pbrt_directive_name(tokens[pos].text)) ||
+    if (!tokens.has(pos) || (tokens[pos].kind == TokenKind::Word && is_pbrt_directive_name(tokens[pos].text)) ||
         tokens[pos].kind == TokenKind::CloseBracket)
       fail(at, at.text + " needs " + std::to_string(count) + " numbers, got " + std::to_string(out.size()));
     const Token& t = tokens[pos++];
@@ -70,7 +70,7 @@ std::vector<Float> read_numbers(const std::vector<Token>& tokens, size_t& pos, s
     out.push_back(static_cast<Float>(t.number));
   }
   if (bracketed) {
-    if (pos >= tokens.size() || tokens[pos].kind != TokenKind::CloseBracket)
+    if (!tokens.has(pos) || tokens[pos].kind != TokenKind::CloseBracket)
       fail(at, "unterminated array for " + at.text + " (expected " + std::to_string(count) + " numbers and ']')");
     ++pos;
   }
@@ -79,9 +79,9 @@ std::vector<Float> read_numbers(const std::vector<Token>& tokens, size_t& pos, s
 
 // Skips an unsupported directive's arguments: everything up to the next word
 // outside brackets that is not a bare bool.
-void skip_arguments(const std::vector<Token>& tokens, size_t& pos) {
+void skip_arguments(TokenStream& tokens, size_t& pos) {
   int depth = 0;
-  while (pos < tokens.size()) {
+  while (tokens.has(pos)) {
     const Token& t = tokens[pos];
     if (t.kind == TokenKind::OpenBracket) ++depth;
     else if (t.kind == TokenKind::CloseBracket) depth = depth > 0 ? depth - 1 : 0;
@@ -112,7 +112,7 @@ void read_spectrum_files(std::vector<Param>& params, const std::string& includin
   }
 }
 
-ParamSet read_params(const std::vector<Token>& tokens, size_t& pos, std::string owner, std::vector<std::string>& warnings,
+ParamSet read_params(TokenStream& tokens, size_t& pos, std::string owner, std::vector<std::string>& warnings,
                      const std::string& including_dir, const std::string& search_dir) {
   std::vector<Param> params = parse_param_list(tokens, pos);
   read_spectrum_files(params, including_dir, search_dir);
@@ -161,12 +161,13 @@ DirectiveContext PbrtParser::context(const Token& at, const std::string& includi
 }
 
 void PbrtParser::parse_text(const std::string& text, const std::string& file_name, const std::string& including_dir) {
-  parse_tokens(tokenize_pbrt(text, file_name), including_dir);
+  TokenStream tokens(text, file_name);
+  parse_tokens(tokens, including_dir);
 }
 
-void PbrtParser::parse_tokens(const std::vector<Token>& tokens, const std::string& including_dir) {
+void PbrtParser::parse_tokens(TokenStream& tokens, const std::string& including_dir) {
   size_t pos = 0;
-  while (pos < tokens.size()) directive(tokens, pos, including_dir);
+  while (tokens.has(pos)) directive(tokens, pos, including_dir);
 }
 
 void PbrtParser::require_world(const Token& at, bool inside) const {
@@ -195,8 +196,10 @@ void PbrtParser::pop(char kind, const Token& at) {
   }
 }
 
-void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const std::string& including_dir) {
-  const Token& at = tokens[pos++];
+void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& including_dir) {
+  // Everything before this directive is done with: drop it (a copy of `at` is kept).
+  tokens.release_before(pos);
+  const Token at = tokens[pos++];
   if (at.kind != TokenKind::Word) fail(at, "expected a directive, got '" + at.text + "'");
   const std::string& d = at.text;
   if (is_world_directive(d)) require_world(at, true);
@@ -460,7 +463,7 @@ void PbrtParser::directive(const std::vector<Token>& tokens, size_t& pos, const 
     // One name: the same medium on both sides; two: inside, then outside.
     const std::string inside = read_string(tokens, pos, at);
     std::string outside = inside;
-    if (pos < tokens.size() && tokens[pos].kind == TokenKind::String) outside = tokens[pos++].text;
+    if (tokens.has(pos) && tokens[pos].kind == TokenKind::String) outside = tokens[pos++].text;
     // pbrt-v4 looks media up by name when the scene is complete, so a medium
     // may be defined after its use: names are numbered here (as -2 - k) and
     // resolved in finish().

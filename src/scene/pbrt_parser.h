@@ -43,8 +43,8 @@ class PbrtParser {
     std::string where;
   };
 
-  void parse_tokens(const std::vector<Token>& tokens, const std::string& including_dir);
-  void directive(const std::vector<Token>& tokens, size_t& pos, const std::string& including_dir);
+  void parse_tokens(TokenStream& tokens, const std::string& including_dir);
+  void directive(TokenStream& tokens, size_t& pos, const std::string& including_dir);
   void shape(const Token& at, const std::string& type, const ParamSet& params, const std::string& including_dir);
   void camera(const Token& at, const std::string& type, const ParamSet& params);
   // Fails unless every vertex (and its end position when it moves) is within

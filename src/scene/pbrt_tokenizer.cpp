@@ -33,57 +33,39 @@ bool is_pbrt_directive_name(const std::string& word) {
   return false;
 }
 
-std::vector<Token> tokenize_pbrt(const std::string& text, const std::string& file) {
-  std::vector<Token> tokens;
-  // Room for every run of non-blanks and bracket up front: a mesh of
-  // millions of numbers otherwise peaks at twice its tokens while the vector
-  // grows.
-  size_t estimate = 0;
-  bool blank = true, comment = false;
-  for (const char ch : text) {
-    if (comment) {
-      comment = ch != '\n';
-      continue;
-    }
-    comment = ch == '#';
-    const bool b = comment || std::isspace(static_cast<unsigned char>(ch)) != 0;
-    estimate += (blank && !b) + (ch == '[' || ch == ']');
-    blank = b;
-  }
-  tokens.reserve(estimate);
-  int line = 1;
-  size_t i = 0;
-  const size_t n = text.size();
+bool TokenStream::produce() {
+  const size_t n = text_.size();
   auto fail = [&](int at_line, const std::string& problem) {
-    throw SceneError(file + ":" + std::to_string(at_line) + ": " + problem);
+    throw SceneError(file_ + ":" + std::to_string(at_line) + ": " + problem);
   };
-  while (i < n) {
-    char c = text[i];
+  while (i_ < n) {
+    char c = text_[i_];
     if (c == '\n') {
-      ++line;
-      ++i;
+      ++line_;
+      ++i_;
     } else if (std::isspace(static_cast<unsigned char>(c))) {
-      ++i;
+      ++i_;
     } else if (c == '#') {
-      while (i < n && text[i] != '\n') ++i;
+      while (i_ < n && text_[i_] != '\n') ++i_;
     } else if (c == '[' || c == ']') {
-      tokens.push_back({c == '[' ? TokenKind::OpenBracket : TokenKind::CloseBracket, std::string(1, c), 0., &file, line});
-      ++i;
+      window_.push_back({c == '[' ? TokenKind::OpenBracket : TokenKind::CloseBracket, std::string(1, c), 0., &file_, line_});
+      ++i_;
+      return true;
     } else if (c == '"') {
-      const int start_line = line;
+      const int start_line = line_;
       std::string s;
-      ++i;
+      ++i_;
       bool closed = false;
-      while (i < n) {
-        char d = text[i++];
+      while (i_ < n) {
+        char d = text_[i_++];
         if (d == '"') {
           closed = true;
           break;
         }
         // pbrt strings cannot span lines; a newline means the quote was never closed.
         if (d == '\n') break;
-        if (d == '\\' && i < n) {
-          char e = text[i++];
+        if (d == '\\' && i_ < n) {
+          char e = text_[i_++];
           switch (e) {
             case 'n': s += '\n'; break;
             case 't': s += '\t'; break;
@@ -94,26 +76,46 @@ std::vector<Token> tokenize_pbrt(const std::string& text, const std::string& fil
         s += d;
       }
       if (!closed) fail(start_line, "unterminated string");
-      tokens.push_back({TokenKind::String, std::move(s), 0., &file, start_line});
+      window_.push_back({TokenKind::String, std::move(s), 0., &file_, start_line});
+      return true;
     } else {
-      size_t start = i;
-      while (i < n && !is_delimiter(text[i])) ++i;
-      std::string word = text.substr(start, i - start);
+      size_t start = i_;
+      while (i_ < n && !is_delimiter(text_[i_])) ++i_;
+      std::string word = text_.substr(start, i_ - start);
       if (starts_number(word[0])) {
         errno = 0;
         char* end = nullptr;
         double v = std::strtod(word.c_str(), &end);
-        if (end != word.c_str() + word.size()) fail(line, "malformed number '" + word + "'");
+        if (end != word.c_str() + word.size()) fail(line_, "malformed number '" + word + "'");
         // Scene values end up as floats: anything beyond float range is an overflow.
         if (!std::isfinite(v) || std::fabs(v) > std::numeric_limits<float>::max())
-          fail(line, "number out of range '" + word + "'");
-        tokens.push_back({TokenKind::Number, std::move(word), v, &file, line});
+          fail(line_, "number out of range '" + word + "'");
+        window_.push_back({TokenKind::Number, std::move(word), v, &file_, line_});
       } else {
-        tokens.push_back({TokenKind::Word, std::move(word), 0., &file, line});
+        window_.push_back({TokenKind::Word, std::move(word), 0., &file_, line_});
       }
+      return true;
     }
   }
-  return tokens;
+  return false;
+}
+
+bool TokenStream::has(size_t index) {
+  while (first_ + window_.size() <= index)
+    if (!produce()) return false;
+  return index >= first_;
+}
+
+const Token& TokenStream::operator[](size_t index) {
+  if (!has(index)) throw SceneError(file_ + ":" + std::to_string(line_) + ": read past the end of the file");
+  return window_[index - first_];
+}
+
+void TokenStream::release_before(size_t index) {
+  while (first_ < index && !window_.empty()) {
+    window_.pop_front();
+    ++first_;
+  }
 }
 
 }  // namespace tessera
