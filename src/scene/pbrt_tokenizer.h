@@ -33,6 +33,9 @@ struct Token {
 class TokenStream {
  public:
   TokenStream(const std::string& text, const std::string& file) : text_(text), file_(file) {}
+  // Temporaries would leave the stream and its tokens pointing at freed strings.
+  TokenStream(std::string&&, const std::string&) = delete;
+  TokenStream(const std::string&, std::string&&) = delete;
   // Whether token `index` exists (making tokens up to it). False past the
   // end, and for tokens already released.
   bool has(size_t index);
