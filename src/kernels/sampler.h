@@ -40,6 +40,7 @@ struct SamplerSetup {
   uint32_t strata_y = 4;
   bool jitter = true;      // Stratified: a random point in each stratum (else its centre)
   HaltonLayout halton;     // Halton: the image's pixel layout (halton_layout of the film's full resolution)
+  HaltonRandomize halton_randomize = HaltonRandomize::PermuteDigits;
 };
 
 // The smallest L with 2^L >= spp, at most 26: the Sobol points use 32 bits
@@ -93,6 +94,7 @@ struct PixelSampler {
   uint64_t morton = 0;     // ZSobol: the pixel's Morton code
   uint64_t halton_index = 0;  // Halton: the sample's index in the global sequence
   uint32_t halton_exponent2 = 0, halton_scale3 = 1;  // Halton: the layout's 2^a and 3^b (pixel2)
+  HaltonRandomize halton_randomize = HaltonRandomize::PermuteDigits;
   uint32_t index = 0;      // sample index within the pixel (ZSobol, Stratified: within its epoch)
   uint32_t epoch = 0;      // ZSobol, Stratified: which round of 2^L (sx * sy) samples
   uint32_t dimension = 0;
@@ -133,6 +135,7 @@ struct PixelSampler {
         s.stream = mix_bits(setup.seed ^ 0x4a1709ull);
         s.halton_exponent2 = setup.halton.exponent[0];
         s.halton_scale3 = setup.halton.scale[1];
+        s.halton_randomize = setup.halton_randomize;
         s.halton_index = halton_pixel_index(setup.halton, x, y) +
                          sample * (static_cast<uint64_t>(setup.halton.scale[0]) * setup.halton.scale[1]);
         s.dimension = 2;  // 0 and 1 are the pixel's (pixel2)
@@ -222,8 +225,10 @@ struct PixelSampler {
   // Halton: dimension d's randomised radical inverse, the same digit
   // permutations for every pixel (they randomise the one global sequence).
   TESSERA_HOST_DEVICE Float halton_dimension(uint32_t d) const {
+    if (halton_randomize == HaltonRandomize::None) return halton_detail::radical_inverse(halton_detail::prime(d), halton_index);
     return halton_detail::scrambled_radical_inverse(halton_detail::prime(d), halton_index,
-                                                    mix_bits(stream ^ (static_cast<uint64_t>(d) * 0x9e3779b97f4a7c15ull)));
+                                                    mix_bits(stream ^ (static_cast<uint64_t>(d) * 0x9e3779b97f4a7c15ull)),
+                                                    halton_randomize == HaltonRandomize::Owen);
   }
   // Stratified: the jitter of coordinate c within the sample's stratum.
   TESSERA_HOST_DEVICE Float jitter_value(uint64_t key, uint32_t c) const {

@@ -52,7 +52,7 @@ uint64_t render_options_fingerprint(const RenderOptions& o, int32_t width, int32
   if (o.sampler.kind == SamplerKind::ZSobol) s << " zsobol " << o.sampler.log2_spp;
   if (o.sampler.kind == SamplerKind::Stratified)
     s << " stratified " << o.sampler.strata_x << 'x' << o.sampler.strata_y << ' ' << o.sampler.jitter;
-  if (o.sampler.kind == SamplerKind::Halton) s << " halton";
+  if (o.sampler.kind == SamplerKind::Halton) s << " halton " << static_cast<uint32_t>(o.sampler.halton_randomize);
   if (o.light_paths) s << " light-paths";
   return fnv1a(s.str());
 }

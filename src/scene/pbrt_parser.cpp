@@ -328,6 +328,14 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     }
     scene_.sampler_spp = scene_.spp;
     ps.find_any("jitter");
+    if (type == "halton") {
+      // pbrt-v4: permutedigits (default), none, owen.
+      const std::string r = ps.get_string("randomization", "permutedigits");
+      if (r == "permutedigits") scene_.halton_randomize = HaltonRandomize::PermuteDigits;
+      else if (r == "none") scene_.halton_randomize = HaltonRandomize::None;
+      else if (r == "owen") scene_.halton_randomize = HaltonRandomize::Owen;
+      else fail(at, "unknown halton randomization \"" + r + "\" (permutedigits, none or owen)");
+    }
     ps.find_any("randomization");
     ps.report_unused(warnings);
   } else if (d == "Integrator") {

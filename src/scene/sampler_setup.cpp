@@ -30,6 +30,7 @@ SamplerSetup sampler_setup(const SceneDesc& desc) {
   s.seed = desc.seed;
   s.log2_spp = ceil_log2_spp(static_cast<uint64_t>(std::max(1, desc.sampler_spp)));
   s.jitter = desc.sampler_jitter;
+  s.halton_randomize = desc.halton_randomize;
   s.strata_x = static_cast<uint32_t>(std::max(1, desc.strata_x));
   s.strata_y = static_cast<uint32_t>(std::max(1, desc.strata_y));
   s.halton = halton_layout(static_cast<uint32_t>(std::max(1, desc.film.xres)), static_cast<uint32_t>(std::max(1, desc.film.yres)));

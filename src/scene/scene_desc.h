@@ -129,6 +129,7 @@ struct SceneDesc {
   // resumes with any --spp.
   int32_t sampler_spp = 16;
   bool sampler_jitter = true;          // stratified: "jitter"
+  HaltonRandomize halton_randomize = HaltonRandomize::PermuteDigits;  // halton: "randomization"
   // Spectral transport (kernels/spectral.h): paths carry three sampled
   // wavelengths, as pbrt-v4's carry four; false: paths carry RGB.
   bool spectral = false;

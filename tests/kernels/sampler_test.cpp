@@ -205,31 +205,51 @@ TEST(Sampler, HaltonIndicesLandInTheirPixel) {
 // a 2D request in bases p, q over (p q)^k samples put one point in every
 // cell (the sample stride 2^a 3^b is coprime to the other primes).
 TEST(Sampler, HaltonPrefixesAreStratified) {
-  const SamplerSetup setup = setup_of(SamplerKind::Halton, 3);
-  auto cells = [&](uint32_t n, auto&& cell_of) {
-    std::set<uint32_t> seen;
-    for (uint32_t i = 0; i < n; ++i) {
-      PixelSampler s = start(setup, 123457, i);
-      seen.insert(cell_of(s));
-    }
-    return static_cast<uint32_t>(seen.size());
-  };
-  EXPECT_EQ(cells(64, [](PixelSampler& s) { return static_cast<uint32_t>(s.pixel2().x * 64); }), 64u);
-  EXPECT_EQ(cells(81, [](PixelSampler& s) { return static_cast<uint32_t>(s.pixel2().y * 81); }), 81u);
-  // Dimension 2 (base 5), then dimensions 3 and 4 (bases 7 and 11).
-  EXPECT_EQ(cells(125, [](PixelSampler& s) { return static_cast<uint32_t>(s.uniform() * 125); }), 125u);
-  EXPECT_EQ(cells(77, [](PixelSampler& s) {
-              s.uniform();
-              const Vec2 p = s.uniform2();
-              return static_cast<uint32_t>(p.y * 11) * 7 + static_cast<uint32_t>(p.x * 7);
-            }),
-            77u);
-  // The first 2D request is dimensions 2 and 3: 25 x 49 cells by 1225 samples.
-  EXPECT_EQ(cells(1225, [](PixelSampler& s) {
-              const Vec2 p = s.uniform2();
-              return static_cast<uint32_t>(p.y * 49) * 25 + static_cast<uint32_t>(p.x * 25);
-            }),
-            1225u);
+  for (HaltonRandomize r : {HaltonRandomize::PermuteDigits, HaltonRandomize::None, HaltonRandomize::Owen}) {
+    SCOPED_TRACE(static_cast<int>(r));
+    SamplerSetup setup = setup_of(SamplerKind::Halton, 3);
+    setup.halton_randomize = r;
+    auto cells = [&](uint32_t n, auto&& cell_of) {
+      std::set<uint32_t> seen;
+      for (uint32_t i = 0; i < n; ++i) {
+        PixelSampler s = start(setup, 123457, i);
+        seen.insert(cell_of(s));
+      }
+      return static_cast<uint32_t>(seen.size());
+    };
+    EXPECT_EQ(cells(64, [](PixelSampler& s) { return static_cast<uint32_t>(s.pixel2().x * 64); }), 64u);
+    EXPECT_EQ(cells(81, [](PixelSampler& s) { return static_cast<uint32_t>(s.pixel2().y * 81); }), 81u);
+    // Dimension 2 (base 5), then dimensions 3 and 4 (bases 7 and 11).
+    EXPECT_EQ(cells(125, [](PixelSampler& s) { return static_cast<uint32_t>(s.uniform() * 125); }), 125u);
+    EXPECT_EQ(cells(77, [](PixelSampler& s) {
+                s.uniform();
+                const Vec2 p = s.uniform2();
+                return static_cast<uint32_t>(p.y * 11) * 7 + static_cast<uint32_t>(p.x * 7);
+              }),
+              77u);
+    // The first 2D request is dimensions 2 and 3: 25 x 49 cells by 1225 samples.
+    EXPECT_EQ(cells(1225, [](PixelSampler& s) {
+                const Vec2 p = s.uniform2();
+                return static_cast<uint32_t>(p.y * 49) * 25 + static_cast<uint32_t>(p.x * 25);
+              }),
+              1225u);
+  }
+  // The three randomisations give three point sets; "none" is the plain radical inverse.
+  SamplerSetup setup = setup_of(SamplerKind::Halton, 3);
+  Float firsts[3];
+  for (int r = 0; r < 3; ++r) {
+    setup.halton_randomize = static_cast<HaltonRandomize>(r);
+    firsts[r] = start(setup, 123457, 5).uniform();
+  }
+  EXPECT_NE(firsts[0], firsts[1]);
+  EXPECT_NE(firsts[0], firsts[2]);
+  EXPECT_NE(firsts[1], firsts[2]);
+  const uint64_t index = halton_pixel_index(setup.halton, 123457 % 1000, 123457 / 1000) +
+                         5ull * setup.halton.scale[0] * setup.halton.scale[1];
+  double plain = 0, f = 0.2;
+  for (uint64_t i = index; i; i /= 5, f /= 5) plain += static_cast<double>(i % 5) * f;
+  EXPECT_NEAR(firsts[1], plain, 1e-6);
+  setup.halton_randomize = HaltonRandomize::PermuteDigits;
   // Past the 1000th prime the dimensions start again at 2, as pbrt-v4's do.
   PixelSampler a = start(setup, 9, 5), b = start(setup, 9, 5);
   const Float first = a.uniform();

@@ -51,6 +51,12 @@ TEST(PbrtOptions, FilmSamplerIntegrator) {
   const SceneDesc halton = load_with_options("Sampler \"halton\" \"string randomization\" \"permutedigits\"\n");
   EXPECT_EQ(halton.sampler, SamplerKind::Halton);
   EXPECT_TRUE(halton.warnings.empty());
+  EXPECT_EQ(halton.halton_randomize, HaltonRandomize::PermuteDigits);
+  EXPECT_EQ(load_with_options("Sampler \"halton\" \"string randomization\" \"owen\"\n").halton_randomize,
+            HaltonRandomize::Owen);
+  EXPECT_EQ(load_with_options("Sampler \"halton\" \"string randomization\" \"none\"\n").halton_randomize,
+            HaltonRandomize::None);
+  EXPECT_THROW(load_with_options("Sampler \"halton\" \"string randomization\" \"fastowen\"\n"), SceneError);
   // pbrt's global "sobol" ordering is not reproduced, nor pmj02bn's points: said so.
   const SceneDesc sobol = load_with_options("Sampler \"sobol\"\n");
   EXPECT_EQ(sobol.sampler, SamplerKind::Sobol);
