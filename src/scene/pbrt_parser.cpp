@@ -57,17 +57,18 @@ std::string read_string(TokenStream& tokens, size_t& pos, const Token& at) {
 }
 
 // `count` numbers, optionally bracketed (Transform [ ... ] and Transform ... are both seen).
-std::vector<Float> read_numbers(TokenStream& tokens, size_t& pos, size_t count, const Token& at) {
+// In double, as the transforms they build are composed (GraphicsState).
+std::vector<double> read_numbers(TokenStream& tokens, size_t& pos, size_t count, const Token& at) {
   bool bracketed = tokens.has(pos) && tokens[pos].kind == TokenKind::OpenBracket;
   if (bracketed) ++pos;
-  std::vector<Float> out;
+  std::vector<double> out;
   while (out.size() < count) {
     if (!tokens.has(pos) || (tokens[pos].kind == TokenKind::Word && is_pbrt_directive_name(tokens[pos].text)) ||
         tokens[pos].kind == TokenKind::CloseBracket)
       fail(at, at.text + " needs " + std::to_string(count) + " numbers, got " + std::to_string(out.size()));
     const Token& t = tokens[pos++];
     if (t.kind != TokenKind::Number) fail(t, "malformed number '" + t.text + "' for " + at.text);
-    out.push_back(static_cast<Float>(t.number));
+    out.push_back(t.number);
   }
   if (bracketed) {
     if (!tokens.has(pos) || tokens[pos].kind != TokenKind::CloseBracket)
@@ -216,25 +217,25 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
   auto post_multiply = [&](const DMat4& m) { set_active(state_.ctm * m, state_.ctm_end * m); };
 
   if (d == "Translate") {
-    std::vector<Float> v = read_numbers(tokens, pos, 3, at);
+    std::vector<double> v = read_numbers(tokens, pos, 3, at);
     post_multiply(glm::translate(DMat4(1.0), glm::dvec3(v[0], v[1], v[2])));
   } else if (d == "Scale") {
-    std::vector<Float> v = read_numbers(tokens, pos, 3, at);
+    std::vector<double> v = read_numbers(tokens, pos, 3, at);
     post_multiply(glm::scale(DMat4(1.0), glm::dvec3(v[0], v[1], v[2])));
   } else if (d == "Rotate") {
-    std::vector<Float> v = read_numbers(tokens, pos, 4, at);
-    Vec3 axis(v[1], v[2], v[3]);
-    if (glm::length(axis) == 0.f) fail(at, "Rotate axis is zero");
-    post_multiply(glm::rotate(DMat4(1.0), double(v[0]) * 3.14159265358979323846 / 180.0, glm::normalize(glm::dvec3(axis))));
+    std::vector<double> v = read_numbers(tokens, pos, 4, at);
+    const glm::dvec3 axis(v[1], v[2], v[3]);
+    if (glm::length(axis) == 0.0) fail(at, "Rotate axis is zero");
+    post_multiply(glm::rotate(DMat4(1.0), v[0] * 3.14159265358979323846 / 180.0, glm::normalize(axis)));
   } else if (d == "LookAt") {
-    std::vector<Float> v = read_numbers(tokens, pos, 9, at);
+    std::vector<double> v = read_numbers(tokens, pos, 9, at);
     post_multiply(look_at(glm::dvec3(v[0], v[1], v[2]), glm::dvec3(v[3], v[4], v[5]), glm::dvec3(v[6], v[7], v[8]), at,
                           warnings));
   } else if (d == "Transform" || d == "ConcatTransform") {
     // pbrt-v4 reads the 16 numbers row-major and transposes: they are the
     // matrix's columns, exactly glm's storage order.
-    std::vector<Float> v = read_numbers(tokens, pos, 16, at);
-    const DMat4 m(glm::make_mat4(v.data()));
+    std::vector<double> v = read_numbers(tokens, pos, 16, at);
+    const DMat4 m = glm::make_mat4(v.data());
     if (d == "ConcatTransform") post_multiply(m);
     else if (world_begun_) set_active(render_from_world_ * m, render_from_world_ * m);  // m is world-space
     else set_active(m, m);
@@ -445,11 +446,11 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     else fail(which, "ActiveTransform takes All, StartTime or EndTime, not '" + which.text + "'");
   } else if (d == "TransformTimes") {
     require_world(at, false);
-    std::vector<Float> v = read_numbers(tokens, pos, 2, at);
+    std::vector<double> v = read_numbers(tokens, pos, 2, at);
     if (!(v[1] > v[0]) || !std::isfinite(v[0]) || !std::isfinite(v[1]))
       fail(at, "TransformTimes needs a start time below its end time");
-    scene_.camera.transform_start_time = v[0];
-    scene_.camera.transform_end_time = v[1];
+    scene_.camera.transform_start_time = static_cast<Float>(v[0]);
+    scene_.camera.transform_end_time = static_cast<Float>(v[1]);
   } else if (d == "MakeNamedMedium") {
     std::string name = read_string(tokens, pos, at);
     ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_);

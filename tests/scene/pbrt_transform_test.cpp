@@ -132,6 +132,16 @@ TEST(PbrtTransform, ObjectInstanceCopiesWithInstanceTransform) {
   EXPECT_EQ(s.meshes[1].where, "test.pbrt:9");
 }
 
+// Transform numbers are read in double: an object at x = 1000000.3 seen from
+// a camera at x = 1000000 sits 0.3 from it in render space (as float,
+// 1000000.3 is 1000000.3125).
+TEST(PbrtTransform, TransformNumbersKeepDoublePrecision) {
+  SceneDesc s = load_pbrt_string(std::string("LookAt 1000000 0 -5  1000000 0 0  0 1 0\nCamera \"perspective\"\n"
+                                             "WorldBegin\nTranslate 1000000.3 0 0\n") + kTriangle,
+                                 "t.pbrt", ".");
+  EXPECT_NEAR(s.meshes[0].p[0].x, 0.3f, 1e-6f);
+}
+
 // With the camera away from the origin (render space moves the world), an
 // instance, an absolute Transform and the "world" coordinate system still
 // land where the file puts them in its world.
