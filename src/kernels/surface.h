@@ -89,13 +89,8 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& 
   if (ray) refine_huge_triangle_hit(h, p0, p1, p2, *ray);
   h.ng = s.face_normals[tri];
   if (moving) {
-    // In double, as the static normals (scene_data.cpp): a huge triangle's cross product overflows float.
-    const glm::dvec3 nd = glm::cross(glm::dvec3(p0) - glm::dvec3(p2), glm::dvec3(p1) - glm::dvec3(p2));
-    const double len = glm::length(nd);
-    if (len > 0.0) {
-      const Vec3 n(nd / len);
-      h.ng = (info.flags & kTriFlipNormal) ? -n : n;
-    }
+    Vec3 n;
+    if (triangle_normal(p0, p1, p2, &n, nullptr)) h.ng = (info.flags & kTriFlipNormal) ? -n : n;
   }
   h.ns = h.ng;
   if (info.flags & kTriHasNormals) {

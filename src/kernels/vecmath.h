@@ -13,6 +13,18 @@ namespace tessera {
 // cost ~5 % of a guided render. fabsf is one and-not on the CPU and on CUDA.
 TESSERA_HOST_DEVICE inline Vec3 abs3(const Vec3& v) { return Vec3(fabsf(v.x), fabsf(v.y), fabsf(v.z)); }
 
+// The unit normal cross(a - c, b - c) / |...| of triangle (a, b, c) and its
+// area, false for a degenerate one. In double: the cross product of a
+// triangle 1e10 across (4e20) squares past float's range in the length.
+TESSERA_HOST_DEVICE inline bool triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c, Vec3* n, double* area) {
+  const glm::dvec3 nd = glm::cross(glm::dvec3(a) - glm::dvec3(c), glm::dvec3(b) - glm::dvec3(c));
+  const double len = glm::length(nd);
+  if (!(len > 0.0)) return false;
+  *n = Vec3(nd / len);
+  if (area) *area = 0.5 * len;
+  return true;
+}
+
 TESSERA_HOST_DEVICE inline Float max_component(const Vec3& v) { return glm::max(v.x, glm::max(v.y, v.z)); }
 TESSERA_HOST_DEVICE inline Float luminance(const Rgb& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 TESSERA_HOST_DEVICE inline bool is_black(const Rgb& c) { return c.x == 0.f && c.y == 0.f && c.z == 0.f; }

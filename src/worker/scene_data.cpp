@@ -60,12 +60,10 @@ void SceneData::flatten_meshes() {
     for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
       const Vec3 &a = m.p[m.indices[t]], &b = m.p[m.indices[t + 1]], &c = m.p[m.indices[t + 2]];
       // Degenerate triangles can never be hit or sampled; dropping them keeps
-      // area-light pdfs finite. In double: the cross product of a triangle
-      // 1e10 across (4e20) squares past float's range in the length.
-      const glm::dvec3 nd = glm::cross(glm::dvec3(a) - glm::dvec3(c), glm::dvec3(b) - glm::dvec3(c));
-      const double len = glm::length(nd);
-      if (!(len > 0.0)) continue;
-      const Vec3 n(nd / len);
+      // area-light pdfs finite.
+      Vec3 n;
+      double area = 0.0;
+      if (!triangle_normal(a, b, c, &n, &area)) continue;
       face_normals_.push_back(m.flip_normals ? -n : n);
       for (int k = 0; k < 3; ++k) indices_.push_back(base + m.indices[t + k]);
       TriangleInfo ti = info;
@@ -78,7 +76,7 @@ void SceneData::flatten_meshes() {
           l.blackbody_kelvin = al.blackbody_kelvin;
           l.two_sided = al.two_sided;
           l.triangle = static_cast<uint32_t>(triangles_.size());
-          l.area = static_cast<Float>(0.5 * len);  // beyond float's range: infinite, so never sampled
+          l.area = static_cast<Float>(area);
           ti.light = static_cast<int32_t>(lights_.size());
           lights_.push_back(l);
         }

@@ -20,6 +20,7 @@ namespace {
 
 using testing::ChannelStats;
 using testing::GuidedScene;
+using testing::rule_name;
 
 struct RoomVariant {
   const char* name;
@@ -92,8 +93,6 @@ void expect_sane(const Film& film, const std::string& what) {
     ASSERT_TRUE(std::isfinite(pixel_estimate(film, i / 3, static_cast<int>(i % 3)).var_of_mean)) << what;
   }
 }
-
-const char* rule_name(GuideTarget t) { return t == GuideTarget::QLearning ? "qlearning" : "qtable"; }
 
 ChannelStats scaled(ChannelStats s, double by) {
   for (int c = 0; c < 3; ++c) {

@@ -28,6 +28,8 @@ struct GuidedScene {
   }
 };
 
+inline const char* rule_name(GuideTarget t) { return t == GuideTarget::QLearning ? "qlearning" : "qtable"; }
+
 inline GuideConfig config_with(GuideTarget target, Float guide_prob = 0.5f) {
   GuideConfig cfg;
   cfg.target = target;

@@ -111,7 +111,7 @@ Shape "trianglemesh" "point3 P" [ -1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1
   return buf;
 }
 
-const char* rule_name(GuideTarget t) { return t == GuideTarget::QLearning ? "qlearning" : "qtable"; }
+using testing::rule_name;
 
 // --- Furnaces -----------------------------------------------------------------
 
