@@ -14,8 +14,17 @@ void serialize(Archive& ar, ImageDesc& i) {
   ar(i.width, i.height, raw(i.texels), i.path);
 }
 template <class Archive>
+void serialize(Archive& ar, SparseGridDesc& g) {
+  ar(raw_value(g.lattice_from_world), g.nx, g.ny, g.nz, g.bx, g.by, g.bz, raw(g.brick_of), raw(g.values), g.max_value,
+     g.min_value);
+}
+template <class Archive>
+void serialize(Archive& ar, MajorantGridDesc& m) {
+  ar(raw_value(m.lo), raw_value(m.hi), m.nx, m.ny, m.nz, raw(m.max_density));
+}
+template <class Archive>
 void serialize(Archive& ar, GridDesc& g) {
-  ar(raw_value(g.medium_from_world), raw_value(g.p0), raw_value(g.p1), g.nx, g.ny, g.nz, raw(g.density), g.max_density);
+  ar(g.density, g.majorants);
 }
 template <class Archive>
 void serialize(Archive& ar, SceneDesc& d) {

@@ -1,7 +1,8 @@
-// pbrt-v4's "uniformgrid" medium: a density grid over a box (in the
-// medium's own space) scaling sigma_a, sigma_s and the emission. Collisions
-// are found by delta tracking against one majorant (the grid's largest
-// density times the largest extinction of the three channels), weighted so
+// pbrt-v4's grid media ("uniformgrid", "nanovdb"): a density lattice
+// (sparse_grid.h) scaling sigma_a, sigma_s and the emission inside a box.
+// Collisions are found by delta tracking against the majorant of the
+// majorant-grid cell they fall in (its largest density times the largest
+// extinction of the three channels), weighted so
 // that every channel stays unbiased (spectral tracking, Kutz et al. 2017,
 // with the channels' mean as probabilities); shadow rays use ratio tracking.
 // The random numbers of a segment come from a PCG32 stream seeded by the
@@ -9,53 +10,41 @@
 // sampler dimensions per segment.
 #pragma once
 
+#include "majorant_grid.h"
 #include "medium.h"
 #include "rng.h"
+#include "sparse_grid.h"
 
 namespace tessera {
 
-struct DensityGridView {
-  Mat3 medium_from_world{1.f};  // linear part of the inverse of the CTM at MakeNamedMedium
-  Vec3 medium_from_world_offset{0.f};
-  Vec3 p0{0.f}, p1{1.f};        // the grid's box, medium space
-  int32_t nx = 1, ny = 1, nz = 1;
-  const Float* density = nullptr;  // nx * ny * nz, x fastest
+// One grid medium: its density lattice, the majorant grid over its box and
+// what makes it glow.
+struct GridMediumView {
+  SparseGridView density;
+  MajorantGridView majorants;  // over the medium's box, in density lattice coordinates
   Float max_density = 0.f;
 };
 
-// pbrt-v4's SampledGrid lookup: samples at voxel centres, trilinear, zero outside.
-TESSERA_HOST_DEVICE inline Float grid_density(const DensityGridView& g, const Vec3& p_medium) {
-  const Vec3 u = (p_medium - g.p0) / (g.p1 - g.p0);
-  const Float fx = u.x * g.nx - 0.5f, fy = u.y * g.ny - 0.5f, fz = u.z * g.nz - 0.5f;
-  if (!(fx > -1.f && fy > -1.f && fz > -1.f && fx < g.nx && fy < g.ny && fz < g.nz)) return 0.f;
-  const int32_t ix = static_cast<int32_t>(glm::floor(fx)), iy = static_cast<int32_t>(glm::floor(fy)),
-                iz = static_cast<int32_t>(glm::floor(fz));
-  const Float dx = fx - ix, dy = fy - iy, dz = fz - iz;
-  auto at = [&](int32_t x, int32_t y, int32_t z) -> Float {
-    if (x < 0 || y < 0 || z < 0 || x >= g.nx || y >= g.ny || z >= g.nz) return 0.f;
-    return g.density[(static_cast<size_t>(z) * g.ny + y) * g.nx + x];
-  };
-  auto lerp = [](Float t, Float a, Float b) { return a + t * (b - a); };
-  const Float d00 = lerp(dx, at(ix, iy, iz), at(ix + 1, iy, iz)), d10 = lerp(dx, at(ix, iy + 1, iz), at(ix + 1, iy + 1, iz));
-  const Float d01 = lerp(dx, at(ix, iy, iz + 1), at(ix + 1, iy, iz + 1));
-  const Float d11 = lerp(dx, at(ix, iy + 1, iz + 1), at(ix + 1, iy + 1, iz + 1));
-  return lerp(dz, lerp(dy, d00, d10), lerp(dy, d01, d11));
+TESSERA_HOST_DEVICE inline Float grid_density(const GridMediumView& g, const Vec3& p_world) {
+  return grid_value(g.density, p_world);
 }
 
-// The part [t0, t1] of the segment o + t d, t in [0, t_max], inside the box.
+// The part [t0, t1] of the segment o + t d, t in [0, t_max], inside the
+// medium's box, in density lattice coordinates (d not unit: t stays the
+// world-space distance).
 struct GridRay {
-  Vec3 o, d;  // medium space (d not unit: t stays the world-space distance)
+  Vec3 o, d;
   Float t0, t1;
 };
 
-TESSERA_HOST_DEVICE inline bool grid_clip(const DensityGridView& g, const Vec3& o, const Vec3& d, Float t_max,
+TESSERA_HOST_DEVICE inline bool grid_clip(const GridMediumView& g, const Vec3& o, const Vec3& d, Float t_max,
                                           GridRay* r) {
-  r->o = g.medium_from_world * o + g.medium_from_world_offset;
-  r->d = g.medium_from_world * d;
+  r->o = grid_lattice_point(g.density, o);
+  r->d = g.density.lattice_from_world * d;
   Float t0 = 0.f, t1 = t_max;
   for (int a = 0; a < 3; ++a) {
     const Float inv = 1.f / r->d[a];
-    Float tn = (g.p0[a] - r->o[a]) * inv, tf = (g.p1[a] - r->o[a]) * inv;
+    Float tn = (g.majorants.lo[a] - r->o[a]) * inv, tf = (g.majorants.hi[a] - r->o[a]) * inv;
     if (tn > tf) {
       const Float t = tn;
       tn = tf;
@@ -71,11 +60,6 @@ TESSERA_HOST_DEVICE inline bool grid_clip(const DensityGridView& g, const Vec3& 
   return true;
 }
 
-// Largest extinction of any channel anywhere in the grid.
-TESSERA_HOST_DEVICE inline Float grid_majorant(const Medium& m, const DensityGridView& g) {
-  return g.max_density * max_component(medium_sigma_t(m));
-}
-
 // The stream of one segment's tracking numbers.
 TESSERA_HOST_DEVICE inline Rng tracking_rng(Float u, const Vec3& o, const Vec3& d) {
   Rng r;
@@ -83,33 +67,68 @@ TESSERA_HOST_DEVICE inline Rng tracking_rng(Float u, const Vec3& o, const Vec3& 
   return r;
 }
 
-// The next tentative collision along the clipped ray, against the majorant:
-// false once past the box (or after 2^20 of them). t is double so that free
-// paths far smaller than t still advance it.
-TESSERA_HOST_DEVICE inline bool next_tentative_collision(const DensityGridView& g, const GridRay& r, Float majorant,
-                                                         Rng& rng, int32_t& steps, double& t, Float& density) {
-  if (++steps > (1 << 20)) return false;
-  t += -glm::log(1.f - rng.uniform()) / majorant;
-  if (!(t < r.t1)) return false;
-  density = grid_density(g, r.o + static_cast<Float>(t) * r.d);
-  return true;
+// The tentative collisions along a clipped ray, each sampled against the
+// majorant of the cell it falls in (an exponential step that crosses into
+// the next cell restarts there: free paths are memoryless).
+struct TentativeCollisions {
+  GridRay r;
+  MajorantWalk walk;
+  Float sigma_t_max;  // the medium's largest extinction coefficient (per unit density)
+  Float tb = 0.f;     // end of the current cell's part
+  Float majorant = 0.f;
+  double t = 0.0;     // double so that free paths far smaller than t still advance it
+  int32_t steps = 0;
+  bool in_cell = false;
+};
+
+TESSERA_HOST_DEVICE inline TentativeCollisions tentative_collisions(const GridMediumView& g, const GridRay& r,
+                                                                    Float sigma_t_max) {
+  TentativeCollisions c;
+  c.r = r;
+  c.walk = majorant_walk(g.majorants, r.o, r.d, r.t0, r.t1);
+  c.sigma_t_max = sigma_t_max;
+  return c;
+}
+
+// The next tentative collision (c.t, its density, c.majorant); false once
+// past the box (or after 2^20 of them).
+TESSERA_HOST_DEVICE inline bool next_tentative_collision(const GridMediumView& g, TentativeCollisions& c, Rng& rng,
+                                                         Float& density) {
+  for (;;) {
+    if (!c.in_cell) {
+      Float ta, cell_max;
+      if (!majorant_next(g.majorants, c.walk, &ta, &c.tb, &cell_max)) return false;
+      c.majorant = cell_max * c.sigma_t_max;
+      if (!(c.majorant > 0.f)) continue;
+      c.t = ta;
+      c.in_cell = true;
+    }
+    if (++c.steps > (1 << 20)) return false;
+    c.t += -glm::log(1.f - rng.uniform()) / c.majorant;
+    if (!(c.t < c.tb)) {
+      c.in_cell = false;
+      continue;
+    }
+    density = lattice_trilinear(g.density, c.r.o + static_cast<Float>(c.t) * c.r.d);
+    return true;
+  }
 }
 
 // Delta tracking along [0, t_max]: a real collision (weight sigma_s / its
 // probability) or the end of the segment; absorption ends the path (weight 0).
-TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, const DensityGridView& g, const Vec3& o,
+TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, const GridMediumView& g, const Vec3& o,
                                                              const Vec3& d, Float t_max, Float u) {
   MediumSegment seg;
   seg.t = t_max;
   GridRay r;
-  const Float majorant = grid_majorant(m, g);
-  if (!(majorant > 0.f) || !grid_clip(g, o, d, t_max, &r)) return seg;
+  const Float sigma_t_max = max_component(medium_sigma_t(m));
+  if (!(sigma_t_max > 0.f) || !grid_clip(g, o, d, t_max, &r)) return seg;
   Rng rng = tracking_rng(u, o, d);
+  TentativeCollisions c = tentative_collisions(g, r, sigma_t_max);
   Rgb w(1.f);
-  double t = r.t0;
-  int32_t steps = 0;
   Float dens = 0.f;
-  while (next_tentative_collision(g, r, majorant, rng, steps, t, dens)) {
+  while (next_tentative_collision(g, c, rng, dens)) {
+    const Float majorant = c.majorant;
     const Rgb sigma_a = dens * m.sigma_a, sigma_s = dens * m.sigma_s;
     const Rgb sigma_n = Rgb(majorant) - sigma_a - sigma_s;
     seg.emitted += w * sigma_a * m.Le / majorant;
@@ -118,7 +137,7 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
     const Float e = rng.uniform();
     if (e < p_s) {
       seg.scattered = true;
-      seg.t = static_cast<Float>(t);
+      seg.t = static_cast<Float>(c.t);
       seg.weight = w * sigma_s / (majorant * p_s);
       return seg;
     }
@@ -127,7 +146,7 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
       continue;
     }
     seg.scattered = true;  // absorbed: the path ends here
-    seg.t = static_cast<Float>(t);
+    seg.t = static_cast<Float>(c.t);
     seg.weight = Rgb(0.f);
     return seg;
   }
@@ -136,18 +155,17 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
 }
 
 // Ratio tracking: an unbiased estimate of the transmittance along [0, t_max].
-TESSERA_HOST_DEVICE inline Rgb grid_transmittance(const Medium& m, const DensityGridView& g, const Vec3& o,
+TESSERA_HOST_DEVICE inline Rgb grid_transmittance(const Medium& m, const GridMediumView& g, const Vec3& o,
                                                   const Vec3& d, Float t_max) {
   GridRay r;
-  const Float majorant = grid_majorant(m, g);
-  if (!(majorant > 0.f) || !grid_clip(g, o, d, t_max, &r)) return Rgb(1.f);
+  const Float sigma_t_max = max_component(medium_sigma_t(m));
+  if (!(sigma_t_max > 0.f) || !grid_clip(g, o, d, t_max, &r)) return Rgb(1.f);
   Rng rng = tracking_rng(0.5f, o, d);
+  TentativeCollisions c = tentative_collisions(g, r, sigma_t_max);
   Rgb tr(1.f);
-  double t = r.t0;
-  int32_t steps = 0;
   Float dens = 0.f;
-  while (next_tentative_collision(g, r, majorant, rng, steps, t, dens)) {
-    tr *= glm::max(Rgb(0.f), Rgb(1.f) - dens * medium_sigma_t(m) / majorant);
+  while (next_tentative_collision(g, c, rng, dens)) {
+    tr *= glm::max(Rgb(0.f), Rgb(1.f) - dens * medium_sigma_t(m) / c.majorant);
     // Russian roulette once little is left (unbiased: survivors are scaled up).
     const Float left = max_component(tr);
     if (left < 0.05f) {

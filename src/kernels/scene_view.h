@@ -95,7 +95,7 @@ struct SceneView {
   uint32_t num_media = 0;
   const MediumInterface* triangle_media = nullptr;  // per triangle
   int32_t camera_medium = -1;                       // -1: vacuum
-  const DensityGridView* grids = nullptr;           // of the grid media
+  const GridMediumView* grids = nullptr;             // of the grid media
   // Whether any material is "interface": only then can a shadow ray pass a
   // surface (else the first hit blocks it and one occlusion query decides).
   bool has_interfaces = false;

@@ -72,29 +72,28 @@ bool valid_coefficient(const Rgb& c) {
 }
 
 // pbrt-v4's GridMedium: "density" (nx * ny * nz floats, x fastest) over
-// the box p0..p1 of the medium's space.
+// the box p0..p1 of the medium's space, with a 16^3 majorant grid as pbrt-v4 builds.
 int32_t read_grid(const ParamSet& params, const Mat4& world_from_medium, const DirectiveContext& ctx) {
-  GridDesc g;
-  g.density = params.get_floats("density");
-  if (g.density.empty()) ctx.fail("uniformgrid medium needs \"float density\" values");
-  g.nx = params.get_int("nx", 1);
-  g.ny = params.get_int("ny", 1);
-  g.nz = params.get_int("nz", 1);
-  if (g.nx < 1 || g.ny < 1 || g.nz < 1) ctx.fail("uniformgrid \"nx\", \"ny\" and \"nz\" must be positive");
-  const uint64_t n = static_cast<uint64_t>(g.nx) * static_cast<uint64_t>(g.ny) * static_cast<uint64_t>(g.nz);
-  if (n != g.density.size())
-    ctx.fail("uniformgrid has " + std::to_string(g.density.size()) + " density values; nx*ny*nz = " + std::to_string(n));
-  for (Float d : g.density) {
+  const std::vector<Float> density = params.get_floats("density");
+  if (density.empty()) ctx.fail("uniformgrid medium needs \"float density\" values");
+  const int32_t nx = params.get_int("nx", 1), ny = params.get_int("ny", 1), nz = params.get_int("nz", 1);
+  if (nx < 1 || ny < 1 || nz < 1) ctx.fail("uniformgrid \"nx\", \"ny\" and \"nz\" must be positive");
+  const uint64_t n = static_cast<uint64_t>(nx) * static_cast<uint64_t>(ny) * static_cast<uint64_t>(nz);
+  if (n != density.size())
+    ctx.fail("uniformgrid has " + std::to_string(density.size()) + " density values; nx*ny*nz = " + std::to_string(n));
+  for (Float d : density)
     if (!(d >= 0.f) || !std::isfinite(d)) ctx.fail("uniformgrid densities must be finite and not negative");
-    g.max_density = std::max(g.max_density, d);
-  }
-  g.p0 = params.get_point3("p0").value_or(Vec3(0.f));
-  g.p1 = params.get_point3("p1").value_or(Vec3(1.f));
-  if (!(g.p1.x > g.p0.x && g.p1.y > g.p0.y && g.p1.z > g.p0.z)) ctx.fail("uniformgrid needs p0 < p1 on every axis");
+  const Vec3 p0 = params.get_point3("p0").value_or(Vec3(0.f));
+  const Vec3 p1 = params.get_point3("p1").value_or(Vec3(1.f));
+  if (!(p1.x > p0.x && p1.y > p0.y && p1.z > p0.z)) ctx.fail("uniformgrid needs p0 < p1 on every axis");
   if (glm::determinant(world_from_medium) == 0.f) ctx.fail("the medium's transform is singular");
-  g.medium_from_world = glm::inverse(world_from_medium);
   if (params.find_any("temperature") || params.get_floats("Lescale").size() > 1)
     ctx.warn("uniformgrid emission grids (\"temperature\", per-voxel \"Lescale\") are not supported; Le is uniform");
+  GridDesc g;
+  g.density = sparse_grid_from_dense(density, nx, ny, nz, p0, p1, glm::inverse(world_from_medium));
+  // The box p0..p1 in lattice coordinates: voxel centres are the integers.
+  const Vec3 n3(static_cast<Float>(nx), static_cast<Float>(ny), static_cast<Float>(nz));
+  g.majorants = build_majorant_grid(g.density, Vec3(-0.5f), n3 - 0.5f, 16);
   ctx.scene.grids.push_back(std::move(g));
   return static_cast<int32_t>(ctx.scene.grids.size() - 1);
 }

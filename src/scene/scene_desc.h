@@ -11,6 +11,7 @@
 #include "kernels/material.h"
 #include "kernels/medium.h"
 #include "kernels/sampler.h"
+#include "scene/sparse_grid_build.h"
 
 namespace tessera {
 
@@ -53,13 +54,10 @@ struct ImageDesc {
   std::string path;
 };
 
-// A uniformgrid medium's densities (Medium::grid indexes these).
+// A grid medium's lattices (Medium::grid indexes these).
 struct GridDesc {
-  Mat4 medium_from_world{1.f};  // inverse of the CTM at MakeNamedMedium
-  Vec3 p0{0.f}, p1{1.f};
-  int32_t nx = 1, ny = 1, nz = 1;
-  std::vector<Float> density;  // nx * ny * nz, x fastest
-  Float max_density = 0.f;
+  SparseGridDesc density;
+  MajorantGridDesc majorants;  // over the medium's box
 };
 
 // "World" in a SceneDesc is pbrt-v4's render space: the scene's world

@@ -16,6 +16,18 @@
 
 namespace tessera {
 
+namespace {
+
+GridMediumView grid_medium_view(const GridDesc& g) {
+  GridMediumView v;
+  v.density = sparse_grid_view(g.density);
+  v.majorants = majorant_grid_view(g.majorants);
+  v.max_density = g.density.max_value;
+  return v;
+}
+
+}  // namespace
+
 SceneData::SceneData(SceneDesc desc) : desc_(std::move(desc)) {
   effects_ = compute_effects(desc_);
   flatten_meshes();
@@ -246,19 +258,7 @@ void SceneData::build_view() {
     v.num_media = static_cast<uint32_t>(desc_.media.size());
     v.triangle_media = triangle_media_.data();
     v.camera_medium = desc_.camera_medium;
-    for (const GridDesc& g : desc_.grids) {
-      DensityGridView gv;
-      gv.medium_from_world = Mat3(g.medium_from_world);
-      gv.medium_from_world_offset = Vec3(g.medium_from_world[3]);
-      gv.p0 = g.p0;
-      gv.p1 = g.p1;
-      gv.nx = g.nx;
-      gv.ny = g.ny;
-      gv.nz = g.nz;
-      gv.density = g.density.data();
-      gv.max_density = g.max_density;
-      grid_views_.push_back(gv);
-    }
+    for (const GridDesc& g : desc_.grids) grid_views_.push_back(grid_medium_view(g));
     v.grids = grid_views_.data();
   }
   v.filter.inverse_cdf_x = filter_inverse_cdf_x_.data();
@@ -314,12 +314,15 @@ uint64_t SceneData::fingerprint() const {
     f.add(&desc_.camera_medium, sizeof desc_.camera_medium);
     for (const Light& l : lights_) f.add(&l.medium, sizeof l.medium);
     for (const GridDesc& g : desc_.grids) {
-      f.add_vector(g.density);
-      f.add(&g.medium_from_world, sizeof g.medium_from_world);
-      f.add(&g.p0, sizeof g.p0);
-      f.add(&g.p1, sizeof g.p1);
-      const int32_t dims[3] = {g.nx, g.ny, g.nz};
-      f.add(dims, sizeof dims);
+      for (const SparseGridDesc* s : {&g.density}) {
+        f.add_vector(s->brick_of);
+        f.add_vector(s->values);
+        f.add(&s->lattice_from_world, sizeof s->lattice_from_world);
+        const int32_t dims[3] = {s->nx, s->ny, s->nz};
+        f.add(dims, sizeof dims);
+      }
+      f.add(&g.majorants.lo, sizeof g.majorants.lo);
+      f.add(&g.majorants.hi, sizeof g.majorants.hi);
     }
   }
   return f.h;

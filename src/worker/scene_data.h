@@ -65,7 +65,7 @@ class SceneData {
   std::vector<TextureSlot> triangle_alpha_;  // per triangle
   bool has_alpha_ = false;                   // any triangle not opaque
   std::vector<MediumInterface> triangle_media_;  // per triangle, only for scenes with media
-  std::vector<DensityGridView> grid_views_;
+  std::vector<GridMediumView> grid_views_;
   std::vector<Vec3> positions_end_, normals_end_;  // per vertex, only when some shape moves (motion blur)
   bool has_media_ = false;
   std::vector<Float> filter_inverse_cdf_x_, filter_inverse_cdf_y_;

@@ -78,12 +78,21 @@ MakeNamedMedium "wisps" "string type" "cloud"
   EXPECT_EQ(d.media[0].grid, 0);
   EXPECT_EQ(d.media[0].sigma_s, Rgb(2.f));
   const GridDesc& g = d.grids[0];
-  EXPECT_EQ(g.nx, 2);
-  EXPECT_EQ(g.density, (std::vector<Float>{0.5f, 3.f}));
-  EXPECT_FLOAT_EQ(g.max_density, 3.f);
-  EXPECT_EQ(g.p0, Vec3(-1.f));
-  // The box sits where the CTM put it: world (10, 0, 0) is the medium's origin.
-  EXPECT_EQ(Vec3(g.medium_from_world * Vec4(Vec3(10.f, 0.f, 0.f) - Vec3(d.render_origin), 1.f)), Vec3(0.f));
+  EXPECT_EQ(g.density.nx, 2);
+  EXPECT_EQ(g.density.ny, 1);
+  const SparseGridView v = sparse_grid_view(g.density);
+  EXPECT_EQ(lattice_value(v, 0, 0, 0), 0.5f);
+  EXPECT_EQ(lattice_value(v, 1, 0, 0), 3.f);
+  EXPECT_FLOAT_EQ(g.density.max_value, 3.f);
+  // The box sits where the CTM put it: world (10, 0, 0) is the medium's
+  // origin, between the two voxel centres (lattice x 0.5).
+  const Vec3 centre = Vec3(g.density.lattice_from_world * Vec4(Vec3(10.f, 0.f, 0.f) - Vec3(d.render_origin), 1.f));
+  EXPECT_NEAR(centre.x, 0.5f, 1e-5f);
+  EXPECT_NEAR(centre.y, 0.f, 1e-5f);
+  EXPECT_NEAR(centre.z, 0.f, 1e-5f);
+  // The box p0..p1 in lattice coordinates.
+  EXPECT_EQ(g.majorants.lo, Vec3(-0.5f));
+  EXPECT_EQ(g.majorants.hi, Vec3(1.5f, 0.5f, 0.5f));
   EXPECT_EQ(d.meshes[0].media.inside, 0);
   bool warned = false;
   for (const std::string& w : d.warnings) warned |= w.find("cloud") != std::string::npos;

@@ -1,0 +1,121 @@
+#include "scene/sparse_grid_build.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tessera {
+
+SparseGridBuilder::SparseGridBuilder(int32_t nx, int32_t ny, int32_t nz) {
+  g_.nx = nx;
+  g_.ny = ny;
+  g_.nz = nz;
+  g_.bx = (nx + kBrickSide - 1) / kBrickSide;
+  g_.by = (ny + kBrickSide - 1) / kBrickSide;
+  g_.bz = (nz + kBrickSide - 1) / kBrickSide;
+  g_.brick_of.assign(static_cast<size_t>(g_.bx) * g_.by * g_.bz, -1);
+}
+
+void SparseGridBuilder::set(int32_t x, int32_t y, int32_t z, Float v) {
+  const size_t b = (static_cast<size_t>(z >> kBrickLog2) * g_.by + (y >> kBrickLog2)) * g_.bx + (x >> kBrickLog2);
+  if (g_.brick_of[b] < 0) {
+    if (v == 0.f) return;
+    g_.brick_of[b] = static_cast<int32_t>(g_.values.size() / kBrickVoxels);
+    g_.values.resize(g_.values.size() + kBrickVoxels, 0.f);
+  }
+  const int32_t m = kBrickSide - 1;
+  g_.values[static_cast<size_t>(g_.brick_of[b]) * kBrickVoxels + (((z & m) * kBrickSide + (y & m)) * kBrickSide + (x & m))] = v;
+  g_.max_value = std::max(g_.max_value, v);
+  g_.min_value = std::min(g_.min_value, v);
+}
+
+SparseGridDesc SparseGridBuilder::finish(const Mat4& lattice_from_world) {
+  g_.lattice_from_world = lattice_from_world;
+  return std::move(g_);
+}
+
+SparseGridDesc sparse_grid_from_dense(const std::vector<Float>& values, int32_t nx, int32_t ny, int32_t nz,
+                                      const Vec3& p0, const Vec3& p1, const Mat4& medium_from_world) {
+  SparseGridBuilder b(nx, ny, nz);
+  size_t i = 0;
+  for (int32_t z = 0; z < nz; ++z)
+    for (int32_t y = 0; y < ny; ++y)
+      for (int32_t x = 0; x < nx; ++x) b.set(x, y, z, values[i++]);
+  // Voxel centre (x + 0.5) / n of the box is lattice point x.
+  const Vec3 n(static_cast<Float>(nx), static_cast<Float>(ny), static_cast<Float>(nz));
+  const Vec3 s = n / (p1 - p0);
+  Mat4 lattice_from_medium(1.f);
+  for (int a = 0; a < 3; ++a) {
+    lattice_from_medium[a][a] = s[a];
+    lattice_from_medium[3][a] = -p0[a] * s[a] - 0.5f;
+  }
+  return b.finish(lattice_from_medium * medium_from_world);
+}
+
+MajorantGridDesc build_majorant_grid(const SparseGridDesc& g, const Vec3& lo, const Vec3& hi, int32_t res) {
+  MajorantGridDesc m;
+  m.lo = lo;
+  m.hi = hi;
+  m.nx = m.ny = m.nz = res;
+  m.max_density.assign(static_cast<size_t>(res) * res * res, 0.f);
+  const int32_t n[3] = {g.nx, g.ny, g.nz};
+  // Lattice point q reaches the lookups at (q - 1, q + 1): the cells [first, last] overlapping that range.
+  std::vector<int32_t> first[3], last[3];
+  for (int a = 0; a < 3; ++a) {
+    const double cells_per_unit = res / (static_cast<double>(hi[a]) - lo[a]);
+    first[a].resize(n[a]);
+    last[a].resize(n[a]);
+    for (int32_t q = 0; q < n[a]; ++q) {
+      first[a][q] = std::clamp(static_cast<int32_t>(std::floor((q - 1.0 - lo[a]) * cells_per_unit)), 0, res - 1);
+      last[a][q] = std::clamp(static_cast<int32_t>(std::floor((q + 1.0 - lo[a]) * cells_per_unit)), 0, res - 1);
+    }
+  }
+  const int32_t mask = kBrickSide - 1;
+  for (int32_t bz = 0; bz < g.bz; ++bz)
+    for (int32_t by = 0; by < g.by; ++by)
+      for (int32_t bx = 0; bx < g.bx; ++bx) {
+        const int32_t brick = g.brick_of[(static_cast<size_t>(bz) * g.by + by) * g.bx + bx];
+        if (brick < 0) continue;
+        const Float* v = g.values.data() + static_cast<size_t>(brick) * kBrickVoxels;
+        for (int32_t i = 0; i < kBrickVoxels; ++i) {
+          if (!(v[i] > 0.f)) continue;
+          const int32_t x = bx * kBrickSide + (i & mask), y = by * kBrickSide + ((i >> kBrickLog2) & mask),
+                        z = bz * kBrickSide + (i >> (2 * kBrickLog2));
+          if (x >= g.nx || y >= g.ny || z >= g.nz) continue;
+          for (int32_t cz = first[2][z]; cz <= last[2][z]; ++cz)
+            for (int32_t cy = first[1][y]; cy <= last[1][y]; ++cy)
+              for (int32_t cx = first[0][x]; cx <= last[0][x]; ++cx) {
+                Float& c = m.max_density[(static_cast<size_t>(cz) * res + cy) * res + cx];
+                c = std::max(c, v[i]);
+              }
+        }
+      }
+  return m;
+}
+
+SparseGridView sparse_grid_view(const SparseGridDesc& g) {
+  SparseGridView v;
+  v.lattice_from_world = Mat3(g.lattice_from_world);
+  v.lattice_from_world_offset = Vec3(g.lattice_from_world[3]);
+  v.nx = g.nx;
+  v.ny = g.ny;
+  v.nz = g.nz;
+  v.bx = g.bx;
+  v.by = g.by;
+  v.bz = g.bz;
+  v.brick_of = g.brick_of.empty() ? nullptr : g.brick_of.data();
+  v.values = g.values.empty() ? nullptr : g.values.data();
+  return v;
+}
+
+MajorantGridView majorant_grid_view(const MajorantGridDesc& m) {
+  MajorantGridView v;
+  v.lo = m.lo;
+  v.hi = m.hi;
+  v.nx = m.nx;
+  v.ny = m.ny;
+  v.nz = m.nz;
+  v.max_density = m.max_density.data();
+  return v;
+}
+
+}  // namespace tessera

@@ -1,0 +1,235 @@
+// Grid media: the brick lattice's lookups, the majorant grid's bounds and
+// walk, and delta / ratio tracking through them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "kernels/grid_medium.h"
+#include "kernels/rng.h"
+#include "scene/scene_desc.h"
+#include "scene/sparse_grid_build.h"
+
+namespace tessera {
+namespace {
+
+// Host storage and its kernel view together.
+struct TestGrid {
+  GridDesc desc;
+  GridMediumView view;
+  TestGrid(const std::vector<Float>& values, int32_t nx, int32_t ny, int32_t nz, Vec3 p0, Vec3 p1,
+           int32_t majorant_res = 16) {
+    desc.density = sparse_grid_from_dense(values, nx, ny, nz, p0, p1, Mat4(1.f));
+    desc.majorants = build_majorant_grid(desc.density, Vec3(-0.5f), Vec3(nx, ny, nz) - 0.5f, majorant_res);
+    view.density = sparse_grid_view(desc.density);
+    view.majorants = majorant_grid_view(desc.majorants);
+    view.max_density = desc.density.max_value;
+  }
+};
+
+// pbrt-v4's SampledGrid lookup on dense values, written out.
+Float dense_lookup(const std::vector<Float>& v, int nx, int ny, int nz, Vec3 p0, Vec3 p1, Vec3 p) {
+  const Vec3 u = (p - p0) / (p1 - p0);
+  const double fx = u.x * nx - 0.5, fy = u.y * ny - 0.5, fz = u.z * nz - 0.5;
+  const int ix = static_cast<int>(std::floor(fx)), iy = static_cast<int>(std::floor(fy)),
+            iz = static_cast<int>(std::floor(fz));
+  auto at = [&](int x, int y, int z) -> double {
+    if (x < 0 || y < 0 || z < 0 || x >= nx || y >= ny || z >= nz) return 0.0;
+    return v[(static_cast<size_t>(z) * ny + y) * nx + x];
+  };
+  double sum = 0.0;
+  for (int c = 0; c < 8; ++c) {
+    const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
+    const double w = (dx ? fx - ix : 1 - (fx - ix)) * (dy ? fy - iy : 1 - (fy - iy)) * (dz ? fz - iz : 1 - (fz - iz));
+    sum += w * at(ix + dx, iy + dy, iz + dz);
+  }
+  return static_cast<Float>(sum);
+}
+
+TEST(GridMedium, DensityIsTrilinearBetweenVoxelCentresAndZeroOutside) {
+  // A 2 x 1 x 1 grid over [0,2] x [0,1] x [0,1]: values 0 and 1 at x = 0.5 and 1.5.
+  const TestGrid t({0.f, 1.f}, 2, 1, 1, Vec3(0.f), Vec3(2.f, 1.f, 1.f));
+  const GridMediumView& g = t.view;
+  EXPECT_FLOAT_EQ(grid_density(g, Vec3(0.5f, 0.5f, 0.5f)), 0.f);
+  EXPECT_FLOAT_EQ(grid_density(g, Vec3(1.5f, 0.5f, 0.5f)), 1.f);
+  EXPECT_FLOAT_EQ(grid_density(g, Vec3(1.0f, 0.5f, 0.5f)), 0.5f);
+  EXPECT_FLOAT_EQ(grid_density(g, Vec3(1.75f, 0.5f, 0.5f)), 0.75f);  // towards the zero beyond the last voxel
+  EXPECT_FLOAT_EQ(grid_density(g, Vec3(1.5f, 0.25f, 0.5f)), 0.75f);
+  EXPECT_EQ(grid_density(g, Vec3(2.5f, 0.5f, 0.5f)), 0.f);
+  EXPECT_EQ(grid_density(g, Vec3(-1.f, 0.5f, 0.5f)), 0.f);
+}
+
+// A 37 x 21 x 45 grid, zero but for two blobs: only their bricks are stored,
+// and every lookup equals the dense one.
+struct TwoBlobs {
+  static constexpr int nx = 37, ny = 21, nz = 45;
+  std::vector<Float> v = std::vector<Float>(static_cast<size_t>(nx) * ny * nz, 0.f);
+  Vec3 p0{-2.f, 0.f, 1.f}, p1{3.f, 2.f, 7.f};
+  TwoBlobs() {
+    Rng rng = Rng::for_sample(1, 2, 3);
+    for (int z = 0; z < nz; ++z)
+      for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x) {
+          const bool a = x < 5 && y < 6 && z < 4, b = x > 30 && y > 15 && z > 38;
+          if (a || b) v[(static_cast<size_t>(z) * ny + y) * nx + x] = (b ? 20.f : 1.f) * rng.uniform();
+        }
+  }
+};
+
+TEST(GridMedium, SparseLatticeStoresOnlyOccupiedBricksAndMatchesDenseLookups) {
+  const TwoBlobs b;
+  const TestGrid t(b.v, b.nx, b.ny, b.nz, b.p0, b.p1);
+  EXPECT_EQ(t.desc.density.values.size(), 5u * kBrickVoxels);  // blob a: 1 brick, blob b: 2 x 1 x 2
+  Rng rng = Rng::for_sample(4, 5, 6);
+  for (int i = 0; i < 100000; ++i) {
+    const Vec3 u(rng.uniform(), rng.uniform(), rng.uniform());
+    const Vec3 p = b.p0 - Vec3(0.3f) + u * (b.p1 - b.p0 + Vec3(0.6f));
+    const Float want = dense_lookup(b.v, b.nx, b.ny, b.nz, b.p0, b.p1, p);
+    ASSERT_NEAR(grid_density(t.view, p), want, 2e-4f) << i;  // float transforms: ~1e-6 voxel at 20 per voxel
+  }
+}
+
+TEST(GridMedium, MajorantCellsBoundEveryLookupAndEmptyCellsAreZero) {
+  const TwoBlobs b;
+  const TestGrid t(b.v, b.nx, b.ny, b.nz, b.p0, b.p1, 16);
+  const MajorantGridView& m = t.view.majorants;
+  int zero_cells = 0;
+  for (Float c : t.desc.majorants.max_density) zero_cells += c == 0.f;
+  EXPECT_GT(zero_cells, 16 * 16 * 16 / 2);  // the space between the blobs is free
+  Rng rng = Rng::for_sample(7, 8, 9);
+  for (int i = 0; i < 200000; ++i) {
+    const Vec3 q = m.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * (m.hi - m.lo);
+    int c[3];
+    for (int a = 0; a < 3; ++a) c[a] = std::min(15, static_cast<int>((q[a] - m.lo[a]) / (m.hi[a] - m.lo[a]) * 16));
+    const Float bound = m.max_density[(c[2] * 16 + c[1]) * 16 + c[0]];
+    ASSERT_LE(lattice_trilinear(t.view.density, q), bound) << i;
+  }
+}
+
+TEST(GridMedium, MajorantWalkVisitsTheCellsAlongTheRayInOrderWithoutGaps) {
+  const TwoBlobs b;
+  const TestGrid t(b.v, b.nx, b.ny, b.nz, b.p0, b.p1, 16);
+  const MajorantGridView& m = t.view.majorants;
+  Rng rng = Rng::for_sample(1, 1, 1);
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3 o = m.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * (m.hi - m.lo);
+    Vec3 d = Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f);
+    if (i % 7 == 0) d.y = 0.f;  // axis-parallel planes too
+    GridRay r;
+    ASSERT_TRUE(grid_clip(t.view, glm::inverse(Mat3(t.desc.density.lattice_from_world)) *
+                                      (o - Vec3(t.desc.density.lattice_from_world[3])),
+                          d, 1e6f, &r));
+    MajorantWalk w = majorant_walk(m, r.o, r.d, r.t0, r.t1);
+    Float ta, tb, bound, last = r.t0;
+    int cells = 0;
+    while (majorant_next(m, w, &ta, &tb, &bound)) {
+      ASSERT_EQ(ta, last);
+      ASSERT_GE(tb, ta);
+      // The middle of the part lies in the cell whose bound was returned.
+      const Vec3 q = r.o + 0.5f * (ta + tb) * r.d;
+      int c[3];
+      for (int a = 0; a < 3; ++a)
+        c[a] = std::clamp(static_cast<int>(std::floor((q[a] - m.lo[a]) / (m.hi[a] - m.lo[a]) * 16)), 0, 15);
+      if (tb - ta > 1e-3f * (r.t1 - r.t0)) {
+        EXPECT_EQ(bound, m.max_density[(c[2] * 16 + c[1]) * 16 + c[0]]) << i;
+      }
+      last = tb;
+      ++cells;
+    }
+    EXPECT_NEAR(last, r.t1, 1e-5f * (1.f + r.t1)) << i;  // up to rounding at the box's faces
+    EXPECT_LE(cells, 3 * 16 + 3);
+  }
+}
+
+// Transmittance along a line, by a fine midpoint rule.
+double quadrature_optical_depth(const GridMediumView& g, Vec3 o, Vec3 d, Float t_max) {
+  const int n = 20000;
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i) sum += grid_density(g, o + ((i + 0.5f) / n * t_max) * d);
+  return sum * t_max / n;
+}
+
+TEST(GridMedium, RatioTrackingThroughASparseGridEstimatesTheTransmittance) {
+  const TwoBlobs b;
+  const TestGrid t(b.v, b.nx, b.ny, b.nz, b.p0, b.p1);
+  Medium m;
+  m.sigma_a = Rgb(0.1f, 0.3f, 0.6f);
+  m.sigma_s = Rgb(0.2f, 0.2f, 0.0f);
+  m.grid = 0;
+  // From near one blob through the other.
+  const Vec3 o(-2.2f, 0.1f, 1.1f), e(2.9f, 1.9f, 6.9f);
+  const Vec3 d = glm::normalize(e - o);
+  const Float len = glm::length(e - o);
+  const double tau = quadrature_optical_depth(t.view, o, d, len);
+  ASSERT_GT(tau, 0.3);
+  const int n = 100000;
+  Rgb sum(0.f);
+  for (int i = 0; i < n; ++i) sum += grid_transmittance(m, t.view, o + Vec3(0.f, 0.f, 1e-7f * i), d, len);
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(sum[k] / n, std::exp(-(m.sigma_a[k] + m.sigma_s[k]) * tau), 0.006) << k;
+}
+
+// A 4^3 grid of ones over [-4, 4]^3: exactly 1 within [-3, 3]^3 (between
+// the outer voxel centres).
+struct ConstantGrid : TestGrid {
+  ConstantGrid() : TestGrid(std::vector<Float>(64, 1.f), 4, 4, 4, Vec3(-4.f), Vec3(4.f)) {}
+};
+
+TEST(GridMedium, RatioTrackingEstimatesTheTransmittance) {
+  const ConstantGrid c;
+  Medium m;
+  m.sigma_a = Rgb(0.1f, 0.3f, 0.6f);
+  m.sigma_s = Rgb(0.1f, 0.2f, 0.0f);
+  m.grid = 0;
+  const Float d = 2.5f;
+  Rgb sum(0.f);
+  const int n = 200000;
+  Rng rng = Rng::for_sample(3, 4, 5);
+  for (int i = 0; i < n; ++i) {
+    const Vec3 o(rng.uniform() - 0.5f, rng.uniform() - 0.5f, -1.f);
+    sum += grid_transmittance(m, c.view, o, Vec3(0.f, 0.f, 1.f), d);
+  }
+  const Rgb mean = sum / static_cast<Float>(n);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(mean[k], std::exp(-(m.sigma_a[k] + m.sigma_s[k]) * d), 0.004) << k;
+}
+
+TEST(GridMedium, DeltaTrackingEstimatesTransmittanceAndScatteringInEveryChannel) {
+  const ConstantGrid c;
+  Medium m;
+  m.sigma_a = Rgb(0.f, 0.2f, 0.5f);
+  m.sigma_s = Rgb(0.f, 0.6f, 1.5f);
+  m.grid = 0;
+  const Float t_max = 1.3f;
+  const int n = 400000;
+  Rgb reach(0.f), scatter(0.f);
+  Rng rng = Rng::for_sample(7, 8, 9);
+  for (int i = 0; i < n; ++i) {
+    const Vec3 o(rng.uniform() - 0.5f, rng.uniform() - 0.5f, -1.f);
+    const MediumSegment seg = sample_grid_segment(m, c.view, o, Vec3(0.f, 0.f, 1.f), t_max, rng.uniform());
+    ASSERT_TRUE(std::isfinite(seg.weight.x) && std::isfinite(seg.weight.y) && std::isfinite(seg.weight.z));
+    (seg.scattered ? scatter : reach) += seg.weight;
+  }
+  reach /= static_cast<Float>(n);
+  scatter /= static_cast<Float>(n);
+  for (int k = 0; k < 3; ++k) {
+    const double sigma_t = m.sigma_a[k] + m.sigma_s[k];
+    const double T = std::exp(-sigma_t * t_max);
+    EXPECT_NEAR(reach[k], T, 0.006) << "channel " << k;
+    const double albedo = sigma_t > 0 ? m.sigma_s[k] / sigma_t : 0.0;
+    EXPECT_NEAR(scatter[k], albedo * (1.0 - T), 0.006) << "channel " << k;
+  }
+}
+
+TEST(GridMedium, RaysMissingTheBoxSeeNoMedium) {
+  const ConstantGrid c;
+  Medium m;
+  m.sigma_s = Rgb(1.f);
+  m.grid = 0;
+  EXPECT_EQ(grid_transmittance(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), 100.f), Rgb(1.f));
+  const MediumSegment seg = sample_grid_segment(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), kInfinity, 0.3f);
+  EXPECT_FALSE(seg.scattered);
+  EXPECT_EQ(seg.weight, Rgb(1.f));
+}
+
+}  // namespace
+}  // namespace tessera
