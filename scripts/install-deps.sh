@@ -17,6 +17,7 @@ PACKAGES=(
   zlib1g-dev                      # .ply.gz meshes
   libopenimageio-dev              # texture and environment images (EXR, PFM, PNG, TGA, HDR...)
   libstb-dev                      # PNG/JPEG read, PNG write
+  libnanovdb-dev                  # "nanovdb" media (.nvdb volumes; brings libblosc-dev)
   python3                         # benchmark and test helper scripts
   python3-matplotlib              # benchmark plots (scripts/bench_*.py)
 )

@@ -24,7 +24,7 @@ void serialize(Archive& ar, MajorantGridDesc& m) {
 }
 template <class Archive>
 void serialize(Archive& ar, GridDesc& g) {
-  ar(g.density, g.majorants);
+  ar(g.density, g.majorants, g.le_scale, g.temperature, g.temperature_offset, g.temperature_scale, g.blackbody_scale);
 }
 template <class Archive>
 void serialize(Archive& ar, SceneDesc& d) {

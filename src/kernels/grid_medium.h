@@ -14,6 +14,8 @@
 #include "medium.h"
 #include "rng.h"
 #include "sparse_grid.h"
+#include "spectral.h"
+#include "blackbody_table.h"
 
 namespace tessera {
 
@@ -23,10 +25,34 @@ struct GridMediumView {
   SparseGridView density;
   MajorantGridView majorants;  // over the medium's box, in density lattice coordinates
   Float max_density = 0.f;
+  // Emission per unit absorption, as pbrt-v4's GridMedium and NanoVDBMedium
+  // give it: le_scale(p) times Medium::Le, or, with a temperature grid,
+  // le_scale(p) * blackbody_scale * B(T) / B(peak) for T = (temperature(p) -
+  // offset) * scale above 100 K.
+  SparseGridView le_scale;     // absent: 1
+  SparseGridView temperature;  // absent: Medium::Le
+  Float temperature_offset = 0.f, temperature_scale = 1.f, blackbody_scale = 1.f;
+  const Float* blackbody_rgb = nullptr;  // RGB transport: kBlackbodyTableSize RGB triples (blackbody_table.h)
 };
 
 TESSERA_HOST_DEVICE inline Float grid_density(const GridMediumView& g, const Vec3& p_world) {
   return grid_value(g.density, p_world);
+}
+
+// Emitted radiance per unit absorption at p (world), at the path's
+// wavelengths (wl) or in RGB. m is the medium as the path sees it (medium_at).
+TESSERA_HOST_DEVICE inline Rgb grid_emission(const GridMediumView& g, const Medium& m, const Vec3& p,
+                                             const Wavelengths* wl) {
+  const Float s = grid_present(g.le_scale) ? grid_value(g.le_scale, p) : 1.f;
+  if (!(s > 0.f)) return Rgb(0.f);
+  if (!grid_present(g.temperature)) return s * m.Le;
+  const Float kelvin = (grid_value(g.temperature, p) - g.temperature_offset) * g.temperature_scale;
+  if (!(kelvin > 100.f)) return Rgb(0.f);
+  const Float k = s * g.blackbody_scale;
+  if (wl)
+    return k * Rgb(blackbody_relative(wl->lambda[0], kelvin), blackbody_relative(wl->lambda[1], kelvin),
+                   blackbody_relative(wl->lambda[2], kelvin));
+  return k * blackbody_table_rgb(g.blackbody_rgb, kelvin);
 }
 
 // The part [t0, t1] of the segment o + t d, t in [0, t_max], inside the
@@ -117,7 +143,9 @@ TESSERA_HOST_DEVICE inline bool next_tentative_collision(const GridMediumView& g
 // Delta tracking along [0, t_max]: a real collision (weight sigma_s / its
 // probability) or the end of the segment; absorption ends the path (weight 0).
 TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, const GridMediumView& g, const Vec3& o,
-                                                             const Vec3& d, Float t_max, Float u) {
+                                                             const Vec3& d, Float t_max, Float u,
+                                                             const Wavelengths* wl) {
+  const bool emits = m.grid_emits || !is_black(m.Le);
   MediumSegment seg;
   seg.t = t_max;
   GridRay r;
@@ -131,7 +159,7 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
     const Float majorant = c.majorant;
     const Rgb sigma_a = dens * m.sigma_a, sigma_s = dens * m.sigma_s;
     const Rgb sigma_n = Rgb(majorant) - sigma_a - sigma_s;
-    seg.emitted += w * sigma_a * m.Le / majorant;
+    if (emits && !is_black(sigma_a)) seg.emitted += w * sigma_a * grid_emission(g, m, o + static_cast<Float>(c.t) * d, wl) / majorant;
     const Float p_s = (sigma_s.x + sigma_s.y + sigma_s.z) / (3.f * majorant);
     const Float p_n = glm::max(0.f, (sigma_n.x + sigma_n.y + sigma_n.z) / (3.f * majorant));
     const Float e = rng.uniform();

@@ -234,7 +234,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         } else {
           const Float u_channel = rng.uniform();
           const Float u_dist = rng.uniform();
-          const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist);
+          const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist, wl);
           if (depth < settings.max_depth) L += beta * seg.emitted;
           beta *= seg.weight;
           rr_beta *= seg.weight;

@@ -265,7 +265,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
         } else {
           const Float u_channel = rng.uniform();
           const Float u_dist = rng.uniform();
-          const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist);
+          const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist, wl);
           beta *= seg.weight;
           if (seg.scattered) {
             if (!reach_scattering_vertex() || is_black(beta)) return;

@@ -19,6 +19,7 @@ struct Medium {
   Rgb Le{0.f};                     // emitted radiance (pbrt-v4: Le * Lescale, emitted where sigma_a is)
   Float g = 0.f;                   // Henyey-Greenstein asymmetry, in [-0.99, 0.99]
   int32_t grid = -1;               // >= 0: a density grid (SceneView::grids) scales sigma_a, sigma_s and Le
+  int32_t grid_emits = 0;          // 1: the grid's emission (a temperature or Lescale grid) glows, whatever Le is
 };
 
 // The media on either side of a surface (-1: vacuum); inside is the side the
@@ -111,7 +112,7 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_medium_segment(const Medium& m, 
 // instead of sampling collisions that would end the path.
 TESSERA_HOST_DEVICE inline bool medium_absorbs_only(const Medium& m) {
   // (A grid medium's transmittance is estimated by ratio tracking.)
-  return is_black(m.sigma_s) && is_black(m.Le);
+  return is_black(m.sigma_s) && is_black(m.Le) && !m.grid_emits;
 }
 
 }  // namespace tessera

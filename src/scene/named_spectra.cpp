@@ -4,7 +4,9 @@
 #include <cmath>
 #include <map>
 
+#include "kernels/blackbody_table.h"
 #include "scene/cie_tables.h"
+#include "scene/rgb_spectrum_fit.h"
 
 namespace tessera {
 namespace {
@@ -113,6 +115,25 @@ Rgb blackbody_rgb(Float kelvin) {
   const Vec3 xyz = blackbody_xyz(kelvin);
   if (!(xyz.y > 0.f)) return Rgb(0.f);
   return glm::max(xyz_to_linear_srgb(xyz / xyz.y), Rgb(0.f));
+}
+
+std::vector<Float> build_blackbody_rgb_table() {
+  std::vector<Float> t(4 * kBlackbodyTableSize);
+  for (int32_t i = 0; i < kBlackbodyTableSize; ++i) {
+    const double kelvin = blackbody_table_kelvin(i);
+    // Planck's law over its peak (Wien), in double: below 1000 K it is far under float's range.
+    constexpr double c2 = 1.4387769e7;  // h c / k_B in nm K
+    const double peak = 2.8977721e6 / kelvin;
+    const std::array<double, 3> rgb = emission_spectrum_rgb([&](double l) {
+      return std::pow(peak / l, 5) * std::expm1(c2 / (peak * kelvin)) / std::expm1(c2 / (l * kelvin));
+    });
+    // Luminance as the film has it; colours outside sRGB (deep red, at low T) clamp at 0 as blackbody_rgb's do.
+    const double y = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+    Float* e = t.data() + 4 * i;
+    e[0] = y > 0. ? static_cast<Float>(std::log(y)) : -700.f;
+    for (int c = 0; c < 3; ++c) e[1 + c] = y > 0. ? static_cast<Float>(std::max(0., rgb[c]) / y) : 0.f;
+  }
+  return t;
 }
 
 Vec2 blackbody_xy(Float kelvin) {

@@ -24,6 +24,10 @@ Rgb blackbody_rgb(Float kelvin);
 // known as spectra (the glasses' dispersion); nullopt for others.
 std::optional<std::vector<Float>> named_spectrum_samples(const std::string& name);
 
+// The table kernels/blackbody_table.h reads: the film's RGB of
+// B(lambda, T) / B(lambda_max, T) over its temperatures.
+std::vector<Float> build_blackbody_rgb_table();
+
 // Chromaticity (CIE 1931 x, y) of a blackbody at `kelvin`.
 Vec2 blackbody_xy(Float kelvin);
 

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "scene/nanovdb_grid.h"
+#include "scene/pbrt_paths.h"
+
 namespace tessera {
 namespace {
 
@@ -71,9 +74,51 @@ bool valid_coefficient(const Rgb& c) {
   return true;
 }
 
+// pbrt-v4's GridMedium emission: an "Lescale" grid (nx * ny * nz values, or
+// one; pbrt-v4's default is a 1x1x1 grid of 1, which, read like any grid
+// with zeros beyond its one voxel centre, fades Le to 1/2 at the box's faces
+// and 1/8 at its corners) times Le, or a blackbody of the "temperature" grid.
+void read_grid_emission(const ParamSet& params, const Mat4& medium_from_world, const Vec3& p0, const Vec3& p1,
+                        int32_t nx, int32_t ny, int32_t nz, Medium* m, GridDesc* g, const DirectiveContext& ctx) {
+  const std::vector<Float> temperature = params.get_floats("temperature");
+  const uint64_t n = static_cast<uint64_t>(nx) * static_cast<uint64_t>(ny) * static_cast<uint64_t>(nz);
+  if (!temperature.empty()) {
+    if (params.find_any("Le")) ctx.fail("uniformgrid: \"Le\" and \"temperature\" cannot both be given (as in pbrt-v4)");
+    if (temperature.size() != n)
+      ctx.fail("uniformgrid has " + std::to_string(temperature.size()) + " temperature values; nx*ny*nz = " +
+               std::to_string(n));
+    for (Float t : temperature)
+      if (!std::isfinite(t)) ctx.fail("uniformgrid temperatures must be finite");
+    g->temperature = sparse_grid_from_dense(temperature, nx, ny, nz, p0, p1, medium_from_world);
+    g->temperature_offset = params.get_float("temperatureoffset", params.get_float("temperaturecutoff", 0.f));
+    g->temperature_scale = params.get_float("temperaturescale", 1.f);
+    if (!std::isfinite(g->temperature_offset) || !std::isfinite(g->temperature_scale))
+      ctx.fail("uniformgrid \"temperatureoffset\" and \"temperaturescale\" must be finite");
+    m->grid_emits = 1;
+  }
+  if (!m->grid_emits && is_black(m->Le)) {
+    params.find_any("Lescale");
+    return;
+  }
+  std::vector<Float> le_scale = params.get_floats("Lescale");
+  int32_t sx = nx, sy = ny, sz = nz;
+  if (le_scale.empty()) le_scale = {1.f};
+  if (le_scale.size() == 1) {
+    sx = sy = sz = 1;
+  } else if (le_scale.size() != n) {
+    ctx.fail("uniformgrid has " + std::to_string(le_scale.size()) + " \"Lescale\" values; nx*ny*nz = " +
+             std::to_string(n) + " (or give one)");
+  }
+  for (Float v : le_scale)
+    if (!(v >= 0.f) || !std::isfinite(v)) ctx.fail("uniformgrid \"Lescale\" values must be finite and not negative");
+  g->le_scale = sparse_grid_from_dense(le_scale, sx, sy, sz, p0, p1, medium_from_world);
+  m->grid_emits = 1;
+}
+
 // pbrt-v4's GridMedium: "density" (nx * ny * nz floats, x fastest) over
 // the box p0..p1 of the medium's space, with a 16^3 majorant grid as pbrt-v4 builds.
-int32_t read_grid(const ParamSet& params, const Mat4& world_from_medium, const DirectiveContext& ctx) {
+int32_t read_uniform_grid(const ParamSet& params, const Mat4& world_from_medium, Medium* m,
+                          const DirectiveContext& ctx) {
   const std::vector<Float> density = params.get_floats("density");
   if (density.empty()) ctx.fail("uniformgrid medium needs \"float density\" values");
   const int32_t nx = params.get_int("nx", 1), ny = params.get_int("ny", 1), nz = params.get_int("nz", 1);
@@ -87,13 +132,68 @@ int32_t read_grid(const ParamSet& params, const Mat4& world_from_medium, const D
   const Vec3 p1 = params.get_point3("p1").value_or(Vec3(1.f));
   if (!(p1.x > p0.x && p1.y > p0.y && p1.z > p0.z)) ctx.fail("uniformgrid needs p0 < p1 on every axis");
   if (glm::determinant(world_from_medium) == 0.f) ctx.fail("the medium's transform is singular");
-  if (params.find_any("temperature") || params.get_floats("Lescale").size() > 1)
-    ctx.warn("uniformgrid emission grids (\"temperature\", per-voxel \"Lescale\") are not supported; Le is uniform");
+  const Mat4 medium_from_world = glm::inverse(world_from_medium);
   GridDesc g;
-  g.density = sparse_grid_from_dense(density, nx, ny, nz, p0, p1, glm::inverse(world_from_medium));
+  g.density = sparse_grid_from_dense(density, nx, ny, nz, p0, p1, medium_from_world);
   // The box p0..p1 in lattice coordinates: voxel centres are the integers.
   const Vec3 n3(static_cast<Float>(nx), static_cast<Float>(ny), static_cast<Float>(nz));
   g.majorants = build_majorant_grid(g.density, Vec3(-0.5f), n3 - 0.5f, 16);
+  read_grid_emission(params, medium_from_world, p0, p1, nx, ny, nz, m, &g, ctx);
+  ctx.scene.grids.push_back(std::move(g));
+  return static_cast<int32_t>(ctx.scene.grids.size() - 1);
+}
+
+// pbrt-v4's NanoVDBMedium: the float grids "density" (gridname) and,
+// optionally, "temperature" (temperaturename) of a .nvdb file, whose world
+// space is the medium's; the box is their worldBBox, with a 64^3 majorant grid.
+int32_t read_nanovdb(const ParamSet& params, const Mat4& world_from_medium, Medium* m, const DirectiveContext& ctx) {
+  const std::string filename = params.get_string("filename", "");
+  if (filename.empty()) ctx.fail("nanovdb medium needs \"string filename\"");
+  const std::string path = resolve_scene_path(filename, ctx.including_dir, ctx.search_dir);
+  const std::string density_name = params.get_string("gridname", "density");
+  const std::string temperature_name = params.get_string("temperaturename", "temperature");
+  if (glm::determinant(world_from_medium) == 0.f) ctx.fail("the medium's transform is singular");
+  const Mat4 medium_from_world = glm::inverse(world_from_medium);
+  NanoVdbGrid density, temperature;
+  try {
+    density = read_nanovdb_grid(path, density_name);
+    if (!density.found) ctx.fail(path + ": no grid named \"" + density_name + "\"");
+    temperature = read_nanovdb_grid(path, temperature_name);
+  } catch (const std::runtime_error& e) {
+    ctx.fail(e.what());
+  }
+  GridDesc g;
+  Vec3 world_lo = density.world_lo, world_hi = density.world_hi;
+  if (temperature.found) {
+    world_lo = glm::min(world_lo, temperature.world_lo);
+    world_hi = glm::max(world_hi, temperature.world_hi);
+  }
+  // The box in density lattice coordinates (its corners' bounds: the same box for axis-aligned grids).
+  Vec3 lo(kInfinity), hi(-kInfinity);
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner((c & 1) ? world_hi.x : world_lo.x, (c & 2) ? world_hi.y : world_lo.y,
+                      (c & 4) ? world_hi.z : world_lo.z);
+    const Vec3 q = Vec3(density.lattice.lattice_from_world * Vec4(corner, 1.f));
+    lo = glm::min(lo, q);
+    hi = glm::max(hi, q);
+  }
+  if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) ctx.fail(path + ": grid \"" + density_name + "\" is empty");
+  g.density = std::move(density.lattice);
+  g.density.lattice_from_world = g.density.lattice_from_world * medium_from_world;
+  g.majorants = build_majorant_grid(g.density, lo, hi, 64);
+  const Float le_scale = params.get_float("Lescale", 1.f);
+  if (!(le_scale >= 0.f) || !std::isfinite(le_scale)) ctx.fail("nanovdb \"Lescale\" must be finite and not negative");
+  g.temperature_offset = params.get_float("temperatureoffset", params.get_float("temperaturecutoff", 0.f));
+  g.temperature_scale = params.get_float("temperaturescale", 1.f);
+  if (!std::isfinite(g.temperature_offset) || !std::isfinite(g.temperature_scale))
+    ctx.fail("nanovdb \"temperatureoffset\" and \"temperaturescale\" must be finite");
+  if (temperature.found && le_scale > 0.f) {
+    g.temperature = std::move(temperature.lattice);
+    g.temperature.lattice_from_world = g.temperature.lattice_from_world * medium_from_world;
+    g.blackbody_scale = le_scale;
+    m->grid_emits = 1;
+  }
+  m->Le = Rgb(0.f);  // pbrt-v4's nanovdb medium glows only by temperature
   ctx.scene.grids.push_back(std::move(g));
   return static_cast<int32_t>(ctx.scene.grids.size() - 1);
 }
@@ -113,8 +213,8 @@ bool medium_preset(const std::string& name, Rgb* sigma_a, Rgb* sigma_s) {
 
 std::optional<Medium> make_medium(const std::string& type, const ParamSet& params, const Mat4& world_from_medium,
                                   const DirectiveContext& ctx) {
-  if (type != "homogeneous" && type != "uniformgrid") {
-    if (type == "rgbgrid" || type == "cloud" || type == "nanovdb") {
+  if (type != "homogeneous" && type != "uniformgrid" && type != "nanovdb") {
+    if (type == "rgbgrid" || type == "cloud") {
       ctx.warn("medium \"" + type + "\" is not simulated; shapes bounding it enclose vacuum");
       params.mark_all_used();
       return std::nullopt;
@@ -142,14 +242,15 @@ std::optional<Medium> make_medium(const std::string& type, const ParamSet& param
   m.sigma_s = sigma_s * scale;
   if (!valid_coefficient(m.sigma_a) || !valid_coefficient(m.sigma_s))
     ctx.fail("medium sigma_a and sigma_s must be finite and not negative");
-  // One "Lescale" scales Le (a per-voxel grid of them is not supported: read_grid warns).
-  const std::vector<Float> le_scale = params.get_floats("Lescale");
-  m.Le = params.get_rgb("Le").value_or(Rgb(0.f)) * (le_scale.size() == 1 ? le_scale[0] : 1.f);
+  // A homogeneous medium's one "Lescale" scales Le (grid media read theirs as a grid).
+  m.Le = params.get_rgb("Le").value_or(Rgb(0.f));
+  if (type == "homogeneous") m.Le *= params.get_float("Lescale", 1.f);
   if (!valid_coefficient(m.Le)) ctx.fail("medium \"Le\" must be finite and not negative");
   m.g = params.get_float("g", 0.f);
   if (!std::isfinite(m.g)) ctx.fail("medium \"g\" must be finite");
   m.g = std::clamp(m.g, -0.99f, 0.99f);  // pbrt-v4 clamps too: |g| = 1 is a delta
-  if (type == "uniformgrid") m.grid = read_grid(params, world_from_medium, ctx);
+  if (type == "uniformgrid") m.grid = read_uniform_grid(params, world_from_medium, &m, ctx);
+  if (type == "nanovdb") m.grid = read_nanovdb(params, world_from_medium, &m, ctx);
   return m;
 }
 

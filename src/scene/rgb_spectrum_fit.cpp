@@ -159,6 +159,18 @@ double spectrum_luminance(const std::function<double(double)>& s) {
   return y / srgb_colour_system().y_integral;
 }
 
+std::array<double, 3> emission_spectrum_rgb(const std::function<double(double)>& s) {
+  const FineGrid& g = fine_grid();
+  std::array<double, 3> xyz{0., 0., 0.};
+  for (int i = 0; i < kFine; ++i) {
+    const double v = g.weight[i] * s(g.lambda[i]);
+    for (int c = 0; c < 3; ++c) xyz[c] += g.cmf[i][c] * v;
+  }
+  const SrgbColourSystem& cs = srgb_colour_system();
+  for (double& c : xyz) c /= cs.y_integral;
+  return mul(cs.rgb_from_xyz, xyz);
+}
+
 std::array<double, 3> sigmoid_spectrum_rgb(const Coeffs3& c_nm) {
   const FineGrid& g = fine_grid();
   const RgbWeights& w = rgb_weights();

@@ -32,6 +32,10 @@ const SrgbColourSystem& srgb_colour_system();
 // Luminance Y = integral(y-bar s) / integral(y-bar) of a spectrum (lambda in nm).
 double spectrum_luminance(const std::function<double(double)>& s);
 
+// Linear sRGB the film records for an emission spectrum s (lambda in nm):
+// the inverse of the illuminant door of kernels/spectral.h.
+std::array<double, 3> emission_spectrum_rgb(const std::function<double(double)>& s);
+
 // Linear sRGB of the reflectance spectrum with coefficients c (for lambda in
 // nm) lit by D65 (white: (1,1,1) for the constant spectrum 1).
 std::array<double, 3> sigmoid_spectrum_rgb(const Coeffs3& c_nm);

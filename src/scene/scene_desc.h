@@ -58,6 +58,11 @@ struct ImageDesc {
 struct GridDesc {
   SparseGridDesc density;
   MajorantGridDesc majorants;  // over the medium's box
+  // Emission (GridMediumView): Le scaled per point, or a blackbody of the
+  // temperature grid's value.
+  SparseGridDesc le_scale;     // nx == 0: 1 everywhere
+  SparseGridDesc temperature;  // nx == 0: Medium::Le is the emission
+  Float temperature_offset = 0.f, temperature_scale = 1.f, blackbody_scale = 1.f;
 };
 
 // "World" in a SceneDesc is pbrt-v4's render space: the scene's world

@@ -18,11 +18,17 @@ namespace tessera {
 
 namespace {
 
-GridMediumView grid_medium_view(const GridDesc& g) {
+GridMediumView grid_medium_view(const GridDesc& g, const std::vector<Float>& blackbody_rgb) {
   GridMediumView v;
   v.density = sparse_grid_view(g.density);
   v.majorants = majorant_grid_view(g.majorants);
   v.max_density = g.density.max_value;
+  v.le_scale = sparse_grid_view(g.le_scale);
+  v.temperature = sparse_grid_view(g.temperature);
+  v.temperature_offset = g.temperature_offset;
+  v.temperature_scale = g.temperature_scale;
+  v.blackbody_scale = g.blackbody_scale;
+  v.blackbody_rgb = blackbody_rgb.empty() ? nullptr : blackbody_rgb.data();
   return v;
 }
 
@@ -258,7 +264,9 @@ void SceneData::build_view() {
     v.num_media = static_cast<uint32_t>(desc_.media.size());
     v.triangle_media = triangle_media_.data();
     v.camera_medium = desc_.camera_medium;
-    for (const GridDesc& g : desc_.grids) grid_views_.push_back(grid_medium_view(g));
+    for (const GridDesc& g : desc_.grids)
+      if (g.temperature.nx > 0 && blackbody_rgb_table_.empty()) blackbody_rgb_table_ = build_blackbody_rgb_table();
+    for (const GridDesc& g : desc_.grids) grid_views_.push_back(grid_medium_view(g, blackbody_rgb_table_));
     v.grids = grid_views_.data();
   }
   v.filter.inverse_cdf_x = filter_inverse_cdf_x_.data();
@@ -314,7 +322,7 @@ uint64_t SceneData::fingerprint() const {
     f.add(&desc_.camera_medium, sizeof desc_.camera_medium);
     for (const Light& l : lights_) f.add(&l.medium, sizeof l.medium);
     for (const GridDesc& g : desc_.grids) {
-      for (const SparseGridDesc* s : {&g.density}) {
+      for (const SparseGridDesc* s : {&g.density, &g.le_scale, &g.temperature}) {
         f.add_vector(s->brick_of);
         f.add_vector(s->values);
         f.add(&s->lattice_from_world, sizeof s->lattice_from_world);
@@ -323,6 +331,8 @@ uint64_t SceneData::fingerprint() const {
       }
       f.add(&g.majorants.lo, sizeof g.majorants.lo);
       f.add(&g.majorants.hi, sizeof g.majorants.hi);
+      const Float emission[3] = {g.temperature_offset, g.temperature_scale, g.blackbody_scale};
+      f.add(emission, sizeof emission);
     }
   }
   return f.h;

@@ -66,6 +66,7 @@ class SceneData {
   bool has_alpha_ = false;                   // any triangle not opaque
   std::vector<MediumInterface> triangle_media_;  // per triangle, only for scenes with media
   std::vector<GridMediumView> grid_views_;
+  std::vector<Float> blackbody_rgb_table_;     // for grids that glow by temperature (RGB transport)
   std::vector<Vec3> positions_end_, normals_end_;  // per vertex, only when some shape moves (motion blur)
   bool has_media_ = false;
   std::vector<Float> filter_inverse_cdf_x_, filter_inverse_cdf_y_;

@@ -205,7 +205,7 @@ TEST(GridMedium, DeltaTrackingEstimatesTransmittanceAndScatteringInEveryChannel)
   Rng rng = Rng::for_sample(7, 8, 9);
   for (int i = 0; i < n; ++i) {
     const Vec3 o(rng.uniform() - 0.5f, rng.uniform() - 0.5f, -1.f);
-    const MediumSegment seg = sample_grid_segment(m, c.view, o, Vec3(0.f, 0.f, 1.f), t_max, rng.uniform());
+    const MediumSegment seg = sample_grid_segment(m, c.view, o, Vec3(0.f, 0.f, 1.f), t_max, rng.uniform(), nullptr);
     ASSERT_TRUE(std::isfinite(seg.weight.x) && std::isfinite(seg.weight.y) && std::isfinite(seg.weight.z));
     (seg.scattered ? scatter : reach) += seg.weight;
   }
@@ -226,7 +226,7 @@ TEST(GridMedium, RaysMissingTheBoxSeeNoMedium) {
   m.sigma_s = Rgb(1.f);
   m.grid = 0;
   EXPECT_EQ(grid_transmittance(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), 100.f), Rgb(1.f));
-  const MediumSegment seg = sample_grid_segment(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), kInfinity, 0.3f);
+  const MediumSegment seg = sample_grid_segment(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), kInfinity, 0.3f, nullptr);
   EXPECT_FALSE(seg.scattered);
   EXPECT_EQ(seg.weight, Rgb(1.f));
 }
