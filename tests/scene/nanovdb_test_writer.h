@@ -19,6 +19,7 @@ struct NvdbGridSpec {
   nanovdb::CoordBBox voxels;               // the voxels value() is asked for (inclusive)
   std::function<float(int, int, int)> value;
   nanovdb::GridClass grid_class = nanovdb::GridClass::FogVolume;
+  bool zeros_active = false;  // zeros set too (active voxels): they widen the grid's bounding box
 };
 
 inline nanovdb::GridHandle<nanovdb::HostBuffer> build_nvdb_grid(const NvdbGridSpec& s) {
@@ -28,7 +29,7 @@ inline nanovdb::GridHandle<nanovdb::HostBuffer> build_nvdb_grid(const NvdbGridSp
     for (int y = s.voxels.min()[1]; y <= s.voxels.max()[1]; ++y)
       for (int x = s.voxels.min()[0]; x <= s.voxels.max()[0]; ++x) {
         const float v = s.value(x, y, z);
-        if (v != 0.f) acc.setValue(nanovdb::Coord(x, y, z), v);
+        if (v != 0.f || s.zeros_active) acc.setValue(nanovdb::Coord(x, y, z), v);
       }
   return builder.getHandle(s.voxel_size, s.origin, s.name);
 }
