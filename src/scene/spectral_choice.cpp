@@ -29,8 +29,11 @@ std::string spectral_reason(const SceneDesc& scene) {
     const Rgb c = l.blackbody_kelvin > 0.f ? blackbody_rgb(l.blackbody_kelvin) : l.L;
     if (strongly_coloured(c)) return "a strongly coloured light";
   }
-  for (const Medium& m : scene.media)
+  for (const Medium& m : scene.media) {
     if (strongly_coloured(m.Le)) return "a strongly coloured emitting medium";
+    // Blackbodies below about 5000 K are strongly coloured; fire is far below.
+    if (m.grid >= 0 && scene.grids[static_cast<size_t>(m.grid)].temperature.nx > 0) return "a medium glowing by temperature";
+  }
   return "";
 }
 

@@ -141,6 +141,34 @@ TEST(GridMedium, MajorantWalkVisitsTheCellsAlongTheRayInOrderWithoutGaps) {
   }
 }
 
+// Tentative collisions (lookups) per ray through the two blobs: the
+// majorant grid skips the free space between them.
+double lookups_per_ray(const TestGrid& t, const Medium& m) {
+  Rng rng = Rng::for_sample(2, 4, 6);
+  uint64_t lookups = 0;
+  const int rays = 20000;
+  for (int i = 0; i < rays; ++i) {
+    const Vec3 o(-2.f, rng.uniform() * 2.f, 1.f + rng.uniform() * 6.f);
+    const Vec3 d = glm::normalize(Vec3(1.f, rng.uniform() - 0.5f, rng.uniform() - 0.5f));
+    GridRay r;
+    if (!grid_clip(t.view, o, d, 100.f, &r)) continue;
+    TentativeCollisions c = tentative_collisions(t.view, r, max_component(medium_sigma_t(m)));
+    Rng track = tracking_rng(0.5f, o, d);
+    Float dens;
+    while (next_tentative_collision(t.view, c, track, dens)) ++lookups;
+  }
+  return static_cast<double>(lookups) / rays;
+}
+
+TEST(GridMedium, MajorantGridSkipsFreeSpace) {
+  const TwoBlobs b;
+  Medium m;
+  m.sigma_s = Rgb(1.f);
+  const double one_cell = lookups_per_ray(TestGrid(b.v, b.nx, b.ny, b.nz, b.p0, b.p1, 1), m);
+  const double cells = lookups_per_ray(TestGrid(b.v, b.nx, b.ny, b.nz, b.p0, b.p1, 16), m);
+  EXPECT_LT(cells, 0.25 * one_cell) << one_cell << " lookups per ray with one majorant, " << cells << " with 16^3";
+}
+
 // Transmittance along a line, by a fine midpoint rule.
 double quadrature_optical_depth(const GridMediumView& g, Vec3 o, Vec3 d, Float t_max) {
   const int n = 20000;

@@ -31,6 +31,10 @@ TEST(SpectralChoice, ColouredLightsAndMeasuredSpectraAreSpectral) {
   EXPECT_EQ(spectral_reason(prism), "a dispersive dielectric");
   SceneDesc plain = load_world(std::string("Material \"dielectric\" \"float eta\" 1.5\n") + kTriangle);
   EXPECT_EQ(spectral_reason(plain), "");
+  SceneDesc fire = load_world(std::string("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [ 1 ] "
+                                          "\"float temperature\" [ 1500 ]\nMediumInterface \"m\" \"\"\n") +
+                              kTriangle);
+  EXPECT_EQ(spectral_reason(fire), "a medium glowing by temperature");
 }
 
 // pbrt-v4's named glasses disperse: Schott's Sellmeier formulas, sampled for
