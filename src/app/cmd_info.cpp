@@ -33,9 +33,18 @@ int run_info(const std::string& path) {
   std::printf("lights:         %u (%u emissive triangles", v.num_lights, area);
   for (auto& [k, n] : light_kinds) std::printf(", %d %s", n, k.c_str());
   std::printf(")\n");
-  if (!scene.desc().media.empty() || scene.desc().camera_medium >= 0)
-    std::printf("media:          %zu homogeneous%s\n", scene.desc().media.size(),
+  if (!scene.desc().media.empty() || scene.desc().camera_medium >= 0) {
+    size_t grids = 0, stored_bricks = 0, glowing = 0;
+    for (const Medium& m : scene.desc().media) {
+      if (m.grid < 0) continue;
+      ++grids;
+      glowing += m.grid_emits != 0;
+      stored_bricks += scene.desc().grids[static_cast<size_t>(m.grid)].density.values.size() / kBrickVoxels;
+    }
+    std::printf("media:          %zu homogeneous, %zu grids (%zu density bricks of 8^3, %zu glowing by grid)%s\n",
+                scene.desc().media.size() - grids, grids, stored_bricks, glowing,
                 scene.desc().camera_medium >= 0 ? ", the camera in one" : "");
+  }
   const Bounds& b = scene.bounds();
   // Bounds in the scene file's world (render space plus its origin, in double).
   const glm::dvec3 o = scene.desc().render_origin;
