@@ -24,7 +24,8 @@ void serialize(Archive& ar, MajorantGridDesc& m) {
 }
 template <class Archive>
 void serialize(Archive& ar, GridDesc& g) {
-  ar(g.density, g.majorants, g.le_scale, g.temperature, g.temperature_offset, g.temperature_scale, g.blackbody_scale);
+  ar(g.density, g.majorants, g.le_scale, g.temperature, g.temperature_offset, g.temperature_scale, g.blackbody_scale,
+     g.cloud, g.cloud_density, g.cloud_wispiness, g.cloud_frequency);
 }
 template <class Archive>
 void serialize(Archive& ar, SceneDesc& d) {

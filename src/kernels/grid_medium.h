@@ -1,5 +1,6 @@
-// pbrt-v4's grid media ("uniformgrid", "nanovdb"): a density lattice
-// (sparse_grid.h) scaling sigma_a, sigma_s and the emission inside a box.
+// pbrt-v4's grid media ("uniformgrid", "nanovdb", and the procedural
+// "cloud"): a density lattice (sparse_grid.h) or function scaling sigma_a,
+// sigma_s and the emission inside a box.
 // Collisions are found by delta tracking against the majorant of the
 // majorant-grid cell they fall in (its largest density times the largest
 // extinction of the three channels), weighted so
@@ -12,6 +13,7 @@
 
 #include "majorant_grid.h"
 #include "medium.h"
+#include "perlin_noise.h"
 #include "rng.h"
 #include "sparse_grid.h"
 #include "spectral.h"
@@ -33,10 +35,43 @@ struct GridMediumView {
   SparseGridView temperature;  // absent: Medium::Le
   Float temperature_offset = 0.f, temperature_scale = 1.f, blackbody_scale = 1.f;
   const Float* blackbody_rgb = nullptr;  // RGB transport: kBlackbodyTableSize RGB triples (blackbody_table.h)
+  // pbrt-v4's "cloud": a procedural density instead of the lattice, whose
+  // lattice_from_world is then the medium's space.
+  int32_t cloud = 0;
+  Float cloud_density = 1.f, cloud_wispiness = 1.f, cloud_frequency = 5.f;
 };
 
+// pbrt-v4's CloudMedium density at p (medium space): five octaves of noise
+// at `frequency`, displaced by two octaves of its gradient (`wispiness`),
+// thinning with height and clamped to [0, 1], with a solid base below y = 0.5.
+TESSERA_HOST_DEVICE inline Float cloud_density(const GridMediumView& g, const Vec3& p) {
+  Vec3 pp = g.cloud_frequency * p;
+  if (g.cloud_wispiness > 0.f) {
+    Float omega = 0.05f * g.cloud_wispiness, lambda = 10.f;
+    for (int i = 0; i < 2; ++i) {
+      pp += omega * perlin_noise_gradient(lambda * pp);
+      omega *= 0.5f;
+      lambda *= 1.99f;
+    }
+  }
+  Float d = 0.f, omega = 0.5f, lambda = 1.f;
+  for (int i = 0; i < 5; ++i) {
+    d += omega * perlin_noise(lambda * pp);
+    omega *= 0.5f;
+    lambda *= 1.99f;
+  }
+  d = glm::clamp((1.f - p.y) * 4.5f * g.cloud_density * d, 0.f, 1.f);
+  d += 2.f * glm::max(0.f, 0.5f - p.y);
+  return glm::clamp(d, 0.f, 1.f);
+}
+
+// Density at q, the density lattice's coordinates (the medium's space for a cloud).
+TESSERA_HOST_DEVICE inline Float density_at(const GridMediumView& g, const Vec3& q) {
+  return g.cloud ? cloud_density(g, q) : lattice_trilinear(g.density, q);
+}
+
 TESSERA_HOST_DEVICE inline Float grid_density(const GridMediumView& g, const Vec3& p_world) {
-  return grid_value(g.density, p_world);
+  return density_at(g, grid_lattice_point(g.density, p_world));
 }
 
 // Emitted radiance per unit absorption at p (world), at the path's
@@ -135,7 +170,7 @@ TESSERA_HOST_DEVICE inline bool next_tentative_collision(const GridMediumView& g
       c.in_cell = false;
       continue;
     }
-    density = lattice_trilinear(g.density, c.r.o + static_cast<Float>(c.t) * c.r.d);
+    density = density_at(g, c.r.o + static_cast<Float>(c.t) * c.r.d);
     return true;
   }
 }

@@ -143,6 +143,29 @@ int32_t read_uniform_grid(const ParamSet& params, const Mat4& world_from_medium,
   return static_cast<int32_t>(ctx.scene.grids.size() - 1);
 }
 
+// pbrt-v4's CloudMedium: a procedural density (kernels/grid_medium.h) over
+// the box p0..p1 of the medium's space, bounded by 1 (one majorant cell).
+int32_t read_cloud(const ParamSet& params, const Mat4& world_from_medium, const DirectiveContext& ctx) {
+  GridDesc g;
+  g.cloud = 1;
+  g.cloud_density = params.get_float("density", 1.f);
+  g.cloud_wispiness = params.get_float("wispiness", 1.f);
+  g.cloud_frequency = params.get_float("frequency", 5.f);
+  if (!(g.cloud_density >= 0.f) || !std::isfinite(g.cloud_density) || !std::isfinite(g.cloud_wispiness) ||
+      !std::isfinite(g.cloud_frequency))
+    ctx.fail("cloud \"density\" must be finite and not negative, \"wispiness\" and \"frequency\" finite");
+  const Vec3 p0 = params.get_point3("p0").value_or(Vec3(0.f));
+  const Vec3 p1 = params.get_point3("p1").value_or(Vec3(1.f));
+  if (!(p1.x > p0.x && p1.y > p0.y && p1.z > p0.z)) ctx.fail("cloud needs p0 < p1 on every axis");
+  if (glm::determinant(world_from_medium) == 0.f) ctx.fail("the medium's transform is singular");
+  g.density.lattice_from_world = glm::inverse(world_from_medium);
+  g.majorants.lo = p0;
+  g.majorants.hi = p1;
+  g.majorants.max_density = {1.f};
+  ctx.scene.grids.push_back(std::move(g));
+  return static_cast<int32_t>(ctx.scene.grids.size() - 1);
+}
+
 // pbrt-v4's NanoVDBMedium: the float grids "density" (gridname) and,
 // optionally, "temperature" (temperaturename) of a .nvdb file, whose world
 // space is the medium's; the box is their worldBBox, with a 64^3 majorant grid.
@@ -213,8 +236,8 @@ bool medium_preset(const std::string& name, Rgb* sigma_a, Rgb* sigma_s) {
 
 std::optional<Medium> make_medium(const std::string& type, const ParamSet& params, const Mat4& world_from_medium,
                                   const DirectiveContext& ctx) {
-  if (type != "homogeneous" && type != "uniformgrid" && type != "nanovdb") {
-    if (type == "rgbgrid" || type == "cloud") {
+  if (type != "homogeneous" && type != "uniformgrid" && type != "nanovdb" && type != "cloud") {
+    if (type == "rgbgrid") {
       ctx.warn("medium \"" + type + "\" is not simulated; shapes bounding it enclose vacuum");
       params.mark_all_used();
       return std::nullopt;
@@ -251,6 +274,10 @@ std::optional<Medium> make_medium(const std::string& type, const ParamSet& param
   m.g = std::clamp(m.g, -0.99f, 0.99f);  // pbrt-v4 clamps too: |g| = 1 is a delta
   if (type == "uniformgrid") m.grid = read_uniform_grid(params, world_from_medium, &m, ctx);
   if (type == "nanovdb") m.grid = read_nanovdb(params, world_from_medium, &m, ctx);
+  if (type == "cloud") {
+    m.grid = read_cloud(params, world_from_medium, ctx);
+    m.Le = Rgb(0.f);  // pbrt-v4's cloud does not glow
+  }
   return m;
 }
 

@@ -63,6 +63,9 @@ struct GridDesc {
   SparseGridDesc le_scale;     // nx == 0: 1 everywhere
   SparseGridDesc temperature;  // nx == 0: Medium::Le is the emission
   Float temperature_offset = 0.f, temperature_scale = 1.f, blackbody_scale = 1.f;
+  // pbrt-v4's "cloud" (density.lattice_from_world is then medium_from_world, density.nx 0).
+  int32_t cloud = 0;
+  Float cloud_density = 1.f, cloud_wispiness = 1.f, cloud_frequency = 5.f;
 };
 
 // "World" in a SceneDesc is pbrt-v4's render space: the scene's world

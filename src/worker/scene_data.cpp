@@ -29,6 +29,10 @@ GridMediumView grid_medium_view(const GridDesc& g, const std::vector<Float>& bla
   v.temperature_scale = g.temperature_scale;
   v.blackbody_scale = g.blackbody_scale;
   v.blackbody_rgb = blackbody_rgb.empty() ? nullptr : blackbody_rgb.data();
+  v.cloud = g.cloud;
+  v.cloud_density = g.cloud_density;
+  v.cloud_wispiness = g.cloud_wispiness;
+  v.cloud_frequency = g.cloud_frequency;
   return v;
 }
 
@@ -333,6 +337,8 @@ uint64_t SceneData::fingerprint() const {
       f.add(&g.majorants.hi, sizeof g.majorants.hi);
       const Float emission[3] = {g.temperature_offset, g.temperature_scale, g.blackbody_scale};
       f.add(emission, sizeof emission);
+      const Float cloud[4] = {static_cast<Float>(g.cloud), g.cloud_density, g.cloud_wispiness, g.cloud_frequency};
+      f.add(cloud, sizeof cloud);
     }
   }
   return f.h;

@@ -166,5 +166,20 @@ TEST(GridMedia, NanoVdbMediaRenderAsTheirUniformGridEquivalents) {
   }
 }
 
+// pbrt-v4's cloud in an albedo-1 furnace: 1 everywhere (its density is
+// bounded by 1, the one majorant cell).
+TEST(GridMedia, CloudFurnaceIsOne) {
+  const std::string scene = header(512, 100000, 40.0) + "WorldBegin\nLightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n"
+                            "AttributeBegin\nTranslate -0.5 -0.5 1.5\n"
+                            "MakeNamedMedium \"m\" \"string type\" \"cloud\" \"rgb sigma_a\" [ 0 0 0 ] "
+                            "\"rgb sigma_s\" [ 4 5 6 ] \"float g\" 0.4\n"
+                            "Material \"interface\"\nMediumInterface \"m\" \"\"\n" +
+                            testing::box(Vec3(0.f), Vec3(1.f)) + "AttributeEnd\n";
+  RenderResult r = testing::render_text(scene);
+  const ChannelStats f = channel_stats(r.film);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(f.mean[c], 1.0, 0.01) << "channel " << c;
+  EXPECT_GT(r.stats.counters.path.medium_vertices, r.stats.counters.samples / 4);
+}
+
 }  // namespace
 }  // namespace tessera

@@ -7,6 +7,7 @@
 
 #include "kernels/grid_medium.h"
 #include "kernels/rng.h"
+#include "scene/pbrt_loader.h"
 #include "scene/scene_desc.h"
 #include "scene/sparse_grid_build.h"
 
@@ -257,6 +258,58 @@ TEST(GridMedium, RaysMissingTheBoxSeeNoMedium) {
   const MediumSegment seg = sample_grid_segment(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), kInfinity, 0.3f, nullptr);
   EXPECT_FALSE(seg.scattered);
   EXPECT_EQ(seg.weight, Rgb(1.f));
+}
+
+}  // namespace
+}  // namespace tessera
+
+namespace tessera {
+namespace {
+
+// pbrt-v4's cloud: solid below y = 0 (its base term), noise above, within
+// [0, 1] everywhere; parameters as pbrt-v4 reads them.
+TEST(CloudMedium, DensityIsSolidBelowAndNoisyAboveWithinOne) {
+  SceneDesc d = load_pbrt_string(
+      "Camera \"perspective\"\nWorldBegin\nAttributeBegin\nTranslate 0 10 0\n"
+      "MakeNamedMedium \"c\" \"string type\" \"cloud\" \"float density\" 2 \"float wispiness\" 0.5 \"float frequency\" 3 "
+      "\"point3 p0\" [ -1 -1 -1 ] \"point3 p1\" [ 2 2 2 ] \"rgb sigma_s\" [ 3 3 3 ]\nAttributeEnd\n"
+      "MediumInterface \"c\" \"\"\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 2 ]\n",
+      "<t>", ".");
+  ASSERT_EQ(d.grids.size(), 1u);
+  const GridDesc& g = d.grids[0];
+  EXPECT_EQ(g.cloud, 1);
+  EXPECT_EQ(g.cloud_density, 2.f);
+  EXPECT_EQ(g.cloud_wispiness, 0.5f);
+  EXPECT_EQ(g.cloud_frequency, 3.f);
+  EXPECT_EQ(g.majorants.lo, Vec3(-1.f));
+  EXPECT_EQ(g.majorants.hi, Vec3(2.f));
+  EXPECT_EQ(d.media[0].sigma_s, Rgb(3.f));
+  GridMediumView v;
+  v.density = sparse_grid_view(g.density);
+  v.majorants = majorant_grid_view(g.majorants);
+  v.cloud = g.cloud;
+  v.cloud_density = g.cloud_density;
+  v.cloud_wispiness = g.cloud_wispiness;
+  v.cloud_frequency = g.cloud_frequency;
+  Rng rng = Rng::for_sample(3, 3, 3);
+  double between = 0.0;
+  int inside = 0;
+  const Vec3 origin = Vec3(0.f, 10.f, 0.f) - Vec3(d.render_origin);  // the medium's origin in render space
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 q(rng.uniform() * 3.f - 1.f, rng.uniform() * 3.f - 1.f, rng.uniform() * 3.f - 1.f);
+    const Float rho = grid_density(v, origin + q);
+    ASSERT_GE(rho, 0.f);
+    ASSERT_LE(rho, 1.f);  // the majorant's bound
+    if (q.y <= 0.f) {
+      EXPECT_EQ(rho, 1.f) << q.y;
+    }
+    if (q.y > 0.55f && q.y < 0.95f) {
+      between += rho;
+      ++inside;
+    }
+  }
+  EXPECT_GT(between / inside, 0.02);
+  EXPECT_LT(between / inside, 0.9);
 }
 
 }  // namespace
