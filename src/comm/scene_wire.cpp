@@ -25,7 +25,8 @@ void serialize(Archive& ar, MajorantGridDesc& m) {
 template <class Archive>
 void serialize(Archive& ar, GridDesc& g) {
   ar(g.density, g.majorants, g.le_scale, g.temperature, g.temperature_offset, g.temperature_scale, g.blackbody_scale,
-     g.cloud, g.cloud_density, g.cloud_wispiness, g.cloud_frequency);
+     g.cloud, g.cloud_density, g.cloud_wispiness, g.cloud_frequency, g.rgb, g.rgb_scale, g.rgb_le_scale);
+  for (int c = 0; c < 3; ++c) ar(g.rgb_sigma_a[c], g.rgb_sigma_s[c], g.rgb_le[c]);
 }
 template <class Archive>
 void serialize(Archive& ar, SceneDesc& d) {

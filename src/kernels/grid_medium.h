@@ -14,6 +14,7 @@
 #include "majorant_grid.h"
 #include "medium.h"
 #include "perlin_noise.h"
+#include "rgb_grid.h"
 #include "rng.h"
 #include "sparse_grid.h"
 #include "spectral.h"
@@ -39,6 +40,14 @@ struct GridMediumView {
   // lattice_from_world is then the medium's space.
   int32_t cloud = 0;
   Float cloud_density = 1.f, cloud_wispiness = 1.f, cloud_frequency = 5.f;
+  // pbrt-v4's "rgbgrid": per-voxel coefficients on the density lattice's
+  // coordinates (which then holds no values), scaled by rgb_scale; a grid
+  // not given is 1 everywhere (Le: 0). Its majorant cells hold the whole
+  // extinction bound.
+  int32_t rgb = 0;
+  RgbGridView rgb_sigma_a, rgb_sigma_s, rgb_le;
+  Float rgb_scale = 1.f, rgb_le_scale = 1.f;
+  const SpectralView* spectral = nullptr;  // spectral transport's tables (rgb grids convert per voxel)
 };
 
 // pbrt-v4's CloudMedium density at p (medium space): five octaves of noise
@@ -74,10 +83,36 @@ TESSERA_HOST_DEVICE inline Float grid_density(const GridMediumView& g, const Vec
   return density_at(g, grid_lattice_point(g.density, p_world));
 }
 
+// sigma_a and sigma_s at q (lattice coordinates) at the path's wavelengths
+// (wl) or in RGB; m is the medium as the path sees it (medium_at).
+TESSERA_HOST_DEVICE inline void grid_coefficients(const GridMediumView& g, const Medium& m, const Vec3& q,
+                                                  const Wavelengths* wl, Rgb* sigma_a, Rgb* sigma_s) {
+  if (g.rgb) {
+    *sigma_a = rgb_grid_present(g.rgb_sigma_a) ? g.rgb_scale * rgb_grid_value(g.rgb_sigma_a, q, g.spectral, wl, false)
+                                               : Rgb(g.rgb_scale);
+    *sigma_s = rgb_grid_present(g.rgb_sigma_s) ? g.rgb_scale * rgb_grid_value(g.rgb_sigma_s, q, g.spectral, wl, false)
+                                               : Rgb(g.rgb_scale);
+    return;
+  }
+  const Float d = density_at(g, q);
+  *sigma_a = d * m.sigma_a;
+  *sigma_s = d * m.sigma_s;
+}
+
+// What the majorant cells are multiplied by: the medium's largest
+// extinction per unit density (rgb grids store the whole bound).
+TESSERA_HOST_DEVICE inline Float grid_extinction_scale(const GridMediumView& g, const Medium& m) {
+  return g.rgb ? 1.f : max_component(medium_sigma_t(m));
+}
+
 // Emitted radiance per unit absorption at p (world), at the path's
 // wavelengths (wl) or in RGB. m is the medium as the path sees it (medium_at).
 TESSERA_HOST_DEVICE inline Rgb grid_emission(const GridMediumView& g, const Medium& m, const Vec3& p,
                                              const Wavelengths* wl) {
+  if (g.rgb)
+    return rgb_grid_present(g.rgb_le)
+               ? g.rgb_le_scale * rgb_grid_value(g.rgb_le, grid_lattice_point(g.density, p), g.spectral, wl, true)
+               : Rgb(0.f);
   const Float s = grid_present(g.le_scale) ? grid_value(g.le_scale, p) : 1.f;
   if (!(s > 0.f)) return Rgb(0.f);
   if (!grid_present(g.temperature)) return s * m.Le;
@@ -151,10 +186,10 @@ TESSERA_HOST_DEVICE inline TentativeCollisions tentative_collisions(const GridMe
   return c;
 }
 
-// The next tentative collision (c.t, its density, c.majorant); false once
-// past the box (or after 2^20 of them).
+// The next tentative collision (c.t, its lattice point q, c.majorant);
+// false once past the box (or after 2^20 of them).
 TESSERA_HOST_DEVICE inline bool next_tentative_collision(const GridMediumView& g, TentativeCollisions& c, Rng& rng,
-                                                         Float& density) {
+                                                         Vec3& q) {
   for (;;) {
     if (!c.in_cell) {
       Float ta, cell_max;
@@ -170,7 +205,7 @@ TESSERA_HOST_DEVICE inline bool next_tentative_collision(const GridMediumView& g
       c.in_cell = false;
       continue;
     }
-    density = density_at(g, c.r.o + static_cast<Float>(c.t) * c.r.d);
+    q = c.r.o + static_cast<Float>(c.t) * c.r.d;
     return true;
   }
 }
@@ -184,15 +219,16 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
   MediumSegment seg;
   seg.t = t_max;
   GridRay r;
-  const Float sigma_t_max = max_component(medium_sigma_t(m));
+  const Float sigma_t_max = grid_extinction_scale(g, m);
   if (!(sigma_t_max > 0.f) || !grid_clip(g, o, d, t_max, &r)) return seg;
   Rng rng = tracking_rng(u, o, d);
   TentativeCollisions c = tentative_collisions(g, r, sigma_t_max);
   Rgb w(1.f);
-  Float dens = 0.f;
-  while (next_tentative_collision(g, c, rng, dens)) {
+  Vec3 q;
+  while (next_tentative_collision(g, c, rng, q)) {
     const Float majorant = c.majorant;
-    const Rgb sigma_a = dens * m.sigma_a, sigma_s = dens * m.sigma_s;
+    Rgb sigma_a, sigma_s;
+    grid_coefficients(g, m, q, wl, &sigma_a, &sigma_s);
     const Rgb sigma_n = Rgb(majorant) - sigma_a - sigma_s;
     if (emits && !is_black(sigma_a)) seg.emitted += w * sigma_a * grid_emission(g, m, o + static_cast<Float>(c.t) * d, wl) / majorant;
     const Float p_s = (sigma_s.x + sigma_s.y + sigma_s.z) / (3.f * majorant);
@@ -219,16 +255,18 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
 
 // Ratio tracking: an unbiased estimate of the transmittance along [0, t_max].
 TESSERA_HOST_DEVICE inline Rgb grid_transmittance(const Medium& m, const GridMediumView& g, const Vec3& o,
-                                                  const Vec3& d, Float t_max) {
+                                                  const Vec3& d, Float t_max, const Wavelengths* wl) {
   GridRay r;
-  const Float sigma_t_max = max_component(medium_sigma_t(m));
+  const Float sigma_t_max = grid_extinction_scale(g, m);
   if (!(sigma_t_max > 0.f) || !grid_clip(g, o, d, t_max, &r)) return Rgb(1.f);
   Rng rng = tracking_rng(0.5f, o, d);
   TentativeCollisions c = tentative_collisions(g, r, sigma_t_max);
   Rgb tr(1.f);
-  Float dens = 0.f;
-  while (next_tentative_collision(g, c, rng, dens)) {
-    tr *= glm::max(Rgb(0.f), Rgb(1.f) - dens * medium_sigma_t(m) / c.majorant);
+  Vec3 q;
+  while (next_tentative_collision(g, c, rng, q)) {
+    Rgb sigma_a, sigma_s;
+    grid_coefficients(g, m, q, wl, &sigma_a, &sigma_s);
+    tr *= glm::max(Rgb(0.f), Rgb(1.f) - (sigma_a + sigma_s) / c.majorant);
     // Russian roulette once little is left (unbiased: survivors are scaled up).
     const Float left = max_component(tr);
     if (left < 0.05f) {

@@ -227,7 +227,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         const Float t_max = found ? hit.t : kInfinity;
         if (medium_absorbs_only(m)) {
           // Its transmittance: no collision to sample, no path ended by absorption.
-          const Rgb T = medium_transmittance(s, m, ray.o, ray.d, t_max);
+          const Rgb T = medium_transmittance(s, m, ray.o, ray.d, t_max, wl);
           beta *= T;
           rr_beta *= T;
           segment_tr = luminance(T);

@@ -261,7 +261,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
         const Medium m = medium_at(s, medium, wl);
         const Float t_max = found ? hit.t : kInfinity;
         if (medium_absorbs_only(m)) {
-          beta *= medium_transmittance(s, m, ray.o, ray.d, t_max);
+          beta *= medium_transmittance(s, m, ray.o, ray.d, t_max, wl);
         } else {
           const Float u_channel = rng.uniform();
           const Float u_dist = rng.uniform();

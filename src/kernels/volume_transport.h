@@ -23,8 +23,8 @@ TESSERA_HOST_DEVICE inline int32_t medium_after(const SceneView& s, uint32_t tri
 // Transmittance of medium m (as the path sees it: medium_at) along o + t d,
 // t in [0, t_max]: exact for a homogeneous medium, a ratio-tracking estimate for a grid.
 TESSERA_HOST_DEVICE inline Rgb medium_transmittance(const SceneView& s, const Medium& m, const Vec3& o, const Vec3& d,
-                                                    Float t_max) {
-  if (m.grid >= 0) return grid_transmittance(m, s.grids[m.grid], o, d, t_max);
+                                                    Float t_max, const Wavelengths* wl) {
+  if (m.grid >= 0) return grid_transmittance(m, s.grids[m.grid], o, d, t_max, wl);
   return transmittance(medium_sigma_t(m), t_max);
 }
 
@@ -48,7 +48,7 @@ TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& t
   if (!s.has_interfaces) {
     ++c.shadow_rays;
     if (tracer.occluded(o, d, t_max, time)) return Rgb(0.f);
-    return medium >= 0 ? medium_transmittance(s, medium_at(s, medium, wl), o, d, t_max) : Rgb(1.f);
+    return medium >= 0 ? medium_transmittance(s, medium_at(s, medium, wl), o, d, t_max, wl) : Rgb(1.f);
   }
   Rgb tr(1.f);
   const bool infinite = !(t_max < kInfinity);
@@ -58,14 +58,14 @@ TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& t
     TraceHit hit;
     ++c.shadow_rays;
     if (!tracer.intersect(o, d, t_max, &hit, time)) {
-      if (medium >= 0) tr *= medium_transmittance(s, medium_at(s, medium, wl), o, d, t_max);
+      if (medium >= 0) tr *= medium_transmittance(s, medium_at(s, medium, wl), o, d, t_max, wl);
       return tr;
     }
     const RayPoint from_ray{o, d, hit.t};
     const SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, time, &from_ray);
     if (resolve_material<kSpecAll>(s, s.triangles[hit.triangle].material, h, -d)->type != MaterialType::Interface)
       return Rgb(0.f);
-    if (medium >= 0) tr *= medium_transmittance(s, medium_at(s, medium, wl), o, d, hit.t);
+    if (medium >= 0) tr *= medium_transmittance(s, medium_at(s, medium, wl), o, d, hit.t, wl);
     if (is_black(tr)) return tr;
     medium = medium_after(s, hit.triangle, h.ng, d, medium);
     o = offset_ray_origin(h, d);

@@ -166,6 +166,76 @@ int32_t read_cloud(const ParamSet& params, const Mat4& world_from_medium, const 
   return static_cast<int32_t>(ctx.scene.grids.size() - 1);
 }
 
+// pbrt-v4's RGBGridMedium: "sigma_a", "sigma_s" and "Le" as nx*ny*nz RGB
+// values at the voxel centres of p0..p1 (as uniformgrid), sigma_a and
+// sigma_s scaled by "scale" (either missing: 1), Le by "Lescale" (Le needs
+// sigma_a, as in pbrt-v4). The majorant cells bound the extinction of any
+// wavelength: an RGB's spectrum stays below twice its largest component.
+int32_t read_rgb_grid(const ParamSet& params, const Mat4& world_from_medium, Medium* m, const DirectiveContext& ctx) {
+  const int32_t nx = params.get_int("nx", 1), ny = params.get_int("ny", 1), nz = params.get_int("nz", 1);
+  if (nx < 1 || ny < 1 || nz < 1) ctx.fail("rgbgrid \"nx\", \"ny\" and \"nz\" must be positive");
+  const uint64_t n = static_cast<uint64_t>(nx) * static_cast<uint64_t>(ny) * static_cast<uint64_t>(nz);
+  const std::vector<Rgb> sigma_a = params.get_rgbs("sigma_a"), sigma_s = params.get_rgbs("sigma_s"),
+                         le = params.get_rgbs("Le");
+  if (sigma_a.empty() && sigma_s.empty()) ctx.fail("rgbgrid needs \"rgb sigma_a\" or \"rgb sigma_s\" values");
+  if (!le.empty() && sigma_a.empty()) ctx.fail("rgbgrid needs \"sigma_a\" where \"Le\" is given (as in pbrt-v4)");
+  const std::pair<const char*, const std::vector<Rgb>*> grids[3] = {{"sigma_a", &sigma_a}, {"sigma_s", &sigma_s}, {"Le", &le}};
+  for (const auto& [name, values] : grids) {
+    if (values->empty()) continue;
+    if (values->size() != n)
+      ctx.fail("rgbgrid has " + std::to_string(values->size()) + " \"" + name + "\" values; nx*ny*nz = " + std::to_string(n));
+    for (const Rgb& v : *values)
+      if (!valid_coefficient(v)) ctx.fail(std::string("rgbgrid \"") + name + "\" values must be finite and not negative");
+  }
+  const Vec3 p0 = params.get_point3("p0").value_or(Vec3(0.f));
+  const Vec3 p1 = params.get_point3("p1").value_or(Vec3(1.f));
+  if (!(p1.x > p0.x && p1.y > p0.y && p1.z > p0.z)) ctx.fail("rgbgrid needs p0 < p1 on every axis");
+  if (glm::determinant(world_from_medium) == 0.f) ctx.fail("the medium's transform is singular");
+  const Float scale = params.get_float("scale", 1.f), le_scale = params.get_float("Lescale", 1.f);
+  if (!(scale >= 0.f) || !std::isfinite(scale) || !(le_scale >= 0.f) || !std::isfinite(le_scale))
+    ctx.fail("rgbgrid \"scale\" and \"Lescale\" must be finite and not negative");
+  const Mat4 medium_from_world = glm::inverse(world_from_medium);
+  GridDesc g;
+  g.rgb = 1;
+  g.rgb_scale = scale;
+  g.rgb_le_scale = le_scale;
+  SparseGridDesc* targets[3] = {g.rgb_sigma_a, g.rgb_sigma_s, g.rgb_le};
+  std::vector<Float> channel(n), bound(n);
+  MajorantGridDesc bounds[2];
+  const Vec3 n3(static_cast<Float>(nx), static_cast<Float>(ny), static_cast<Float>(nz));
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<Rgb>& values = *grids[k].second;
+    if (values.empty()) continue;
+    for (int c = 0; c < 3; ++c) {
+      for (uint64_t i = 0; i < n; ++i) channel[i] = values[i][c];
+      targets[k][c] = sparse_grid_from_dense(channel, nx, ny, nz, p0, p1, medium_from_world);
+    }
+    if (k == 2) break;
+    for (uint64_t i = 0; i < n; ++i) bound[i] = 2.f * max_component(values[i]);
+    bounds[k] = build_majorant_grid(sparse_grid_from_dense(bound, nx, ny, nz, p0, p1, medium_from_world),
+                                    Vec3(-0.5f), n3 - 0.5f, 16);
+  }
+  // The lattice coordinates (voxel centres at the integers) without values.
+  g.density.lattice_from_world = targets[sigma_a.empty() ? 1 : 0][0].lattice_from_world;
+  g.majorants.lo = Vec3(-0.5f);
+  g.majorants.hi = n3 - 0.5f;
+  g.majorants.nx = g.majorants.ny = g.majorants.nz = 16;
+  g.majorants.max_density.assign(16 * 16 * 16, 0.f);
+  for (size_t i = 0; i < g.majorants.max_density.size(); ++i)
+    g.majorants.max_density[i] = scale * ((sigma_a.empty() ? 1.f : bounds[0].max_density[i]) +
+                                          (sigma_s.empty() ? 1.f : bounds[1].max_density[i]));
+  // The medium's own coefficients only say whether it scatters and glows.
+  Float max_a = sigma_a.empty() ? 1.f : 0.f, max_s = sigma_s.empty() ? 1.f : 0.f;
+  for (const Rgb& v : sigma_a) max_a = std::max(max_a, max_component(v));
+  for (const Rgb& v : sigma_s) max_s = std::max(max_s, max_component(v));
+  m->sigma_a = Rgb(scale * max_a);
+  m->sigma_s = Rgb(scale * max_s);
+  m->Le = Rgb(0.f);
+  m->grid_emits = !le.empty() && le_scale > 0.f;
+  ctx.scene.grids.push_back(std::move(g));
+  return static_cast<int32_t>(ctx.scene.grids.size() - 1);
+}
+
 // pbrt-v4's NanoVDBMedium: the float grids "density" (gridname) and,
 // optionally, "temperature" (temperaturename) of a .nvdb file, whose world
 // space is the medium's; the box is their worldBBox, with a 64^3 majorant grid.
@@ -236,15 +306,16 @@ bool medium_preset(const std::string& name, Rgb* sigma_a, Rgb* sigma_s) {
 
 std::optional<Medium> make_medium(const std::string& type, const ParamSet& params, const Mat4& world_from_medium,
                                   const DirectiveContext& ctx) {
-  if (type != "homogeneous" && type != "uniformgrid" && type != "nanovdb" && type != "cloud") {
-    if (type == "rgbgrid") {
-      ctx.warn("medium \"" + type + "\" is not simulated; shapes bounding it enclose vacuum");
-      params.mark_all_used();
-      return std::nullopt;
-    }
+  if (type != "homogeneous" && type != "uniformgrid" && type != "nanovdb" && type != "cloud" && type != "rgbgrid")
     ctx.fail("unknown medium type \"" + type + "\"");
-  }
   Medium m;
+  m.g = params.get_float("g", 0.f);
+  if (!std::isfinite(m.g)) ctx.fail("medium \"g\" must be finite");
+  m.g = std::clamp(m.g, -0.99f, 0.99f);  // pbrt-v4 clamps too: |g| = 1 is a delta
+  if (type == "rgbgrid") {
+    m.grid = read_rgb_grid(params, world_from_medium, &m, ctx);
+    return m;
+  }
   Rgb sigma_a(1.f), sigma_s(1.f);  // pbrt-v4's defaults
   bool preset_found = false;
   const std::string preset = params.get_string("preset", "");
@@ -269,9 +340,6 @@ std::optional<Medium> make_medium(const std::string& type, const ParamSet& param
   m.Le = params.get_rgb("Le").value_or(Rgb(0.f));
   if (type == "homogeneous") m.Le *= params.get_float("Lescale", 1.f);
   if (!valid_coefficient(m.Le)) ctx.fail("medium \"Le\" must be finite and not negative");
-  m.g = params.get_float("g", 0.f);
-  if (!std::isfinite(m.g)) ctx.fail("medium \"g\" must be finite");
-  m.g = std::clamp(m.g, -0.99f, 0.99f);  // pbrt-v4 clamps too: |g| = 1 is a delta
   if (type == "uniformgrid") m.grid = read_uniform_grid(params, world_from_medium, &m, ctx);
   if (type == "nanovdb") m.grid = read_nanovdb(params, world_from_medium, &m, ctx);
   if (type == "cloud") {

@@ -106,7 +106,8 @@ std::vector<Param> parse_param_list(TokenStream& tokens, size_t& pos) {
         fail(p.where, "\"" + decl.text + "\" needs wavelength/value pairs, got " + std::to_string(p.numbers.size()) +
                           " values");
     }
-    if ((p.type == "blackbody" || p.type == "rgb") && p.numbers.size() != static_cast<size_t>(width))
+    // (rgb arrays are pbrt-v4's rgbgrid voxels; get_rgb takes exactly one triple.)
+    if (p.type == "blackbody" && p.numbers.size() != static_cast<size_t>(width))
       fail(p.where, "\"" + decl.text + "\" takes exactly " + std::to_string(width) + " values");
     params.push_back(std::move(p));
   }
@@ -209,8 +210,10 @@ std::optional<Rgb> ParamSet::get_rgb(const std::string& name, bool allow_float) 
   const Param* p = allow_float ? find(name, {"rgb", "spectrum", "blackbody", "float"})
                                : find(name, {"rgb", "spectrum", "blackbody"});
   if (!p) return std::nullopt;
-  if (p->type == "rgb")
+  if (p->type == "rgb") {
+    if (p->numbers.size() != 3) fail(p->where, "\"rgb " + name + "\" takes exactly 3 values");
     return Rgb(static_cast<Float>(p->numbers[0]), static_cast<Float>(p->numbers[1]), static_cast<Float>(p->numbers[2]));
+  }
   if (p->type == "float") {
     if (p->numbers.empty()) fail(p->where, "\"float " + name + "\" has no value");
     return Rgb(static_cast<Float>(p->numbers[0]));
@@ -226,6 +229,16 @@ std::optional<Rgb> ParamSet::get_rgb(const std::string& name, bool allow_float) 
     warnings->push_back(p->where + ": \"spectrum " + name + "\" given as samples" +
                         (p->file.empty() ? std::string() : " (file '" + p->file + "')") + "; using an approximate RGB");
   return sampled_spectrum_rgb(pairs);
+}
+
+std::vector<Rgb> ParamSet::get_rgbs(const std::string& name) const {
+  std::vector<Rgb> out;
+  const Param* p = find(name, {"rgb"});
+  if (!p) return out;
+  for (size_t i = 0; i + 2 < p->numbers.size(); i += 3)
+    out.emplace_back(static_cast<Float>(p->numbers[i]), static_cast<Float>(p->numbers[i + 1]),
+                     static_cast<Float>(p->numbers[i + 2]));
+  return out;
 }
 
 std::optional<std::string> ParamSet::get_texture(const std::string& name) const {

@@ -44,6 +44,8 @@ class ParamSet {
   // "rgb", "spectrum" (named or sampled) or "blackbody" → linear RGB. A lone
   // "float" is accepted too (grey) where `allow_float`.
   std::optional<Rgb> get_rgb(const std::string& name, bool allow_float = false) const;
+  // Every triple of an "rgb" array (pbrt-v4's rgbgrid voxels).
+  std::vector<Rgb> get_rgbs(const std::string& name) const;
   // Name of a "texture" parameter, if given.
   std::optional<std::string> get_texture(const std::string& name) const;
   // The declaration of `name` whatever its type (marks it used).

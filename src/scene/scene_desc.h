@@ -66,6 +66,10 @@ struct GridDesc {
   // pbrt-v4's "cloud" (density.lattice_from_world is then medium_from_world, density.nx 0).
   int32_t cloud = 0;
   Float cloud_density = 1.f, cloud_wispiness = 1.f, cloud_frequency = 5.f;
+  // pbrt-v4's "rgbgrid": r, g, b lattices per quantity (nx 0: not given).
+  int32_t rgb = 0;
+  SparseGridDesc rgb_sigma_a[3], rgb_sigma_s[3], rgb_le[3];
+  Float rgb_scale = 1.f, rgb_le_scale = 1.f;
 };
 
 // "World" in a SceneDesc is pbrt-v4's render space: the scene's world

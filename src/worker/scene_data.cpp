@@ -18,7 +18,8 @@ namespace tessera {
 
 namespace {
 
-GridMediumView grid_medium_view(const GridDesc& g, const std::vector<Float>& blackbody_rgb) {
+GridMediumView grid_medium_view(const GridDesc& g, const std::vector<Float>& blackbody_rgb,
+                                const SpectralView* spectral) {
   GridMediumView v;
   v.density = sparse_grid_view(g.density);
   v.majorants = majorant_grid_view(g.majorants);
@@ -33,6 +34,15 @@ GridMediumView grid_medium_view(const GridDesc& g, const std::vector<Float>& bla
   v.cloud_density = g.cloud_density;
   v.cloud_wispiness = g.cloud_wispiness;
   v.cloud_frequency = g.cloud_frequency;
+  v.rgb = g.rgb;
+  for (int c = 0; c < 3; ++c) {
+    v.rgb_sigma_a.channel[c] = sparse_grid_view(g.rgb_sigma_a[c]);
+    v.rgb_sigma_s.channel[c] = sparse_grid_view(g.rgb_sigma_s[c]);
+    v.rgb_le.channel[c] = sparse_grid_view(g.rgb_le[c]);
+  }
+  v.rgb_scale = g.rgb_scale;
+  v.rgb_le_scale = g.rgb_le_scale;
+  v.spectral = spectral;
   return v;
 }
 
@@ -270,7 +280,9 @@ void SceneData::build_view() {
     v.camera_medium = desc_.camera_medium;
     for (const GridDesc& g : desc_.grids)
       if (g.temperature.nx > 0 && blackbody_rgb_table_.empty()) blackbody_rgb_table_ = build_blackbody_rgb_table();
-    for (const GridDesc& g : desc_.grids) grid_views_.push_back(grid_medium_view(g, blackbody_rgb_table_));
+    // (SceneData never moves: the views may point into view_.)
+    for (const GridDesc& g : desc_.grids)
+      grid_views_.push_back(grid_medium_view(g, blackbody_rgb_table_, desc_.spectral ? &v.spectral : nullptr));
     v.grids = grid_views_.data();
   }
   v.filter.inverse_cdf_x = filter_inverse_cdf_x_.data();
@@ -326,7 +338,9 @@ uint64_t SceneData::fingerprint() const {
     f.add(&desc_.camera_medium, sizeof desc_.camera_medium);
     for (const Light& l : lights_) f.add(&l.medium, sizeof l.medium);
     for (const GridDesc& g : desc_.grids) {
-      for (const SparseGridDesc* s : {&g.density, &g.le_scale, &g.temperature}) {
+      for (const SparseGridDesc* s : {&g.density, &g.le_scale, &g.temperature, &g.rgb_sigma_a[0], &g.rgb_sigma_a[1],
+                                      &g.rgb_sigma_a[2], &g.rgb_sigma_s[0], &g.rgb_sigma_s[1], &g.rgb_sigma_s[2],
+                                      &g.rgb_le[0], &g.rgb_le[1], &g.rgb_le[2]}) {
         f.add_vector(s->brick_of);
         f.add_vector(s->values);
         f.add(&s->lattice_from_world, sizeof s->lattice_from_world);
@@ -339,6 +353,8 @@ uint64_t SceneData::fingerprint() const {
       f.add(emission, sizeof emission);
       const Float cloud[4] = {static_cast<Float>(g.cloud), g.cloud_density, g.cloud_wispiness, g.cloud_frequency};
       f.add(cloud, sizeof cloud);
+      const Float rgb[3] = {static_cast<Float>(g.rgb), g.rgb_scale, g.rgb_le_scale};
+      f.add(rgb, sizeof rgb);
     }
   }
   return f.h;

@@ -166,6 +166,46 @@ TEST(GridMedia, NanoVdbMediaRenderAsTheirUniformGridEquivalents) {
   }
 }
 
+// The blob as an rgbgrid whose voxels are the density times the
+// coefficients (and an Le grid the density times Le) has, at every point,
+// the coefficients and emission of the uniformgrid blob with a per-voxel
+// Lescale grid of the density: both transports give the same image.
+TEST(GridMedia, RgbGridsRenderAsTheirUniformGridEquivalents) {
+  const Rgb sa(0.2f, 0.4f, 0.8f), ss(1.5f, 1.f, 0.6f), le(0.3f, 0.2f, 0.1f);
+  std::string voxels_a, voxels_s, voxels_le, lescale;
+  for (int z = 0; z < kN; ++z)
+    for (int y = 0; y < kN; ++y)
+      for (int x = 0; x < kN; ++x) {
+        const float b = blob(x, y, z);
+        auto rgb = [&](const Rgb& c) {
+          return std::to_string(b * c.x) + " " + std::to_string(b * c.y) + " " + std::to_string(b * c.z) + " ";
+        };
+        voxels_a += rgb(sa);
+        voxels_s += rgb(ss);
+        voxels_le += rgb(le);
+        lescale += std::to_string(b) + " ";
+      }
+  const std::string n = std::to_string(kN);
+  const std::string rgbgrid = "\"string type\" \"rgbgrid\" \"integer nx\" " + n + " \"integer ny\" " + n +
+                              " \"integer nz\" " + n + " \"point3 p0\" [ -1.5 -1.5 -1.5 ] \"point3 p1\" [ 1.5 1.5 1.5 ] "
+                              "\"rgb sigma_a\" [ " + voxels_a + "] \"rgb sigma_s\" [ " + voxels_s + "] \"rgb Le\" [ " +
+                              voxels_le + "] \"float scale\" 0.5 \"float Lescale\" 2 \"float g\" 0.3";
+  const std::string uniform = blob_uniformgrid() +
+                              " \"rgb sigma_a\" [ 0.1 0.2 0.4 ] \"rgb sigma_s\" [ 0.75 0.5 0.3 ] \"rgb Le\" [ 0.6 0.4 0.2 ] "
+                              "\"float Lescale\" [ " + lescale + "] \"float g\" 0.3";
+  for (bool spectral : {false, true}) {
+    SCOPED_TRACE(spectral ? "spectral transport" : "RGB transport");
+    auto run = [&](const std::string& medium) {
+      SceneDesc d = load_pbrt_string(blob_scene(medium, "", 256), "<t>", ".");
+      d.spectral = spectral;
+      return channel_stats(testing::render_desc(std::move(d), {}).film);
+    };
+    const ChannelStats u = run(uniform), r = run(rgbgrid);
+    testing::expect_precise(u, 0.01, "uniformgrid blob");
+    testing::expect_agree(u, r, "rgbgrid against uniformgrid");
+  }
+}
+
 // pbrt-v4's cloud in an albedo-1 furnace: 1 everywhere (its density is
 // bounded by 1, the one majorant cell).
 TEST(GridMedia, CloudFurnaceIsOne) {

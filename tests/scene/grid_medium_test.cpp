@@ -155,8 +155,8 @@ double lookups_per_ray(const TestGrid& t, const Medium& m) {
     if (!grid_clip(t.view, o, d, 100.f, &r)) continue;
     TentativeCollisions c = tentative_collisions(t.view, r, max_component(medium_sigma_t(m)));
     Rng track = tracking_rng(0.5f, o, d);
-    Float dens;
-    while (next_tentative_collision(t.view, c, track, dens)) ++lookups;
+    Vec3 q;
+    while (next_tentative_collision(t.view, c, track, q)) ++lookups;
   }
   return static_cast<double>(lookups) / rays;
 }
@@ -193,7 +193,7 @@ TEST(GridMedium, RatioTrackingThroughASparseGridEstimatesTheTransmittance) {
   ASSERT_GT(tau, 0.3);
   const int n = 100000;
   Rgb sum(0.f);
-  for (int i = 0; i < n; ++i) sum += grid_transmittance(m, t.view, o + Vec3(0.f, 0.f, 1e-7f * i), d, len);
+  for (int i = 0; i < n; ++i) sum += grid_transmittance(m, t.view, o + Vec3(0.f, 0.f, 1e-7f * i), d, len, nullptr);
   for (int k = 0; k < 3; ++k)
     EXPECT_NEAR(sum[k] / n, std::exp(-(m.sigma_a[k] + m.sigma_s[k]) * tau), 0.006) << k;
 }
@@ -216,7 +216,7 @@ TEST(GridMedium, RatioTrackingEstimatesTheTransmittance) {
   Rng rng = Rng::for_sample(3, 4, 5);
   for (int i = 0; i < n; ++i) {
     const Vec3 o(rng.uniform() - 0.5f, rng.uniform() - 0.5f, -1.f);
-    sum += grid_transmittance(m, c.view, o, Vec3(0.f, 0.f, 1.f), d);
+    sum += grid_transmittance(m, c.view, o, Vec3(0.f, 0.f, 1.f), d, nullptr);
   }
   const Rgb mean = sum / static_cast<Float>(n);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(mean[k], std::exp(-(m.sigma_a[k] + m.sigma_s[k]) * d), 0.004) << k;
@@ -254,7 +254,7 @@ TEST(GridMedium, RaysMissingTheBoxSeeNoMedium) {
   Medium m;
   m.sigma_s = Rgb(1.f);
   m.grid = 0;
-  EXPECT_EQ(grid_transmittance(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), 100.f), Rgb(1.f));
+  EXPECT_EQ(grid_transmittance(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), 100.f, nullptr), Rgb(1.f));
   const MediumSegment seg = sample_grid_segment(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), kInfinity, 0.3f, nullptr);
   EXPECT_FALSE(seg.scattered);
   EXPECT_EQ(seg.weight, Rgb(1.f));

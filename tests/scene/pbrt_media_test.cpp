@@ -3,6 +3,7 @@
 
 #include "scene/pbrt_loader.h"
 #include "scene/pbrt_media.h"
+#include "scene_test_helpers.h"
 
 namespace tessera {
 namespace {
@@ -71,7 +72,6 @@ MakeNamedMedium "smoke" "string type" "uniformgrid" "integer nx" 2 "integer ny" 
   "float density" [ 0.5 3 ] "point3 p0" [ -1 -1 -1 ] "point3 p1" [ 1 1 1 ] "rgb sigma_s" [ 2 2 2 ]
 AttributeEnd
 MediumInterface "smoke" ""
-MakeNamedMedium "wisps" "string type" "rgbgrid"
 )" + std::string(kTriangle), "<t>", ".");
   ASSERT_EQ(d.media.size(), 1u);
   ASSERT_EQ(d.grids.size(), 1u);
@@ -94,9 +94,34 @@ MakeNamedMedium "wisps" "string type" "rgbgrid"
   EXPECT_EQ(g.majorants.lo, Vec3(-0.5f));
   EXPECT_EQ(g.majorants.hi, Vec3(1.5f, 0.5f, 0.5f));
   EXPECT_EQ(d.meshes[0].media.inside, 0);
-  bool warned = false;
-  for (const std::string& w : d.warnings) warned |= w.find("rgbgrid") != std::string::npos;
-  EXPECT_TRUE(warned);  // rgbgrid media are not simulated
+}
+
+TEST(PbrtMedia, RgbGridReadsItsVoxelsAndBoundsEveryWavelength) {
+  SceneDesc d = load_pbrt_string(R"(
+LookAt 0 0 -5  0 0 0  0 1 0
+Camera "perspective"
+WorldBegin
+MakeNamedMedium "smoke" "string type" "rgbgrid" "integer nx" 2 "float scale" 3
+  "rgb sigma_a" [ 0.1 0.2 0.3  1 0 0 ] "rgb Le" [ 0 0 0  5 4 3 ] "float Lescale" 2
+MediumInterface "smoke" ""
+)" + std::string(kTriangle), "<t>", ".");
+  ASSERT_EQ(d.grids.size(), 1u);
+  const GridDesc& g = d.grids[0];
+  EXPECT_EQ(g.rgb, 1);
+  EXPECT_EQ(g.rgb_scale, 3.f);
+  EXPECT_EQ(g.rgb_le_scale, 2.f);
+  EXPECT_EQ(lattice_value(sparse_grid_view(g.rgb_sigma_a[1]), 0, 0, 0), 0.2f);
+  EXPECT_EQ(lattice_value(sparse_grid_view(g.rgb_le[0]), 1, 0, 0), 5.f);
+  EXPECT_EQ(g.rgb_sigma_s[0].nx, 0);  // not given: 1 everywhere
+  // Every cell bounds scale * (2 max(sigma_a) + 1): here 3 * (2 * 1 + 1) where the red voxel reaches.
+  Float most = 0.f;
+  for (Float c : g.majorants.max_density) most = std::max(most, c);
+  EXPECT_FLOAT_EQ(most, 9.f);
+  EXPECT_EQ(d.media[0].grid_emits, 1);
+  const std::string e = test::load_error("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"rgbgrid\" \"integer nx\" 2 "
+                                         "\"rgb sigma_s\" [ 1 1 1 ]\n");
+  EXPECT_NE(e.find("bad.pbrt:2"), std::string::npos) << e;
+  EXPECT_NE(e.find("nx*ny*nz = 2"), std::string::npos) << e;
 }
 
 TEST(PbrtMedia, AMediumMayBeDefinedAfterItsUseAsInPbrtV4) {
