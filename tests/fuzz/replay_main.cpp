@@ -1,6 +1,8 @@
-// Runs files through the fuzz target once each (the shipped scenes, the test
-// scenes and tests/fuzz/corpus, where inputs that once broke the loader are
-// kept): the suite's check that none crashes, built without libFuzzer.
+// Runs files through a fuzz target once each (for the scene loader: the
+// shipped scenes, the test scenes and tests/fuzz/corpus, where inputs that
+// once broke the loader are kept; for the NanoVDB reader:
+// tests/fuzz/nvdb_corpus): the suite's check that none crashes, built
+// without libFuzzer.
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -22,6 +24,6 @@ int main(int argc, char** argv) {
     LLVMFuzzerTestOneInput(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
     ++files;
   }
-  std::printf("%d inputs replayed through the scene loader\n", files);
+  std::printf("%d inputs replayed\n", files);
   return files > 0 ? 0 : 1;
 }

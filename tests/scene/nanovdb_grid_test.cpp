@@ -59,6 +59,18 @@ TEST(NanoVdb, LatticeLookupsEqualNanoVdbsTrilinearSamples) {
   }
 }
 
+// The fuzz seeds: density and temperature, zlib- and Blosc-compressed, as
+// NanoVDB's writer makes them.
+TEST(NanoVdb, ReadsZipAndBloscCompressedFiles) {
+  for (const char* name : {"fire-zip.nvdb", "fire-blosc.nvdb"}) {
+    const std::string path = std::string(TESSERA_SOURCE_DIR) + "/tests/fuzz/nvdb_corpus/" + name;
+    const NanoVdbGrid d = read_nanovdb_grid(path, "density"), t = read_nanovdb_grid(path, "temperature");
+    ASSERT_TRUE(d.found && t.found) << name;
+    EXPECT_FLOAT_EQ(d.lattice.max_value, 1.5f) << name;  // 1 + 0.1 x at x = 5, the blob's largest x
+    EXPECT_FLOAT_EQ(t.lattice.max_value, 800.f + 50.f * 9.f) << name;
+  }
+}
+
 TEST(NanoVdb, MissingGridsAreNotFoundAndBadFilesAreRefused) {
   TempDir dir;
   const std::string path = dir.file("blob.nvdb");
