@@ -16,7 +16,7 @@ void serialize(Archive& ar, ImageDesc& i) {
 template <class Archive>
 void serialize(Archive& ar, SparseGridDesc& g) {
   ar(raw_value(g.lattice_from_world), g.nx, g.ny, g.nz, g.bx, g.by, g.bz, raw(g.brick_of), raw(g.values), g.max_value,
-     g.min_value);
+     g.background);
 }
 template <class Archive>
 void serialize(Archive& ar, MajorantGridDesc& m) {

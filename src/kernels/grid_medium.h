@@ -27,7 +27,6 @@ namespace tessera {
 struct GridMediumView {
   SparseGridView density;
   MajorantGridView majorants;  // over the medium's box, in density lattice coordinates
-  Float max_density = 0.f;
   // Emission per unit absorption, as pbrt-v4's GridMedium and NanoVDBMedium
   // give it: le_scale(p) times Medium::Le, or, with a temperature grid,
   // le_scale(p) * blackbody_scale * B(T) / B(peak) for T = (temperature(p) -

@@ -24,15 +24,12 @@ TESSERA_HOST_DEVICE inline Rgb rgb_grid_value(const RgbGridView& v, const Vec3& 
   if (!wl || !spectral)
     return Rgb(lattice_trilinear(v.channel[0], q), lattice_trilinear(v.channel[1], q),
                lattice_trilinear(v.channel[2], q));
-  const SparseGridView& g = v.channel[0];
-  if (!(q.x > -1.f && q.y > -1.f && q.z > -1.f && q.x < g.nx && q.y < g.ny && q.z < g.nz)) return Rgb(0.f);
-  const int32_t ix = static_cast<int32_t>(glm::floor(q.x)), iy = static_cast<int32_t>(glm::floor(q.y)),
-                iz = static_cast<int32_t>(glm::floor(q.z));
-  const Float dx = q.x - ix, dy = q.y - iy, dz = q.z - iz;
+  LatticeCell cell;
+  if (!lattice_cell(v.channel[0], q, &cell)) return Rgb(0.f);
   Rgb sum(0.f);
-  for (int c = 0; c < 8; ++c) {
-    const int32_t x = ix + (c & 1), y = iy + ((c >> 1) & 1), z = iz + (c >> 2);
-    const Float w = ((c & 1) ? dx : 1.f - dx) * (((c >> 1) & 1) ? dy : 1.f - dy) * ((c >> 2) ? dz : 1.f - dz);
+  for (int k = 0; k < 8; ++k) {
+    int32_t x, y, z;
+    const Float w = lattice_corner(cell, k, &x, &y, &z);
     if (!(w > 0.f)) continue;
     const Rgb rgb(lattice_value(v.channel[0], x, y, z), lattice_value(v.channel[1], x, y, z),
                   lattice_value(v.channel[2], x, y, z));

@@ -98,13 +98,24 @@ TESSERA_HOST_DEVICE inline Float sample_table(const Float* t, int32_t stride, Fl
   return (1.f - f) * t[i * stride] + f * t[(i + 1) * stride];
 }
 
-// Planck's law relative to its peak, B(lambda, T) / B(lambda_max, T).
+// Planck's law relative to its peak, B(lambda, T) / B(lambda_max, T), in
+// float for the kernels or double for tables (below 1000 K the visible
+// values are far under float's range). 0 for T beyond 1e30 K, where
+// lambda T would overflow float (the visible values are ~0 there anyway).
+TESSERA_HOST_DEVICE inline float exp_minus_one(float x) { return expm1f(x); }
+TESSERA_HOST_DEVICE inline double exp_minus_one(double x) { return ::expm1(x); }
+
+template <class T>
+TESSERA_HOST_DEVICE inline T planck_over_peak(T lambda_nm, T kelvin) {
+  if (!(kelvin > T(0)) || !(lambda_nm > T(0)) || !(kelvin < T(1e30))) return T(0);
+  const T c2 = T(1.4387769e7);  // h c / k_B in nm K
+  const T peak = T(2.8977721e6) / kelvin;  // Wien's displacement law, nm
+  const T r = peak / lambda_nm;
+  return (r * r) * (r * r) * r * exp_minus_one(c2 / (peak * kelvin)) / exp_minus_one(c2 / (lambda_nm * kelvin));
+}
+
 TESSERA_HOST_DEVICE inline Float blackbody_relative(Float lambda_nm, Float kelvin) {
-  if (!(kelvin > 0.f) || !(lambda_nm > 0.f)) return 0.f;
-  constexpr Float c2 = 1.4387769e7f;  // h c / k_B in nm K
-  const Float peak = 2.8977721e6f / kelvin;  // Wien's displacement law, nm
-  const Float r = peak / lambda_nm;
-  return (r * r) * (r * r) * r * expm1f(c2 / (peak * kelvin)) / expm1f(c2 / (lambda_nm * kelvin));
+  return planck_over_peak<Float>(lambda_nm, kelvin);
 }
 
 TESSERA_HOST_DEVICE inline Float sigmoid(Float x) {

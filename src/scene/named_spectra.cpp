@@ -5,6 +5,7 @@
 #include <map>
 
 #include "kernels/blackbody_table.h"
+#include "kernels/spectral.h"
 #include "scene/cie_tables.h"
 #include "scene/rgb_spectrum_fit.h"
 
@@ -121,12 +122,7 @@ std::vector<Float> build_blackbody_rgb_table() {
   std::vector<Float> t(4 * kBlackbodyTableSize);
   for (int32_t i = 0; i < kBlackbodyTableSize; ++i) {
     const double kelvin = blackbody_table_kelvin(i);
-    // Planck's law over its peak (Wien), in double: below 1000 K it is far under float's range.
-    constexpr double c2 = 1.4387769e7;  // h c / k_B in nm K
-    const double peak = 2.8977721e6 / kelvin;
-    const std::array<double, 3> rgb = emission_spectrum_rgb([&](double l) {
-      return std::pow(peak / l, 5) * std::expm1(c2 / (peak * kelvin)) / std::expm1(c2 / (l * kelvin));
-    });
+    const std::array<double, 3> rgb = emission_spectrum_rgb([&](double l) { return planck_over_peak(l, kelvin); });
     // Luminance as the film has it; colours outside sRGB (deep red, at low T) clamp at 0 as blackbody_rgb's do.
     const double y = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
     Float* e = t.data() + 4 * i;

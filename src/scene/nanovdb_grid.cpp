@@ -167,7 +167,7 @@ bool layout_fits(const nanovdb::GridHandle<nanovdb::HostBuffer>& handle) {
 
 }  // namespace
 
-NanoVdbGrid read_nanovdb_grid(const std::string& path, const std::string& name) {
+NanoVdbGrid read_nanovdb_grid(const std::string& path, const std::string& name, bool density) {
   NanoVdbGrid out;
   nanovdb::GridHandle<nanovdb::HostBuffer> handle;
   try {
@@ -191,13 +191,23 @@ NanoVdbGrid read_nanovdb_grid(const std::string& path, const std::string& name) 
   if (!layout_fits(handle))
     throw std::runtime_error(path + ": grid \"" + name + "\" is damaged (its nodes lie outside the data read)");
 
+  // A density is finite and not negative, with no density outside the grid;
+  // a temperature only finite (its background is what lies outside).
   const FloatTree& tree = grid->tree();
-  if (tree.root().background() != 0.f)
-    throw std::runtime_error(path + ": grid \"" + name + "\" has a non-zero background value");
+  const float background = tree.root().background();
+  auto check = [&](float v) {
+    if (!std::isfinite(v) || (density && v < 0.f))
+      throw std::runtime_error(path + ": grid \"" + name + "\" holds a " + (density ? "negative or " : "") +
+                               "non-finite value");
+  };
+  check(background);
+  if (density && background != 0.f)
+    throw std::runtime_error(path + ": grid \"" + name + "\" has a non-zero background density");
   for (auto it = tree.root().beginValue(); it; ++it)
-    if (*it != 0.f) throw std::runtime_error(path + ": grid \"" + name + "\" has a non-zero root tile (4096^3 voxels)");
+    if (*it != background)
+      throw std::runtime_error(path + ": grid \"" + name + "\" has a root tile (4096^3 voxels) unlike its background");
 
-  // Leaves, and the internal nodes' constant tiles that are not zero.
+  // Leaves, and the internal nodes' constant tiles unlike the background.
   std::vector<Tile> tiles;
   const uint32_t uppers = tree.nodeCount(2), lowers = tree.nodeCount(1), leaves = tree.nodeCount(0);
   auto node_tiles = [&](const auto* node, int32_t child_dim) {
@@ -205,7 +215,7 @@ NanoVdbGrid read_nanovdb_grid(const std::string& path, const std::string& name) 
     for (uint32_t n = 0; n < Node::SIZE; ++n) {
       if (node->childMask().isOn(n)) continue;
       const float v = node->data()->getValue(n);
-      if (v != 0.f) tiles.push_back({node->offsetToGlobalCoord(n), child_dim, v});
+      if (v != background) tiles.push_back({node->offsetToGlobalCoord(n), child_dim, v});
     }
   };
   for (uint32_t i = 0; i < uppers; ++i) node_tiles(tree.getFirstUpper() + i, static_cast<int32_t>(Lower::DIM));
@@ -231,8 +241,9 @@ NanoVdbGrid read_nanovdb_grid(const std::string& path, const std::string& name) 
     for (int a = 0; a < 3; ++a) {
       shift[a] = static_cast<int64_t>(std::floor(lo[a] / static_cast<double>(kBrickSide))) * kBrickSide;
       n[a] = hi[a] - shift[a] + 1;
-      if (n[a] > (int64_t{1} << 30))
-        throw std::runtime_error(path + ": grid \"" + name + "\" spans more than 2^30 voxels along an axis");
+      // Lattice coordinates are float in the kernels: exact integers up to 2^24.
+      if (n[a] > (int64_t{1} << 24))
+        throw std::runtime_error(path + ": grid \"" + name + "\" spans more than 2^24 voxels along an axis");
     }
   }
   // The brick index has an entry per 8^3 voxels of the box around the
@@ -243,28 +254,28 @@ NanoVdbGrid read_nanovdb_grid(const std::string& path, const std::string& name) 
                              std::to_string(n[1]) + " x " + std::to_string(n[2]) +
                              " voxels; at most 4096^3 voxels' worth are supported");
 
-  SparseGridBuilder b(static_cast<int32_t>(n[0]), static_cast<int32_t>(n[1]), static_cast<int32_t>(n[2]));
-  auto put = [&](int64_t x, int64_t y, int64_t z, float v) {
-    b.set(static_cast<int32_t>(x - shift[0]), static_cast<int32_t>(y - shift[1]), static_cast<int32_t>(z - shift[2]), v);
-  };
-  for (const Tile& t : tiles)
-    for (int32_t z = 0; z < t.dim; ++z)
-      for (int32_t y = 0; y < t.dim; ++y)
-        for (int32_t x = 0; x < t.dim; ++x) put(t.origin[0] + x, t.origin[1] + y, t.origin[2] + z, t.value);
+  SparseGridBuilder b(static_cast<int32_t>(n[0]), static_cast<int32_t>(n[1]), static_cast<int32_t>(n[2]), background);
+  // Tiles (aligned to their 8^3 or 128^3 size, so to bricks) share one brick per value.
+  for (const Tile& t : tiles) {
+    check(t.value);
+    const int32_t bricks_per_side = t.dim / kBrickSide;
+    int32_t first[3];
+    for (int a = 0; a < 3; ++a) first[a] = static_cast<int32_t>((t.origin[a] - shift[a]) / kBrickSide);
+    for (int32_t z = 0; z < bricks_per_side; ++z)
+      for (int32_t y = 0; y < bricks_per_side; ++y)
+        for (int32_t x = 0; x < bricks_per_side; ++x) b.fill_brick(first[0] + x, first[1] + y, first[2] + z, t.value);
+  }
   for (uint32_t i = 0; i < leaves; ++i) {
     const Leaf* leaf = first_leaf + i;
     const nanovdb::Coord o = leaf->origin();
     for (uint32_t k = 0; k < Leaf::voxelCount(); ++k) {
       const float v = leaf->getValue(k);
-      if (!std::isfinite(v) || v < 0.f)
-        throw std::runtime_error(path + ": grid \"" + name + "\" holds a negative or non-finite value");
+      check(v);
       const nanovdb::Coord c = Leaf::OffsetToLocalCoord(k);
-      put(int64_t{o[0]} + c[0], int64_t{o[1]} + c[1], int64_t{o[2]} + c[2], v);
+      b.set(static_cast<int32_t>(o[0] + c[0] - shift[0]), static_cast<int32_t>(o[1] + c[1] - shift[1]),
+            static_cast<int32_t>(o[2] + c[2] - shift[2]), v);
     }
   }
-  for (const Tile& t : tiles)
-    if (!std::isfinite(t.value) || t.value < 0.f)
-      throw std::runtime_error(path + ": grid \"" + name + "\" holds a negative or non-finite value");
 
   // world -> index is affine (NanoVDB's map): read it off at the origin and the unit vectors.
   const nanovdb::Vec3d i0 = grid->worldToIndex(nanovdb::Vec3d(0.0, 0.0, 0.0));
@@ -284,8 +295,12 @@ NanoVdbGrid read_nanovdb_grid(const std::string& path, const std::string& name) 
   const auto& wb = grid->worldBBox();
   out.world_lo = Vec3(static_cast<Float>(wb.min()[0]), static_cast<Float>(wb.min()[1]), static_cast<Float>(wb.min()[2]));
   out.world_hi = Vec3(static_cast<Float>(wb.max()[0]), static_cast<Float>(wb.max()[1]), static_cast<Float>(wb.max()[2]));
-  if (!is_finite(out.world_lo) || !is_finite(out.world_hi))
-    throw std::runtime_error(path + ": grid \"" + name + "\" has a non-finite bounding box");
+  if (!is_finite(out.world_lo) || !is_finite(out.world_hi)) {
+    // NanoVDB's bounding box of a grid with no active voxel is empty (+-DBL_MAX).
+    if (leaves > 0 || !tiles.empty())
+      throw std::runtime_error(path + ": grid \"" + name + "\" has a non-finite bounding box");
+    out.world_lo = out.world_hi = Vec3(0.f);
+  }
   out.found = true;
   return out;
 }

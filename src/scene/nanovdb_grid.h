@@ -21,8 +21,11 @@ struct NanoVdbGrid {
 };
 
 // The float grid `name` of `path`; found == false when the file has no grid
-// of that name. Throws std::runtime_error for an unreadable file, a corrupt
-// grid, or a grid that is not a float fog volume (as pbrt-v4 requires).
-NanoVdbGrid read_nanovdb_grid(const std::string& path, const std::string& name);
+// of that name. A density must be finite and not negative, with a zero
+// background; other grids (temperature) only finite, their background kept.
+// Throws std::runtime_error for an unreadable file, a corrupt grid, or a
+// grid that is not a float fog volume (as pbrt-v4 requires); world_lo ==
+// world_hi for a grid with no active voxel.
+NanoVdbGrid read_nanovdb_grid(const std::string& path, const std::string& name, bool density);
 
 }  // namespace tessera

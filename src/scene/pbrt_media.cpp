@@ -74,6 +74,28 @@ bool valid_coefficient(const Rgb& c) {
   return true;
 }
 
+// The inverse of the CTM at MakeNamedMedium (pbrt-v4's medium space).
+Mat4 medium_from_world_of(const Mat4& world_from_medium, const DirectiveContext& ctx) {
+  if (glm::determinant(world_from_medium) == 0.f) ctx.fail("the medium's transform is singular");
+  return glm::inverse(world_from_medium);
+}
+
+// "p0" and "p1" (pbrt-v4's defaults 0 0 0 and 1 1 1), p0 below p1.
+void read_box(const ParamSet& params, const std::string& type, const DirectiveContext& ctx, Vec3* p0, Vec3* p1) {
+  *p0 = params.get_point3("p0").value_or(Vec3(0.f));
+  *p1 = params.get_point3("p1").value_or(Vec3(1.f));
+  if (!(p1->x > p0->x && p1->y > p0->y && p1->z > p0->z)) ctx.fail(type + " needs p0 < p1 on every axis");
+}
+
+// "temperatureoffset" (or its older name "temperaturecutoff") and "temperaturescale".
+void read_temperature_mapping(const ParamSet& params, const std::string& type, GridDesc* g,
+                              const DirectiveContext& ctx) {
+  g->temperature_offset = params.get_float("temperatureoffset", params.get_float("temperaturecutoff", 0.f));
+  g->temperature_scale = params.get_float("temperaturescale", 1.f);
+  if (!std::isfinite(g->temperature_offset) || !std::isfinite(g->temperature_scale))
+    ctx.fail(type + " \"temperatureoffset\" and \"temperaturescale\" must be finite");
+}
+
 // pbrt-v4's GridMedium emission: an "Lescale" grid (nx * ny * nz values, or
 // one; pbrt-v4's default is a 1x1x1 grid of 1, which, read like any grid
 // with zeros beyond its one voxel centre, fades Le to 1/2 at the box's faces
@@ -90,10 +112,7 @@ void read_grid_emission(const ParamSet& params, const Mat4& medium_from_world, c
     for (Float t : temperature)
       if (!std::isfinite(t)) ctx.fail("uniformgrid temperatures must be finite");
     g->temperature = sparse_grid_from_dense(temperature, nx, ny, nz, p0, p1, medium_from_world);
-    g->temperature_offset = params.get_float("temperatureoffset", params.get_float("temperaturecutoff", 0.f));
-    g->temperature_scale = params.get_float("temperaturescale", 1.f);
-    if (!std::isfinite(g->temperature_offset) || !std::isfinite(g->temperature_scale))
-      ctx.fail("uniformgrid \"temperatureoffset\" and \"temperaturescale\" must be finite");
+    read_temperature_mapping(params, "uniformgrid", g, ctx);
     m->grid_emits = 1;
   }
   if (!m->grid_emits && is_black(m->Le)) {
@@ -128,11 +147,9 @@ int32_t read_uniform_grid(const ParamSet& params, const Mat4& world_from_medium,
     ctx.fail("uniformgrid has " + std::to_string(density.size()) + " density values; nx*ny*nz = " + std::to_string(n));
   for (Float d : density)
     if (!(d >= 0.f) || !std::isfinite(d)) ctx.fail("uniformgrid densities must be finite and not negative");
-  const Vec3 p0 = params.get_point3("p0").value_or(Vec3(0.f));
-  const Vec3 p1 = params.get_point3("p1").value_or(Vec3(1.f));
-  if (!(p1.x > p0.x && p1.y > p0.y && p1.z > p0.z)) ctx.fail("uniformgrid needs p0 < p1 on every axis");
-  if (glm::determinant(world_from_medium) == 0.f) ctx.fail("the medium's transform is singular");
-  const Mat4 medium_from_world = glm::inverse(world_from_medium);
+  Vec3 p0, p1;
+  read_box(params, "uniformgrid", ctx, &p0, &p1);
+  const Mat4 medium_from_world = medium_from_world_of(world_from_medium, ctx);
   GridDesc g;
   g.density = sparse_grid_from_dense(density, nx, ny, nz, p0, p1, medium_from_world);
   // The box p0..p1 in lattice coordinates: voxel centres are the integers.
@@ -154,11 +171,9 @@ int32_t read_cloud(const ParamSet& params, const Mat4& world_from_medium, const 
   if (!(g.cloud_density >= 0.f) || !std::isfinite(g.cloud_density) || !std::isfinite(g.cloud_wispiness) ||
       !std::isfinite(g.cloud_frequency))
     ctx.fail("cloud \"density\" must be finite and not negative, \"wispiness\" and \"frequency\" finite");
-  const Vec3 p0 = params.get_point3("p0").value_or(Vec3(0.f));
-  const Vec3 p1 = params.get_point3("p1").value_or(Vec3(1.f));
-  if (!(p1.x > p0.x && p1.y > p0.y && p1.z > p0.z)) ctx.fail("cloud needs p0 < p1 on every axis");
-  if (glm::determinant(world_from_medium) == 0.f) ctx.fail("the medium's transform is singular");
-  g.density.lattice_from_world = glm::inverse(world_from_medium);
+  Vec3 p0, p1;
+  read_box(params, "cloud", ctx, &p0, &p1);
+  g.density.lattice_from_world = medium_from_world_of(world_from_medium, ctx);
   g.majorants.lo = p0;
   g.majorants.hi = p1;
   g.majorants.max_density = {1.f};
@@ -187,14 +202,12 @@ int32_t read_rgb_grid(const ParamSet& params, const Mat4& world_from_medium, Med
     for (const Rgb& v : *values)
       if (!valid_coefficient(v)) ctx.fail(std::string("rgbgrid \"") + name + "\" values must be finite and not negative");
   }
-  const Vec3 p0 = params.get_point3("p0").value_or(Vec3(0.f));
-  const Vec3 p1 = params.get_point3("p1").value_or(Vec3(1.f));
-  if (!(p1.x > p0.x && p1.y > p0.y && p1.z > p0.z)) ctx.fail("rgbgrid needs p0 < p1 on every axis");
-  if (glm::determinant(world_from_medium) == 0.f) ctx.fail("the medium's transform is singular");
+  Vec3 p0, p1;
+  read_box(params, "rgbgrid", ctx, &p0, &p1);
   const Float scale = params.get_float("scale", 1.f), le_scale = params.get_float("Lescale", 1.f);
   if (!(scale >= 0.f) || !std::isfinite(scale) || !(le_scale >= 0.f) || !std::isfinite(le_scale))
     ctx.fail("rgbgrid \"scale\" and \"Lescale\" must be finite and not negative");
-  const Mat4 medium_from_world = glm::inverse(world_from_medium);
+  const Mat4 medium_from_world = medium_from_world_of(world_from_medium, ctx);
   GridDesc g;
   g.rgb = 1;
   g.rgb_scale = scale;
@@ -245,15 +258,19 @@ int32_t read_nanovdb(const ParamSet& params, const Mat4& world_from_medium, Medi
   const std::string path = resolve_scene_path(filename, ctx.including_dir, ctx.search_dir);
   const std::string density_name = params.get_string("gridname", "density");
   const std::string temperature_name = params.get_string("temperaturename", "temperature");
-  if (glm::determinant(world_from_medium) == 0.f) ctx.fail("the medium's transform is singular");
-  const Mat4 medium_from_world = glm::inverse(world_from_medium);
+  const Mat4 medium_from_world = medium_from_world_of(world_from_medium, ctx);
+  const Float le_scale = params.get_float("Lescale", 1.f);
+  if (!(le_scale >= 0.f) || !std::isfinite(le_scale)) ctx.fail("nanovdb \"Lescale\" must be finite and not negative");
   NanoVdbGrid density, temperature;
   try {
-    density = read_nanovdb_grid(path, density_name);
+    density = read_nanovdb_grid(path, density_name, true);
     if (!density.found) ctx.fail(path + ": no grid named \"" + density_name + "\"");
-    temperature = read_nanovdb_grid(path, temperature_name);
+    // (As in pbrt-v4, a medium whose Lescale is 0 does not glow; its temperatures are not read.)
+    if (le_scale > 0.f) temperature = read_nanovdb_grid(path, temperature_name, false);
   } catch (const std::runtime_error& e) {
     ctx.fail(e.what());
+  } catch (const std::bad_alloc&) {
+    ctx.fail(path + ": its grids do not fit in memory");
   }
   GridDesc g;
   Vec3 world_lo = density.world_lo, world_hi = density.world_hi;
@@ -270,23 +287,20 @@ int32_t read_nanovdb(const ParamSet& params, const Mat4& world_from_medium, Medi
     lo = glm::min(lo, q);
     hi = glm::max(hi, q);
   }
-  if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) ctx.fail(path + ": grid \"" + density_name + "\" is empty");
   g.density = std::move(density.lattice);
   g.density.lattice_from_world = g.density.lattice_from_world * medium_from_world;
-  g.majorants = build_majorant_grid(g.density, lo, hi, 64);
-  const Float le_scale = params.get_float("Lescale", 1.f);
-  if (!(le_scale >= 0.f) || !std::isfinite(le_scale)) ctx.fail("nanovdb \"Lescale\" must be finite and not negative");
-  g.temperature_offset = params.get_float("temperatureoffset", params.get_float("temperaturecutoff", 0.f));
-  g.temperature_scale = params.get_float("temperaturescale", 1.f);
-  if (!std::isfinite(g.temperature_offset) || !std::isfinite(g.temperature_scale))
-    ctx.fail("nanovdb \"temperatureoffset\" and \"temperaturescale\" must be finite");
+  if (hi.x > lo.x && hi.y > lo.y && hi.z > lo.z) {
+    g.majorants = build_majorant_grid(g.density, lo, hi, 64);
+  } else {
+    g.majorants.max_density = {0.f};  // an empty grid: no collision anywhere
+  }
+  read_temperature_mapping(params, "nanovdb", &g, ctx);
   if (temperature.found && le_scale > 0.f) {
     g.temperature = std::move(temperature.lattice);
     g.temperature.lattice_from_world = g.temperature.lattice_from_world * medium_from_world;
     g.blackbody_scale = le_scale;
     m->grid_emits = 1;
   }
-  m->Le = Rgb(0.f);  // pbrt-v4's nanovdb medium glows only by temperature
   ctx.scene.grids.push_back(std::move(g));
   return static_cast<int32_t>(ctx.scene.grids.size() - 1);
 }
@@ -318,7 +332,10 @@ std::optional<Medium> make_medium(const std::string& type, const ParamSet& param
   }
   Rgb sigma_a(1.f), sigma_s(1.f);  // pbrt-v4's defaults
   bool preset_found = false;
-  const std::string preset = params.get_string("preset", "");
+  // pbrt-v4 reads "preset" for homogeneous media only, "Le" for homogeneous
+  // and uniformgrid, and has no "scale" for clouds: elsewhere they are
+  // unused parameters (warned).
+  const std::string preset = type == "homogeneous" ? params.get_string("preset", "") : "";
   if (!preset.empty()) {
     preset_found = medium_preset(preset, &sigma_a, &sigma_s);
     if (!preset_found) ctx.warn("medium preset \"" + preset + "\" not found (as in pbrt-v4, sigma_a/sigma_s are used)");
@@ -330,22 +347,19 @@ std::optional<Medium> make_medium(const std::string& type, const ParamSet& param
     params.find_any("sigma_a");
     params.find_any("sigma_s");
   }
-  const Float scale = params.get_float("scale", 1.f);
+  const Float scale = type == "cloud" ? 1.f : params.get_float("scale", 1.f);
   if (!(scale >= 0.f) || !std::isfinite(scale)) ctx.fail("medium \"scale\" must be finite and not negative");
   m.sigma_a = sigma_a * scale;
   m.sigma_s = sigma_s * scale;
   if (!valid_coefficient(m.sigma_a) || !valid_coefficient(m.sigma_s))
     ctx.fail("medium sigma_a and sigma_s must be finite and not negative");
-  // A homogeneous medium's one "Lescale" scales Le (grid media read theirs as a grid).
-  m.Le = params.get_rgb("Le").value_or(Rgb(0.f));
+  // A homogeneous medium's one "Lescale" scales Le (uniformgrid reads its as a grid).
+  if (type == "homogeneous" || type == "uniformgrid") m.Le = params.get_rgb("Le").value_or(Rgb(0.f));
   if (type == "homogeneous") m.Le *= params.get_float("Lescale", 1.f);
   if (!valid_coefficient(m.Le)) ctx.fail("medium \"Le\" must be finite and not negative");
   if (type == "uniformgrid") m.grid = read_uniform_grid(params, world_from_medium, &m, ctx);
   if (type == "nanovdb") m.grid = read_nanovdb(params, world_from_medium, &m, ctx);
-  if (type == "cloud") {
-    m.grid = read_cloud(params, world_from_medium, ctx);
-    m.Le = Rgb(0.f);  // pbrt-v4's cloud does not glow
-  }
+  if (type == "cloud") m.grid = read_cloud(params, world_from_medium, ctx);
   return m;
 }
 

@@ -153,7 +153,7 @@ struct SceneDesc {
   std::vector<AreaLightDesc> area_lights;
   std::vector<Light> lights;        // point, spot, distant, infinite (area lights come from meshes)
   std::vector<Medium> media;        // MakeNamedMedium, in order of definition
-  std::vector<GridDesc> grids;      // of the uniformgrid media
+  std::vector<GridDesc> grids;      // of the grid media (uniformgrid, rgbgrid, nanovdb, cloud)
   int32_t camera_medium = -1;       // the medium the camera sits in (pbrt-v4: the outside medium at Camera)
   std::vector<std::string> warnings;  // "file:line: message", in order of appearance
   std::string source;               // file name, or "<builtin:cornell-box>"

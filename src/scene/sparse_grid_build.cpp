@@ -5,7 +5,9 @@
 
 namespace tessera {
 
-SparseGridBuilder::SparseGridBuilder(int32_t nx, int32_t ny, int32_t nz) {
+SparseGridBuilder::SparseGridBuilder(int32_t nx, int32_t ny, int32_t nz, Float background) {
+  g_.background = background;
+  g_.max_value = background;
   g_.nx = nx;
   g_.ny = ny;
   g_.nz = nz;
@@ -15,17 +17,43 @@ SparseGridBuilder::SparseGridBuilder(int32_t nx, int32_t ny, int32_t nz) {
   g_.brick_of.assign(static_cast<size_t>(g_.bx) * g_.by * g_.bz, -1);
 }
 
+int32_t SparseGridBuilder::new_brick(Float fill) {
+  const int32_t index = static_cast<int32_t>(g_.values.size() / kBrickVoxels);
+  g_.values.resize(g_.values.size() + kBrickVoxels, fill);
+  shared_.push_back(0);
+  return index;
+}
+
 void SparseGridBuilder::set(int32_t x, int32_t y, int32_t z, Float v) {
   const size_t b = (static_cast<size_t>(z >> kBrickLog2) * g_.by + (y >> kBrickLog2)) * g_.bx + (x >> kBrickLog2);
-  if (g_.brick_of[b] < 0) {
-    if (v == 0.f) return;
-    g_.brick_of[b] = static_cast<int32_t>(g_.values.size() / kBrickVoxels);
-    g_.values.resize(g_.values.size() + kBrickVoxels, 0.f);
+  int32_t brick = g_.brick_of[b];
+  if (brick < 0) {
+    if (v == g_.background) return;
+    brick = g_.brick_of[b] = new_brick(g_.background);
+  } else if (shared_[static_cast<size_t>(brick)]) {
+    const int32_t copy = new_brick(0.f);
+    std::copy_n(g_.values.begin() + static_cast<ptrdiff_t>(brick) * kBrickVoxels, kBrickVoxels,
+                g_.values.begin() + static_cast<ptrdiff_t>(copy) * kBrickVoxels);
+    brick = g_.brick_of[b] = copy;
   }
   const int32_t m = kBrickSide - 1;
-  g_.values[static_cast<size_t>(g_.brick_of[b]) * kBrickVoxels + (((z & m) * kBrickSide + (y & m)) * kBrickSide + (x & m))] = v;
+  g_.values[static_cast<size_t>(brick) * kBrickVoxels + (((z & m) * kBrickSide + (y & m)) * kBrickSide + (x & m))] = v;
   g_.max_value = std::max(g_.max_value, v);
-  g_.min_value = std::min(g_.min_value, v);
+}
+
+void SparseGridBuilder::fill_brick(int32_t bx, int32_t by, int32_t bz, Float v) {
+  const size_t b = (static_cast<size_t>(bz) * g_.by + by) * g_.bx + bx;
+  if (v == g_.background) {
+    g_.brick_of[b] = -1;
+    return;
+  }
+  // One brick per distinct value, the most recent one kept (tiles of one value come together).
+  if (shared_brick_ < 0 || g_.values[static_cast<size_t>(shared_brick_) * kBrickVoxels] != v) {
+    shared_brick_ = new_brick(v);
+    shared_[static_cast<size_t>(shared_brick_)] = 1;
+  }
+  g_.brick_of[b] = shared_brick_;
+  g_.max_value = std::max(g_.max_value, v);
 }
 
 SparseGridDesc SparseGridBuilder::finish(const Mat4& lattice_from_world) {
@@ -57,18 +85,13 @@ MajorantGridDesc build_majorant_grid(const SparseGridDesc& g, const Vec3& lo, co
   m.hi = hi;
   m.nx = m.ny = m.nz = res;
   m.max_density.assign(static_cast<size_t>(res) * res * res, 0.f);
-  const int32_t n[3] = {g.nx, g.ny, g.nz};
   // Lattice point q reaches the lookups at (q - 1, q + 1): the cells [first, last] overlapping that range.
-  std::vector<int32_t> first[3], last[3];
-  for (int a = 0; a < 3; ++a) {
-    const double cells_per_unit = res / (static_cast<double>(hi[a]) - lo[a]);
-    first[a].resize(n[a]);
-    last[a].resize(n[a]);
-    for (int32_t q = 0; q < n[a]; ++q) {
-      first[a][q] = std::clamp(static_cast<int32_t>(std::floor((q - 1.0 - lo[a]) * cells_per_unit)), 0, res - 1);
-      last[a][q] = std::clamp(static_cast<int32_t>(std::floor((q + 1.0 - lo[a]) * cells_per_unit)), 0, res - 1);
-    }
-  }
+  double cells_per_unit[3];
+  for (int a = 0; a < 3; ++a) cells_per_unit[a] = res / (static_cast<double>(hi[a]) - lo[a]);
+  auto cell = [&](int a, double x) {
+    const double c = std::floor((x - lo[a]) * cells_per_unit[a]);
+    return c < 0.0 ? 0 : c > res - 1 ? res - 1 : static_cast<int32_t>(c);
+  };
   const int32_t mask = kBrickSide - 1;
   for (int32_t bz = 0; bz < g.bz; ++bz)
     for (int32_t by = 0; by < g.by; ++by)
@@ -81,9 +104,9 @@ MajorantGridDesc build_majorant_grid(const SparseGridDesc& g, const Vec3& lo, co
           const int32_t x = bx * kBrickSide + (i & mask), y = by * kBrickSide + ((i >> kBrickLog2) & mask),
                         z = bz * kBrickSide + (i >> (2 * kBrickLog2));
           if (x >= g.nx || y >= g.ny || z >= g.nz) continue;
-          for (int32_t cz = first[2][z]; cz <= last[2][z]; ++cz)
-            for (int32_t cy = first[1][y]; cy <= last[1][y]; ++cy)
-              for (int32_t cx = first[0][x]; cx <= last[0][x]; ++cx) {
+          for (int32_t cz = cell(2, z - 1.0); cz <= cell(2, z + 1.0); ++cz)
+            for (int32_t cy = cell(1, y - 1.0); cy <= cell(1, y + 1.0); ++cy)
+              for (int32_t cx = cell(0, x - 1.0); cx <= cell(0, x + 1.0); ++cx) {
                 Float& c = m.max_density[(static_cast<size_t>(cz) * res + cy) * res + cx];
                 c = std::max(c, v[i]);
               }
@@ -104,6 +127,7 @@ SparseGridView sparse_grid_view(const SparseGridDesc& g) {
   v.bz = g.bz;
   v.brick_of = g.brick_of.empty() ? nullptr : g.brick_of.data();
   v.values = g.values.empty() ? nullptr : g.values.data();
+  v.background = g.background;
   return v;
 }
 

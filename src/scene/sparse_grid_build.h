@@ -14,21 +14,26 @@ struct SparseGridDesc {
   Mat4 lattice_from_world{1.f};
   int32_t nx = 0, ny = 0, nz = 0;  // nx == 0: no grid
   int32_t bx = 0, by = 0, bz = 0;
-  std::vector<int32_t> brick_of;   // bx * by * bz, -1: zeros
+  std::vector<int32_t> brick_of;   // bx * by * bz, -1: the background
   std::vector<Float> values;       // kBrickVoxels per stored brick
-  Float max_value = 0.f;
-  Float min_value = 0.f;           // of the stored values and the implicit zeros
+  Float max_value = 0.f;           // of the stored values and the background
+  Float background = 0.f;          // outside the lattice and in bricks not stored
 };
 
-// Fills a SparseGridDesc point by point; zeros never allocate a brick.
+// Fills a SparseGridDesc point by point; the background value never
+// allocates a brick, and constant bricks (NanoVDB's tiles) share one.
 class SparseGridBuilder {
  public:
-  SparseGridBuilder(int32_t nx, int32_t ny, int32_t nz);
+  SparseGridBuilder(int32_t nx, int32_t ny, int32_t nz, Float background = 0.f);
   void set(int32_t x, int32_t y, int32_t z, Float v);  // x, y, z inside the lattice
+  void fill_brick(int32_t bx, int32_t by, int32_t bz, Float v);  // brick coordinates inside the lattice
   SparseGridDesc finish(const Mat4& lattice_from_world);
 
  private:
+  int32_t new_brick(Float fill);
   SparseGridDesc g_;
+  std::vector<uint8_t> shared_;  // per stored brick: filled by fill_brick, copied before set() changes it
+  int32_t shared_brick_ = -1;    // the last brick fill_brick made
 };
 
 // A dense grid (nx * ny * nz values, x fastest) as pbrt-v4's SampledGrid

@@ -23,7 +23,6 @@ GridMediumView grid_medium_view(const GridDesc& g, const std::vector<Float>& bla
   GridMediumView v;
   v.density = sparse_grid_view(g.density);
   v.majorants = majorant_grid_view(g.majorants);
-  v.max_density = g.density.max_value;
   v.le_scale = sparse_grid_view(g.le_scale);
   v.temperature = sparse_grid_view(g.temperature);
   v.temperature_offset = g.temperature_offset;
@@ -346,9 +345,13 @@ uint64_t SceneData::fingerprint() const {
         f.add(&s->lattice_from_world, sizeof s->lattice_from_world);
         const int32_t dims[3] = {s->nx, s->ny, s->nz};
         f.add(dims, sizeof dims);
+        f.add(&s->background, sizeof s->background);
       }
       f.add(&g.majorants.lo, sizeof g.majorants.lo);
       f.add(&g.majorants.hi, sizeof g.majorants.hi);
+      const int32_t cells[3] = {g.majorants.nx, g.majorants.ny, g.majorants.nz};
+      f.add(cells, sizeof cells);
+      f.add_vector(g.majorants.max_density);
       const Float emission[3] = {g.temperature_offset, g.temperature_scale, g.blackbody_scale};
       f.add(emission, sizeof emission);
       const Float cloud[4] = {static_cast<Float>(g.cloud), g.cloud_density, g.cloud_wispiness, g.cloud_frequency};

@@ -22,12 +22,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::ofstream f(path, std::ios::binary | std::ios::trunc);
     f.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   }
-  try {
-    const tessera::NanoVdbGrid g = tessera::read_nanovdb_grid(path, "density");
-    for (float v : g.lattice.values)
-      if (!(std::isfinite(v) && v >= 0.f)) std::abort();  // the reader promises finite, non-negative values
-  } catch (const std::runtime_error&) {
-    // A clear error is the right answer to a damaged file.
+  for (bool density : {true, false}) {
+    try {
+      const tessera::NanoVdbGrid g = tessera::read_nanovdb_grid(path, density ? "density" : "temperature", density);
+      for (float v : g.lattice.values)  // the reader promises finite values (and non-negative densities)
+        if (!std::isfinite(v) || (density && v < 0.f)) std::abort();
+    } catch (const std::runtime_error&) {
+      // A clear error is the right answer to a damaged file.
+    }
   }
   return 0;
 }

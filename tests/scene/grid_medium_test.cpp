@@ -24,7 +24,6 @@ struct TestGrid {
     desc.majorants = build_majorant_grid(desc.density, Vec3(-0.5f), Vec3(nx, ny, nz) - 0.5f, majorant_res);
     view.density = sparse_grid_view(desc.density);
     view.majorants = majorant_grid_view(desc.majorants);
-    view.max_density = desc.density.max_value;
   }
 };
 

@@ -45,7 +45,7 @@ TEST(NanoVdb, LatticeLookupsEqualNanoVdbsTrilinearSamples) {
   TempDir dir;
   const std::string path = dir.file("blob.nvdb");
   nanovdb::io::writeGrid(path, handle);
-  const NanoVdbGrid g = read_nanovdb_grid(path, "density");
+  const NanoVdbGrid g = read_nanovdb_grid(path, "density", true);
   ASSERT_TRUE(g.found);
   const SparseGridView v = sparse_grid_view(g.lattice);
   using Sampler = nanovdb::SampleFromVoxels<nanovdb::FloatGrid::TreeType, 1, false>;
@@ -64,7 +64,7 @@ TEST(NanoVdb, LatticeLookupsEqualNanoVdbsTrilinearSamples) {
 TEST(NanoVdb, ReadsZipAndBloscCompressedFiles) {
   for (const char* name : {"fire-zip.nvdb", "fire-blosc.nvdb"}) {
     const std::string path = std::string(TESSERA_SOURCE_DIR) + "/tests/fuzz/nvdb_corpus/" + name;
-    const NanoVdbGrid d = read_nanovdb_grid(path, "density"), t = read_nanovdb_grid(path, "temperature");
+    const NanoVdbGrid d = read_nanovdb_grid(path, "density", true), t = read_nanovdb_grid(path, "temperature", false);
     ASSERT_TRUE(d.found && t.found) << name;
     EXPECT_FLOAT_EQ(d.lattice.max_value, 1.5f) << name;  // 1 + 0.1 x at x = 5, the blob's largest x
     EXPECT_FLOAT_EQ(t.lattice.max_value, 800.f + 50.f * 9.f) << name;
@@ -77,10 +77,10 @@ TEST(NanoVdb, MissingGridsAreNotFoundAndBadFilesAreRefused) {
   NvdbGridSpec small = blob_spec();  // within one upper node: a file of about 300 kB
   small.voxels = nanovdb::CoordBBox(nanovdb::Coord(0, 0, 0), nanovdb::Coord(20, 9, 3));
   test::write_nvdb(path, {small});
-  EXPECT_FALSE(read_nanovdb_grid(path, "temperature").found);
+  EXPECT_FALSE(read_nanovdb_grid(path, "temperature", false).found);
   auto message = [](const std::string& p, const std::string& name) -> std::string {
     try {
-      read_nanovdb_grid(p, name);
+      read_nanovdb_grid(p, name, true);
     } catch (const std::runtime_error& e) {
       return e.what();
     }
@@ -93,7 +93,7 @@ TEST(NanoVdb, MissingGridsAreNotFoundAndBadFilesAreRefused) {
   for (size_t len : {size_t{0}, size_t{10}, bytes.size() / 3, bytes.size() / 2, bytes.size() - 1}) {
     const std::string cut = dir.write("cut.nvdb", bytes.substr(0, len));
     try {
-      EXPECT_FALSE(read_nanovdb_grid(cut, "density").found) << len;
+      EXPECT_FALSE(read_nanovdb_grid(cut, "density", true).found) << len;
     } catch (const std::runtime_error& e) {
       EXPECT_NE(std::string(e.what()).find("cut.nvdb"), std::string::npos) << e.what();
     }
@@ -106,7 +106,7 @@ TEST(NanoVdb, MissingGridsAreNotFoundAndBadFilesAreRefused) {
     flipped[at] = static_cast<char>(flipped[at] ^ 0x5a);
     const std::string bad = dir.write("flipped.nvdb", flipped);
     try {
-      const NanoVdbGrid g = read_nanovdb_grid(bad, "density");
+      const NanoVdbGrid g = read_nanovdb_grid(bad, "density", true);
       ++read;
       for (Float v : g.lattice.values) ASSERT_TRUE(std::isfinite(v) && v >= 0.f) << at;
     } catch (const std::runtime_error& e) {
@@ -122,6 +122,30 @@ TEST(NanoVdb, MissingGridsAreNotFoundAndBadFilesAreRefused) {
   const std::string level_set = dir.file("ls.nvdb");
   test::write_nvdb(level_set, {ls});
   EXPECT_NE(message(level_set, "density").find("fog volume"), std::string::npos);
+}
+
+// Temperatures may be negative (Celsius) and have a background; densities may not.
+TEST(NanoVdb, TemperaturesKeepTheirSignAndBackground) {
+  TempDir dir;
+  NvdbGridSpec t = blob_spec();
+  t.value = [](int x, int, int) { return x < 0 ? -40.f : 0.f; };
+  t.background = 20.f;
+  const std::string path = dir.file("t.nvdb");
+  test::write_nvdb(path, {t});
+  const NanoVdbGrid g = read_nanovdb_grid(path, "density", false);
+  ASSERT_TRUE(g.found);
+  const SparseGridView v = sparse_grid_view(g.lattice);
+  EXPECT_EQ(v.background, 20.f);
+  EXPECT_EQ(grid_value(v, Vec3(1e4f)), 20.f);  // far outside: the background
+  Float lowest = 0.f;
+  for (Float x : g.lattice.values) lowest = std::min(lowest, x);
+  EXPECT_EQ(lowest, -40.f);
+  try {
+    read_nanovdb_grid(path, "density", true);
+    ADD_FAILURE() << "a density with a background or negative values was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("t.nvdb"), std::string::npos) << e.what();
+  }
 }
 
 TEST(NanoVdb, MediumReadsDensityTemperatureAndParameters) {

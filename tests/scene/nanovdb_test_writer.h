@@ -20,10 +20,11 @@ struct NvdbGridSpec {
   std::function<float(int, int, int)> value;
   nanovdb::GridClass grid_class = nanovdb::GridClass::FogVolume;
   bool zeros_active = false;  // zeros set too (active voxels): they widen the grid's bounding box
+  float background = 0.f;
 };
 
 inline nanovdb::GridHandle<nanovdb::HostBuffer> build_nvdb_grid(const NvdbGridSpec& s) {
-  nanovdb::GridBuilder<float> builder(0.f, s.grid_class);
+  nanovdb::GridBuilder<float> builder(s.background, s.grid_class);
   auto acc = builder.getAccessor();
   for (int z = s.voxels.min()[2]; z <= s.voxels.max()[2]; ++z)
     for (int y = s.voxels.min()[1]; y <= s.voxels.max()[1]; ++y)
