@@ -28,6 +28,17 @@ TEST(PerlinNoise, ZeroOnTheLatticeBoundedAndCentred) {
   EXPECT_GT(sum2 / n, 0.01);  // not flat
 }
 
+// Values of pbrt-v4's Noise() (src/pbrt/util/noise.cpp) at float inputs,
+// computed in double by a separate transcription of it; (3.14, 42, 7) is
+// also Perlin's own reference value (0.136919958784).
+TEST(PerlinNoise, MatchesPbrtV4sNoiseAtReferencePoints) {
+  EXPECT_NEAR(perlin_noise(Vec3(0.5f, 0.5f, 0.5f)), -0.1250000f, 2e-6f);
+  EXPECT_NEAR(perlin_noise(Vec3(3.14f, 42.f, 7.f)), 0.1369201f, 2e-6f);
+  EXPECT_NEAR(perlin_noise(Vec3(-1.3f, 2.7f, -0.4f)), 0.2085486f, 2e-6f);
+  EXPECT_NEAR(perlin_noise(Vec3(17.25f, -8.5f, 100.125f)), -0.0704209f, 2e-6f);
+  EXPECT_NEAR(perlin_noise(Vec3(0.1f, 0.9f, 0.33f)), 0.1136272f, 2e-6f);
+}
+
 TEST(PerlinNoise, ContinuousAndPeriodicIn256) {
   Rng rng = Rng::for_sample(4, 5, 6);
   for (int i = 0; i < 20000; ++i) {

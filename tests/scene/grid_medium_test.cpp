@@ -111,14 +111,24 @@ TEST(GridMedium, MajorantWalkVisitsTheCellsAlongTheRayInOrderWithoutGaps) {
   const TestGrid t(b.v, b.nx, b.ny, b.nz, b.p0, b.p1, 16);
   const MajorantGridView& m = t.view.majorants;
   Rng rng = Rng::for_sample(1, 1, 1);
-  for (int i = 0; i < 2000; ++i) {
-    const Vec3 o = m.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * (m.hi - m.lo);
+  for (int i = 0; i < 3000; ++i) {
+    Vec3 o = m.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * (m.hi - m.lo);
     Vec3 d = Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f);
-    if (i % 7 == 0) d.y = 0.f;  // axis-parallel planes too
+    if (i % 7 == 0) d.y = 0.f;   // axis-parallel planes too
+    if (i % 11 == 0) d.x = -0.f;
+    if (i % 13 == 0) o.z = m.lo.z + (m.hi.z - m.lo.z) * 5.f / 16.f;  // on a cell face
+    Float t_max = 1e6f;
+    if (i % 3 == 0) {  // from outside the box, unbounded
+      o -= 100.f * d;
+      t_max = kInfinity;
+    }
     GridRay r;
-    ASSERT_TRUE(grid_clip(t.view, glm::inverse(Mat3(t.desc.density.lattice_from_world)) *
-                                      (o - Vec3(t.desc.density.lattice_from_world[3])),
-                          d, 1e6f, &r));
+    if (!grid_clip(t.view, glm::inverse(Mat3(t.desc.density.lattice_from_world)) *
+                               (o - Vec3(t.desc.density.lattice_from_world[3])),
+                   d, t_max, &r)) {
+      ASSERT_EQ(i % 3, 0) << "a ray from inside the box missed it";
+      continue;
+    }
     MajorantWalk w = majorant_walk(m, r.o, r.d, r.t0, r.t1);
     Float ta, tb, bound, last = r.t0;
     int cells = 0;
@@ -138,6 +148,46 @@ TEST(GridMedium, MajorantWalkVisitsTheCellsAlongTheRayInOrderWithoutGaps) {
     }
     EXPECT_NEAR(last, r.t1, 1e-5f * (1.f + r.t1)) << i;  // up to rounding at the box's faces
     EXPECT_LE(cells, 3 * 16 + 3);
+  }
+}
+
+// Transmittance along a line, by a fine midpoint rule.
+double quadrature_optical_depth(const GridMediumView& g, Vec3 o, Vec3 d, Float t_max) {
+  const int n = 20000;
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i) sum += grid_density(g, o + ((i + 0.5f) / n * t_max) * d);
+  return sum * t_max / n;
+}
+
+// Delta tracking through the two blobs (cells of every majorant, restarts
+// at their faces): reaching the end, scattering and the emission along the
+// way each match their integrals over the ray, per channel.
+TEST(GridMedium, DeltaTrackingThroughSparseCellsMatchesQuadrature) {
+  const TwoBlobs b;
+  const TestGrid t(b.v, b.nx, b.ny, b.nz, b.p0, b.p1);
+  Medium m;
+  m.sigma_a = Rgb(0.05f, 0.1f, 0.2f);
+  m.sigma_s = Rgb(0.2f, 0.15f, 0.1f);
+  m.Le = Rgb(1.f, 2.f, 3.f);
+  m.grid = 0;
+  const Vec3 o(-2.2f, 0.1f, 1.1f), e(2.9f, 1.9f, 6.9f);
+  const Vec3 d = glm::normalize(e - o);
+  const Float len = glm::length(e - o);
+  const double tau = quadrature_optical_depth(t.view, o, d, len);
+  const int n = 400000;
+  Rgb reach(0.f), scatter(0.f), glow(0.f);
+  Rng rng = Rng::for_sample(5, 5, 5);
+  for (int i = 0; i < n; ++i) {
+    const MediumSegment seg = sample_grid_segment(m, t.view, o, d, len, rng.uniform(), nullptr);
+    (seg.scattered ? scatter : reach) += seg.weight;
+    glow += seg.emitted;
+  }
+  for (int k = 0; k < 3; ++k) {
+    const double sigma_t = m.sigma_a[k] + m.sigma_s[k], T = std::exp(-sigma_t * tau);
+    EXPECT_NEAR(reach[k] / n, T, 0.005) << k;
+    EXPECT_NEAR(scatter[k] / n, m.sigma_s[k] / sigma_t * (1.0 - T), 0.005) << k;
+    const double want = m.Le[k] * m.sigma_a[k] / sigma_t * (1.0 - T);
+    EXPECT_NEAR(glow[k] / n, want, 0.02 * want) << k;
   }
 }
 
@@ -169,13 +219,6 @@ TEST(GridMedium, MajorantGridSkipsFreeSpace) {
   EXPECT_LT(cells, 0.25 * one_cell) << one_cell << " lookups per ray with one majorant, " << cells << " with 16^3";
 }
 
-// Transmittance along a line, by a fine midpoint rule.
-double quadrature_optical_depth(const GridMediumView& g, Vec3 o, Vec3 d, Float t_max) {
-  const int n = 20000;
-  double sum = 0.0;
-  for (int i = 0; i < n; ++i) sum += grid_density(g, o + ((i + 0.5f) / n * t_max) * d);
-  return sum * t_max / n;
-}
 
 TEST(GridMedium, RatioTrackingThroughASparseGridEstimatesTheTransmittance) {
   const TwoBlobs b;
