@@ -168,6 +168,12 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   // A resume holds the checkpoint's film twice more; --guide auto's trial one more.
   check_film_memory(desc.film.xres, desc.film.yres, m.opt.light_paths, !a.checkpoint.empty(),
                     (a.resume.empty() ? 0u : 2u) + (a.guide.mode == "auto" ? 1u : 0u));
+  uint64_t triangles = 0, vertices = 0;
+  for (const MeshDesc& mesh : desc.meshes) {
+    triangles += mesh.indices.size() / 3;
+    vertices += mesh.p.size();
+  }
+  check_scene_memory(triangles, vertices);
   if (!a.snapshot_every.empty()) m.snapshots = parse_snapshot_policy(a.snapshot_every);
   if (scene_bytes) *scene_bytes = encode_scene(desc);
   m.scene = std::make_unique<SceneData>(std::move(desc));

@@ -72,6 +72,21 @@ std::string format_bytes(uint64_t bytes) {
   return b;
 }
 
+uint64_t scene_build_memory(uint64_t triangles, uint64_t vertices) { return triangles * 128 + vertices * 32; }
+
+void check_scene_memory(uint64_t triangles, uint64_t vertices) {
+  const uint64_t need = scene_build_memory(triangles, vertices);
+  const std::string what = "the scene's " + std::to_string(triangles) + " triangles need about " + format_bytes(need) +
+                           " for their arrays and BVH";
+  const std::optional<uint64_t> limit = memory_limit_bytes();
+  if (limit && need > *limit / 10 * 9)
+    throw std::runtime_error(what + ", more than the " + format_bytes(*limit) + " of memory this process may use");
+  const std::optional<uint64_t> avail = available_memory_bytes();
+  if (avail && need > *avail)
+    std::fprintf(stderr, "tessera: warning: %s, more than the %s of memory available now\n", what.c_str(),
+                 format_bytes(*avail).c_str());
+}
+
 void check_film_memory(int64_t width, int64_t height, bool light_paths, bool checkpoints, uint32_t extra_films) {
   const FilmMemory need = film_memory(width, height, light_paths, checkpoints, extra_films);
   const std::string what = std::to_string(width) + "x" + std::to_string(height) + " needs about " +

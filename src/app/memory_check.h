@@ -35,6 +35,16 @@ FilmMemory film_memory(int64_t width, int64_t height, bool light_paths, bool che
 // else; warns when it exceeds the memory free now.
 void check_film_memory(int64_t width, int64_t height, bool light_paths, bool checkpoints, uint32_t extra_films);
 
+// What a loaded scene still needs before rendering: per triangle its flat
+// arrays (indices, face normal, material and light, media, alpha) and its
+// share of the BVH, per vertex its position, normal and uv, counted high
+// (scripts/bench_mesh_load.py measures what a mesh takes).
+uint64_t scene_build_memory(uint64_t triangles, uint64_t vertices);
+
+// The same refusal and warning as check_film_memory, for the scene's
+// triangles, before its arrays and BVH are built.
+void check_scene_memory(uint64_t triangles, uint64_t vertices);
+
 // "1.5 GB"
 std::string format_bytes(uint64_t bytes);
 
