@@ -27,6 +27,15 @@ struct TestGrid {
   }
 };
 
+// A medium on grid 0 with these coefficients per unit density.
+Medium on_grid(const Rgb& sigma_a, const Rgb& sigma_s) {
+  Medium m;
+  m.sigma_a = sigma_a;
+  m.sigma_s = sigma_s;
+  m.grid = 0;
+  return m;
+}
+
 // pbrt-v4's SampledGrid lookup on dense values, written out.
 Float dense_lookup(const std::vector<Float>& v, int nx, int ny, int nz, Vec3 p0, Vec3 p1, Vec3 p) {
   const Vec3 u = (p - p0) / (p1 - p0);
@@ -159,26 +168,35 @@ double quadrature_optical_depth(const GridMediumView& g, Vec3 o, Vec3 d, Float t
   return sum * t_max / n;
 }
 
+// A ray from near one blob through the other, and its optical depth per unit extinction.
+struct BlobRay {
+  Vec3 o, d;
+  Float len;
+  double tau;
+  explicit BlobRay(const TestGrid& t) {
+    const Vec3 e(2.9f, 1.9f, 6.9f);
+    o = Vec3(-2.2f, 0.1f, 1.1f);
+    d = glm::normalize(e - o);
+    len = glm::length(e - o);
+    tau = quadrature_optical_depth(t.view, o, d, len);
+  }
+};
+
 // Delta tracking through the two blobs (cells of every majorant, restarts
 // at their faces): reaching the end, scattering and the emission along the
 // way each match their integrals over the ray, per channel.
 TEST(GridMedium, DeltaTrackingThroughSparseCellsMatchesQuadrature) {
   const TwoBlobs b;
   const TestGrid t(b.v, b.nx, b.ny, b.nz, b.p0, b.p1);
-  Medium m;
-  m.sigma_a = Rgb(0.05f, 0.1f, 0.2f);
-  m.sigma_s = Rgb(0.2f, 0.15f, 0.1f);
+  Medium m = on_grid(Rgb(0.05f, 0.1f, 0.2f), Rgb(0.2f, 0.15f, 0.1f));
   m.Le = Rgb(1.f, 2.f, 3.f);
-  m.grid = 0;
-  const Vec3 o(-2.2f, 0.1f, 1.1f), e(2.9f, 1.9f, 6.9f);
-  const Vec3 d = glm::normalize(e - o);
-  const Float len = glm::length(e - o);
-  const double tau = quadrature_optical_depth(t.view, o, d, len);
+  const BlobRay ray(t);
+  const double tau = ray.tau;
   const int n = 400000;
   Rgb reach(0.f), scatter(0.f), glow(0.f);
   Rng rng = Rng::for_sample(5, 5, 5);
   for (int i = 0; i < n; ++i) {
-    const MediumSegment seg = sample_grid_segment(m, t.view, o, d, len, rng.uniform(), nullptr);
+    const MediumSegment seg = sample_grid_segment(m, t.view, ray.o, ray.d, ray.len, rng.uniform(), nullptr);
     (seg.scattered ? scatter : reach) += seg.weight;
     glow += seg.emitted;
   }
@@ -223,19 +241,13 @@ TEST(GridMedium, MajorantGridSkipsFreeSpace) {
 TEST(GridMedium, RatioTrackingThroughASparseGridEstimatesTheTransmittance) {
   const TwoBlobs b;
   const TestGrid t(b.v, b.nx, b.ny, b.nz, b.p0, b.p1);
-  Medium m;
-  m.sigma_a = Rgb(0.1f, 0.3f, 0.6f);
-  m.sigma_s = Rgb(0.2f, 0.2f, 0.0f);
-  m.grid = 0;
-  // From near one blob through the other.
-  const Vec3 o(-2.2f, 0.1f, 1.1f), e(2.9f, 1.9f, 6.9f);
-  const Vec3 d = glm::normalize(e - o);
-  const Float len = glm::length(e - o);
-  const double tau = quadrature_optical_depth(t.view, o, d, len);
+  Medium m = on_grid(Rgb(0.1f, 0.3f, 0.6f), Rgb(0.2f, 0.2f, 0.0f));
+  const BlobRay ray(t);
+  const double tau = ray.tau;
   ASSERT_GT(tau, 0.3);
   const int n = 100000;
   Rgb sum(0.f);
-  for (int i = 0; i < n; ++i) sum += grid_transmittance(m, t.view, o + Vec3(0.f, 0.f, 1e-7f * i), d, len, nullptr);
+  for (int i = 0; i < n; ++i) sum += grid_transmittance(m, t.view, ray.o + Vec3(0.f, 0.f, 1e-7f * i), ray.d, ray.len, nullptr);
   for (int k = 0; k < 3; ++k)
     EXPECT_NEAR(sum[k] / n, std::exp(-(m.sigma_a[k] + m.sigma_s[k]) * tau), 0.006) << k;
 }
@@ -248,10 +260,7 @@ struct ConstantGrid : TestGrid {
 
 TEST(GridMedium, RatioTrackingEstimatesTheTransmittance) {
   const ConstantGrid c;
-  Medium m;
-  m.sigma_a = Rgb(0.1f, 0.3f, 0.6f);
-  m.sigma_s = Rgb(0.1f, 0.2f, 0.0f);
-  m.grid = 0;
+  Medium m = on_grid(Rgb(0.1f, 0.3f, 0.6f), Rgb(0.1f, 0.2f, 0.0f));
   const Float d = 2.5f;
   Rgb sum(0.f);
   const int n = 200000;
@@ -266,10 +275,7 @@ TEST(GridMedium, RatioTrackingEstimatesTheTransmittance) {
 
 TEST(GridMedium, DeltaTrackingEstimatesTransmittanceAndScatteringInEveryChannel) {
   const ConstantGrid c;
-  Medium m;
-  m.sigma_a = Rgb(0.f, 0.2f, 0.5f);
-  m.sigma_s = Rgb(0.f, 0.6f, 1.5f);
-  m.grid = 0;
+  Medium m = on_grid(Rgb(0.f, 0.2f, 0.5f), Rgb(0.f, 0.6f, 1.5f));
   const Float t_max = 1.3f;
   const int n = 400000;
   Rgb reach(0.f), scatter(0.f);
