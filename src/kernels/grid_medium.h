@@ -209,11 +209,13 @@ TESSERA_HOST_DEVICE inline bool next_tentative_collision(const GridMediumView& g
   }
 }
 
-// Delta tracking along [0, t_max]: a real collision (weight sigma_s / its
-// probability) or the end of the segment; absorption ends the path (weight 0).
+// Delta tracking along [0, t_max] with the hero's collision probabilities
+// (scatter sigma_s / majorant, null the rest of the majorant, absorb
+// sigma_a), each channel weighted by hero_event: a real collision, or the end
+// of the segment; absorption ends the path (weight 0).
 TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, const GridMediumView& g, const Vec3& o,
                                                              const Vec3& d, Float t_max, Float u,
-                                                             const Wavelengths* wl) {
+                                                             const Wavelengths* wl, HeroChannels& h) {
   const bool emits = m.grid_emits || !is_black(m.Le);
   MediumSegment seg;
   seg.t = t_max;
@@ -228,19 +230,19 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
     const Float majorant = c.majorant;
     Rgb sigma_a, sigma_s;
     grid_coefficients(g, m, q, wl, &sigma_a, &sigma_s);
-    const Rgb sigma_n = Rgb(majorant) - sigma_a - sigma_s;
+    const Rgb sigma_n = glm::max(Rgb(majorant) - sigma_a - sigma_s, Rgb(0.f));
     if (emits && !is_black(sigma_a)) seg.emitted += w * sigma_a * grid_emission(g, m, o + static_cast<Float>(c.t) * d, wl) / majorant;
-    const Float p_s = (sigma_s.x + sigma_s.y + sigma_s.z) / (3.f * majorant);
-    const Float p_n = glm::max(0.f, (sigma_n.x + sigma_n.y + sigma_n.z) / (3.f * majorant));
+    const Float p_s = sigma_s[h.hero] / majorant, p_n = sigma_n[h.hero] / majorant;
     const Float e = rng.uniform();
     if (e < p_s) {
       seg.scattered = true;
       seg.t = static_cast<Float>(c.t);
-      seg.weight = w * sigma_s / (majorant * p_s);
+      seg.weight = w * (hero_event(h, sigma_s) * sigma_s);
       return seg;
     }
     if (e < p_s + p_n) {
-      w *= glm::max(sigma_n, Rgb(0.f)) / (majorant * p_n);
+      w *= hero_event(h, sigma_n) * sigma_n;
+      if (is_black(w)) break;
       continue;
     }
     seg.scattered = true;  // absorbed: the path ends here

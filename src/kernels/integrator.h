@@ -148,6 +148,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   constexpr bool kGuide = (Spec & kSpecGuiding) != 0;
   constexpr bool kMedia = (Spec & kSpecMedia) != 0;
   int32_t medium = kMedia ? s.camera_medium : -1;  // the medium the ray travels in (-1: vacuum)
+  HeroChannels heroes;  // the channel media sample distances with, and the MIS over it (medium.h)
   // Luminance of the medium's weight on the segment just traced (its
   // transmittance, or the collision estimator's weight): learning targets
   // are the radiance arriving at x, after the medium between.
@@ -234,7 +235,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         } else {
           const Float u_channel = rng.uniform();
           const Float u_dist = rng.uniform();
-          const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist, wl);
+          const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist, wl, heroes);
           if (depth < settings.max_depth) L += beta * seg.emitted;
           beta *= seg.weight;
           rr_beta *= seg.weight;

@@ -171,6 +171,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
   Ray ray;
   Rgb beta(0.f);
   int32_t medium = kMedia ? l.medium : -1;  // point and spot lights: where they were defined
+  HeroChannels heroes;  // the channel media sample distances with (medium.h)
   switch (l.type) {
     case LightType::Area: {
       const Vec3 b = sample_uniform_triangle(u_pos);
@@ -265,7 +266,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
         } else {
           const Float u_channel = rng.uniform();
           const Float u_dist = rng.uniform();
-          const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist, wl);
+          const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist, wl, heroes);
           beta *= seg.weight;
           if (seg.scattered) {
             if (!reach_scattering_vertex() || is_black(beta)) return;

@@ -2,11 +2,14 @@
 // MediumInterface) with the Henyey-Greenstein phase function: the pieces the
 // volumetric path tracer needs per ray segment.
 //
-// Distances are sampled from the mixture of the three channels' exponential
-// densities (pick a channel uniformly, sample its free path) and weighted by
-// the mixture's density: that is pbrt-v4's hero-wavelength MIS carried over to
-// RGB, unbiased in every channel, including chromatic media where one channel
-// has no extinction at all.
+// Distances (and, in grids, collision events) are sampled with one channel's
+// coefficients, the path's hero channel, picked uniformly once per path, and
+// weighted by the balance heuristic over the three channels as heroes of the
+// whole path: pbrt-v4's hero-wavelength MIS (its r_u), carried over to RGB.
+// Unbiased in every channel, including chromatic media where one channel has
+// no extinction at all, and with weights bounded by the number of channels
+// however many collisions a path has (a per-collision mixture multiplies
+// ratios along the path: heavy tails in deep chromatic media).
 #pragma once
 
 #include "sampling.h"
@@ -70,6 +73,33 @@ TESSERA_HOST_DEVICE inline Vec3 sample_henyey_greenstein(const Vec3& wo, Float g
   return wi;
 }
 
+// The path's hero channel and each channel's path pdf relative to it (up
+// to a common factor: only ratios matter).
+struct HeroChannels {
+  int32_t hero = -1;  // -1: not chosen yet (choose_hero)
+  Rgb r{1.f};
+};
+
+TESSERA_HOST_DEVICE inline void choose_hero(HeroChannels& h, Float u) {
+  if (h.hero < 0) h.hero = glm::min(static_cast<int32_t>(u * 3.f), 2);
+}
+
+// An event the hero's coefficients sampled, with per-channel densities p
+// (any common unit): the factor its integrand is multiplied by (the
+// balance heuristic over heroes, as a ratio to the path so far), 0 if the
+// hero could not have sampled it. Updates the channels' relative pdfs.
+TESSERA_HOST_DEVICE inline Float hero_event(HeroChannels& h, const Rgb& p) {
+  const Rgb rp = h.r * p;
+  const Float mean_rp = (rp.x + rp.y + rp.z) / 3.f;
+  const Float ph = p[h.hero];
+  if (!(mean_rp > 0.f) || !(ph > 0.f)) return 0.f;
+  const Float k = (h.r.x + h.r.y + h.r.z) / 3.f / mean_rp;
+  h.r = rp / ph;
+  const Float top = max_component(h.r);
+  if (top > 0.f && top < kInfinity) h.r /= top;
+  return k;
+}
+
 // What happened on a ray segment of length t_max through a medium.
 struct MediumSegment {
   bool scattered = false;  // a real collision at distance t (else the ray reached t_max)
@@ -79,32 +109,28 @@ struct MediumSegment {
   Rgb transmittance{1.f};  // T(t) itself (for learning targets)
 };
 
-// One collision-distance sample; u_channel picks the channel, u_dist its free path.
-TESSERA_HOST_DEVICE inline MediumSegment sample_medium_segment(const Medium& m, Float t_max, Float u_channel,
+// One collision-distance sample with the hero's extinction (h.hero chosen);
+// u_dist picks the free path.
+TESSERA_HOST_DEVICE inline MediumSegment sample_medium_segment(const Medium& m, Float t_max, HeroChannels& h,
                                                                Float u_dist) {
   MediumSegment seg;
   const Rgb sigma_t = medium_sigma_t(m);
-  const int c = glm::min(static_cast<int>(u_channel * 3.f), 2);
+  const int c = h.hero;
   const Float t = sigma_t[c] > 0.f ? -glm::log(1.f - u_dist) / sigma_t[c] : kInfinity;
   if (t < t_max) {
     const Rgb T = transmittance(sigma_t, t);
-    const Float pdf = (sigma_t.x * T.x + sigma_t.y * T.y + sigma_t.z * T.z) / 3.f;
     seg.scattered = true;
     seg.t = t;
     seg.transmittance = T;
-    if (!(pdf > 0.f)) {
-      seg.weight = Rgb(0.f);
-      return seg;
-    }
-    seg.weight = T * m.sigma_s / pdf;
-    seg.emitted = T * m.sigma_a * m.Le / pdf;
+    const Float k = hero_event(h, sigma_t * T);  // each channel's free-path density at t
+    seg.weight = k * T * m.sigma_s;
+    seg.emitted = k * T * m.sigma_a * m.Le;
     return seg;
   }
   const Rgb T = transmittance(sigma_t, t_max);
-  const Float p_reach = (T.x + T.y + T.z) / 3.f;
   seg.t = t_max;
   seg.transmittance = T;
-  seg.weight = p_reach > 0.f ? T / p_reach : Rgb(0.f);
+  seg.weight = hero_event(h, T) * T;  // each channel's probability of reaching t_max
   return seg;
 }
 

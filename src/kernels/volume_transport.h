@@ -29,12 +29,16 @@ TESSERA_HOST_DEVICE inline Rgb medium_transmittance(const SceneView& s, const Me
 }
 
 // One collision sample on a segment through `m` (medium.h, grid_medium.h).
-// wl: the path's wavelengths under spectral transport (a grid's emission is evaluated at them), else null.
+// wl: the path's wavelengths under spectral transport (a grid's emission is
+// evaluated at them), else null. u_channel picks the path's hero channel at
+// its first medium segment (the number is drawn on every segment, so a path
+// draws the same sampler dimensions either way).
 TESSERA_HOST_DEVICE inline MediumSegment sample_medium(const SceneView& s, const Medium& m, const Vec3& o, const Vec3& d,
                                                        Float t_max, Float u_channel, Float u_dist,
-                                                       const Wavelengths* wl) {
-  if (m.grid >= 0) return sample_grid_segment(m, s.grids[m.grid], o, d, t_max, u_dist, wl);
-  return sample_medium_segment(m, t_max, u_channel, u_dist);
+                                                       const Wavelengths* wl, HeroChannels& h) {
+  choose_hero(h, u_channel);
+  if (m.grid >= 0) return sample_grid_segment(m, s.grids[m.grid], o, d, t_max, u_dist, wl, h);
+  return sample_medium_segment(m, t_max, h, u_dist);
 }
 
 // Transmittance from o to o + t_max d (d unit length, t_max = kInfinity for

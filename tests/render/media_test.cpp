@@ -103,6 +103,22 @@ TEST(Media, ScatteringFurnaceIsOneInEveryChannel) {
   expect_unguided_furnace(GuidedScene(scattering_furnace(1024)), 0.003);
 }
 
+// The same furnace dense and strongly chromatic (optical depths 9, 18 and
+// 36 across the box): hundreds of collisions a path, still 1 in every
+// channel (the hero MIS keeps each path's weight bounded).
+TEST(Media, DeepChromaticFurnaceIsOneInEveryChannel) {
+  std::string text = header(256, 100000, 40.0) + "WorldBegin\n" + "LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n"
+                     "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ 0 0 0 ] "
+                     "\"rgb sigma_s\" [ 3 6 12 ] \"float g\" 0.6\n"
+                     "AttributeBegin\nMaterial \"interface\"\nMediumInterface \"m\" \"\"\n" +
+                     box(Vec3(-1.5, -1.5, 3), Vec3(1.5, 1.5, 6)) + "AttributeEnd\n";
+  GuidedScene s(load_pbrt_string(text, "<deep furnace>", "."));
+  RenderResult r = s.run(nullptr);
+  const ChannelStats m = channel_stats(r.film);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.mean[c], 1.0, 0.01) << "channel " << c;
+  EXPECT_GT(r.stats.counters.path.medium_vertices, 20 * r.stats.counters.samples);
+}
+
 // The furnace again, lit by the walls of a box of emitters (L = 1) around
 // the camera, filled with a white medium: radiance 1 everywhere. Light
 // samples from points in the medium take the large wall triangles by solid

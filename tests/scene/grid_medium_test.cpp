@@ -193,12 +193,14 @@ TEST(GridMedium, DeltaTrackingThroughSparseCellsMatchesQuadrature) {
   const BlobRay ray(t);
   const double tau = ray.tau;
   const int n = 400000;
-  Rgb reach(0.f), scatter(0.f), glow(0.f);
+  glm::dvec3 reach(0.0), scatter(0.0), glow(0.0);  // (float sums of 400,000 weights drift)
   Rng rng = Rng::for_sample(5, 5, 5);
   for (int i = 0; i < n; ++i) {
-    const MediumSegment seg = sample_grid_segment(m, t.view, ray.o, ray.d, ray.len, rng.uniform(), nullptr);
-    (seg.scattered ? scatter : reach) += seg.weight;
-    glow += seg.emitted;
+    HeroChannels h;
+    choose_hero(h, rng.uniform());
+    const MediumSegment seg = sample_grid_segment(m, t.view, ray.o, ray.d, ray.len, rng.uniform(), nullptr, h);
+    (seg.scattered ? scatter : reach) += glm::dvec3(seg.weight);
+    glow += glm::dvec3(seg.emitted);
   }
   for (int k = 0; k < 3; ++k) {
     const double sigma_t = m.sigma_a[k] + m.sigma_s[k], T = std::exp(-sigma_t * tau);
@@ -278,16 +280,18 @@ TEST(GridMedium, DeltaTrackingEstimatesTransmittanceAndScatteringInEveryChannel)
   Medium m = on_grid(Rgb(0.f, 0.2f, 0.5f), Rgb(0.f, 0.6f, 1.5f));
   const Float t_max = 1.3f;
   const int n = 400000;
-  Rgb reach(0.f), scatter(0.f);
+  glm::dvec3 reach(0.0), scatter(0.0);
   Rng rng = Rng::for_sample(7, 8, 9);
   for (int i = 0; i < n; ++i) {
     const Vec3 o(rng.uniform() - 0.5f, rng.uniform() - 0.5f, -1.f);
-    const MediumSegment seg = sample_grid_segment(m, c.view, o, Vec3(0.f, 0.f, 1.f), t_max, rng.uniform(), nullptr);
+    HeroChannels h;
+    choose_hero(h, rng.uniform());
+    const MediumSegment seg = sample_grid_segment(m, c.view, o, Vec3(0.f, 0.f, 1.f), t_max, rng.uniform(), nullptr, h);
     ASSERT_TRUE(std::isfinite(seg.weight.x) && std::isfinite(seg.weight.y) && std::isfinite(seg.weight.z));
-    (seg.scattered ? scatter : reach) += seg.weight;
+    (seg.scattered ? scatter : reach) += glm::dvec3(seg.weight);
   }
-  reach /= static_cast<Float>(n);
-  scatter /= static_cast<Float>(n);
+  reach /= static_cast<double>(n);
+  scatter /= static_cast<double>(n);
   for (int k = 0; k < 3; ++k) {
     const double sigma_t = m.sigma_a[k] + m.sigma_s[k];
     const double T = std::exp(-sigma_t * t_max);
@@ -303,7 +307,10 @@ TEST(GridMedium, RaysMissingTheBoxSeeNoMedium) {
   m.sigma_s = Rgb(1.f);
   m.grid = 0;
   EXPECT_EQ(grid_transmittance(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), 100.f, nullptr), Rgb(1.f));
-  const MediumSegment seg = sample_grid_segment(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), kInfinity, 0.3f, nullptr);
+  HeroChannels h;
+  choose_hero(h, 0.5f);
+  const MediumSegment seg =
+      sample_grid_segment(m, c.view, Vec3(10.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), kInfinity, 0.3f, nullptr, h);
   EXPECT_FALSE(seg.scattered);
   EXPECT_EQ(seg.weight, Rgb(1.f));
 }
