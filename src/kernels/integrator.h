@@ -364,6 +364,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       const Rgb mask = dispersion_mask(wl->single);
       beta *= mask;
       rr_beta *= mask;
+      if constexpr (kMedia) keep_only_channel(heroes, wl->single);
     }
 
     const Frame frame = shading_frame<Spec>(s, bsdf, h);

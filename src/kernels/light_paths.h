@@ -300,7 +300,10 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
       ray.o = offset_ray_origin(h, ray.d);
       continue;
     }
-    if (wl && wl->single != single_before) beta *= dispersion_mask(wl->single);  // as trace_path
+    if (wl && wl->single != single_before) {  // as trace_path
+      beta *= dispersion_mask(wl->single);
+      if constexpr (kMedia) keep_only_channel(heroes, wl->single);
+    }
     const Frame frame = shading_frame<Spec>(s, bsdf, h);
     if (lobes_have_non_specular(lobes_of<Spec>(bsdf))) {
       if (!reach_scattering_vertex()) return;

@@ -94,10 +94,18 @@ TESSERA_HOST_DEVICE inline Float hero_event(HeroChannels& h, const Rgb& p) {
   const Float ph = p[h.hero];
   if (!(mean_rp > 0.f) || !(ph > 0.f)) return 0.f;
   const Float k = (h.r.x + h.r.y + h.r.z) / 3.f / mean_rp;
-  h.r = rp / ph;
-  const Float top = max_component(h.r);
-  if (top > 0.f && top < kInfinity) h.r /= top;
+  h.r = rp / max_component(rp);  // only ratios matter: kept at most 1, finite
   return k;
+}
+
+// After a dispersive surface only channel c carries light (spectral.h): it
+// becomes the hero for the rest of the path, so no distance is sampled with
+// a channel whose throughput is 0. (The path's pdf is then the mixture so far
+// times channel c's from here: each remaining event weighs 1 / p[c].)
+TESSERA_HOST_DEVICE inline void keep_only_channel(HeroChannels& h, int32_t c) {
+  h.hero = c;
+  h.r = Rgb(0.f);
+  h.r[c] = 1.f;
 }
 
 // What happened on a ray segment of length t_max through a medium.

@@ -92,6 +92,43 @@ TEST(MediumSegment, EstimatesTransmittanceAndScatteringInEveryChannel) {
   }
 }
 
+// Three segments chained on one path (one hero, its relative pdfs carried
+// from segment to segment): for each pattern of collided / passed segments,
+// E[product of weights] is the product of each segment's T or albedo (1 - T),
+// per channel. (A fresh path per segment, as above, cannot see the carry.)
+TEST(MediumSegment, ChainedSegmentsStayUnbiasedForEveryPattern) {
+  Medium m;
+  m.sigma_a = Rgb(0.05f, 0.3f, 0.2f);
+  m.sigma_s = Rgb(0.1f, 0.9f, 2.4f);
+  const Float t_max = 1.1f;
+  const int n = 1000000, segments = 3;
+  glm::dvec3 sum[8], sum2[8];
+  for (int k = 0; k < 8; ++k) sum[k] = sum2[k] = glm::dvec3(0.0);
+  Rng rng = Rng::for_sample(3, 1, 4);
+  for (int i = 0; i < n; ++i) {
+    HeroChannels h;
+    choose_hero(h, rng.uniform());
+    glm::dvec3 w(1.0);
+    int pattern = 0;
+    for (int j = 0; j < segments; ++j) {
+      const MediumSegment seg = sample_medium_segment(m, t_max, h, rng.uniform());
+      w *= glm::dvec3(seg.weight);
+      pattern |= (seg.scattered ? 1 : 0) << j;
+    }
+    sum[pattern] += w;
+    sum2[pattern] += w * w;
+  }
+  const Rgb sigma_t = m.sigma_a + m.sigma_s;
+  for (int k = 0; k < 8; ++k)
+    for (int c = 0; c < 3; ++c) {
+      const double T = std::exp(-sigma_t[c] * t_max), collide = m.sigma_s[c] / sigma_t[c] * (1.0 - T);
+      double want = 1.0;
+      for (int j = 0; j < segments; ++j) want *= ((k >> j) & 1) ? collide : T;
+      const double mean = sum[k][c] / n, se = std::sqrt(std::max(0.0, sum2[k][c] / n - mean * mean) / n);
+      EXPECT_NEAR(mean, want, 4.0 * se + 1e-4 * want) << "pattern " << k << " channel " << c;
+    }
+}
+
 TEST(MediumSegment, AnInfiniteSegmentAlwaysCollidesWhereEveryChannelExtinguishes) {
   Medium m;
   m.sigma_s = Rgb(0.1f, 0.2f, 0.3f);
