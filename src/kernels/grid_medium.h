@@ -3,14 +3,15 @@
 // sigma_s and the emission inside a box.
 // Collisions are found by delta tracking against the majorant of the
 // majorant-grid cell they fall in (its largest density times the largest
-// extinction of the three channels), weighted so
-// that every channel stays unbiased (spectral tracking, Kutz et al. 2017,
-// with the channels' mean as probabilities); shadow rays use ratio tracking.
+// extinction of the three channels), the events chosen with the path's hero
+// channel and weighted by the hero MIS of medium.h (spectral tracking, Kutz
+// et al. 2017, made path-level as pbrt-v4 does); shadow rays use ratio tracking.
 // The random numbers of a segment come from a PCG32 stream seeded by the
 // pixel sampler and the ray, so a path still draws a fixed number of
 // sampler dimensions per segment.
 #pragma once
 
+#include "blackbody_table.h"
 #include "majorant_grid.h"
 #include "medium.h"
 #include "perlin_noise.h"
@@ -18,7 +19,6 @@
 #include "rng.h"
 #include "sparse_grid.h"
 #include "spectral.h"
-#include "blackbody_table.h"
 
 namespace tessera {
 
@@ -231,7 +231,8 @@ TESSERA_HOST_DEVICE inline MediumSegment sample_grid_segment(const Medium& m, co
     Rgb sigma_a, sigma_s;
     grid_coefficients(g, m, q, wl, &sigma_a, &sigma_s);
     const Rgb sigma_n = glm::max(Rgb(majorant) - sigma_a - sigma_s, Rgb(0.f));
-    if (emits && !is_black(sigma_a)) seg.emitted += w * sigma_a * grid_emission(g, m, o + static_cast<Float>(c.t) * d, wl) / majorant;
+    if (emits && !is_black(sigma_a))
+      seg.emitted += w * sigma_a * grid_emission(g, m, o + static_cast<Float>(c.t) * d, wl) / majorant;
     const Float p_s = sigma_s[h.hero] / majorant, p_n = sigma_n[h.hero] / majorant;
     const Float e = rng.uniform();
     if (e < p_s) {
