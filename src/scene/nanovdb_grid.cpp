@@ -1,19 +1,17 @@
 #include "scene/nanovdb_grid.h"
 
+#include <blosc.h>
+#include <nanovdb/NanoVDB.h>
+#include <nanovdb/util/IO.h>  // the file's Header and MetaData layout
+#include <zlib.h>
+
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <stdexcept>
 #include <type_traits>
-
-#include <nanovdb/NanoVDB.h>
-#include <nanovdb/util/IO.h>  // the file's Header and MetaData layout
-#include <blosc.h>
-#include <zlib.h>
-
-#include <filesystem>
-#include <fstream>
-#include <memory>
 
 namespace tessera {
 

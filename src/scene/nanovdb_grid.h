@@ -2,7 +2,9 @@
 // NanoVDB library (libnanovdb-dev) and copied into our brick lattice: NanoVDB
 // leaves are 8^3 voxels, so each leaf becomes one brick, and constant tiles
 // of the internal nodes become bricks of their value. The kernels then need
-// no NanoVDB type, on the CPU or a GPU.
+// no NanoVDB type, on the CPU or a GPU. The file's container is read by our
+// own code, not NanoVDB's io::readGrid: that one trusts the sizes in the file
+// (a damaged file makes it read past its buffers or allocate what it says).
 #pragma once
 
 #include <string>

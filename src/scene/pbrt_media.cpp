@@ -80,6 +80,22 @@ Mat4 medium_from_world_of(const Mat4& world_from_medium, const DirectiveContext&
   return glm::inverse(world_from_medium);
 }
 
+// "nx", "ny", "nz" (pbrt-v4's default 1 each), positive.
+void read_dims(const ParamSet& params, const std::string& type, const DirectiveContext& ctx, int32_t* nx, int32_t* ny,
+               int32_t* nz) {
+  *nx = params.get_int("nx", 1);
+  *ny = params.get_int("ny", 1);
+  *nz = params.get_int("nz", 1);
+  if (*nx < 1 || *ny < 1 || *nz < 1) ctx.fail(type + " \"nx\", \"ny\" and \"nz\" must be positive");
+}
+
+// A per-voxel array must have nx*ny*nz values.
+void check_count(size_t count, uint64_t n, const std::string& type, const std::string& what,
+                 const DirectiveContext& ctx) {
+  if (count != n)
+    ctx.fail(type + " has " + std::to_string(count) + " " + what + " values; nx*ny*nz = " + std::to_string(n));
+}
+
 // "p0" and "p1" (pbrt-v4's defaults 0 0 0 and 1 1 1), p0 below p1.
 void read_box(const ParamSet& params, const std::string& type, const DirectiveContext& ctx, Vec3* p0, Vec3* p1) {
   *p0 = params.get_point3("p0").value_or(Vec3(0.f));
@@ -106,9 +122,7 @@ void read_grid_emission(const ParamSet& params, const Mat4& medium_from_world, c
   const uint64_t n = static_cast<uint64_t>(nx) * static_cast<uint64_t>(ny) * static_cast<uint64_t>(nz);
   if (!temperature.empty()) {
     if (params.find_any("Le")) ctx.fail("uniformgrid: \"Le\" and \"temperature\" cannot both be given (as in pbrt-v4)");
-    if (temperature.size() != n)
-      ctx.fail("uniformgrid has " + std::to_string(temperature.size()) + " temperature values; nx*ny*nz = " +
-               std::to_string(n));
+    check_count(temperature.size(), n, "uniformgrid", "temperature", ctx);
     for (Float t : temperature)
       if (!std::isfinite(t)) ctx.fail("uniformgrid temperatures must be finite");
     g->temperature = sparse_grid_from_dense(temperature, nx, ny, nz, p0, p1, medium_from_world);
@@ -124,9 +138,8 @@ void read_grid_emission(const ParamSet& params, const Mat4& medium_from_world, c
   if (le_scale.empty()) le_scale = {1.f};
   if (le_scale.size() == 1) {
     sx = sy = sz = 1;
-  } else if (le_scale.size() != n) {
-    ctx.fail("uniformgrid has " + std::to_string(le_scale.size()) + " \"Lescale\" values; nx*ny*nz = " +
-             std::to_string(n) + " (or give one)");
+  } else {
+    check_count(le_scale.size(), n, "uniformgrid", "\"Lescale\"", ctx);
   }
   for (Float v : le_scale)
     if (!(v >= 0.f) || !std::isfinite(v)) ctx.fail("uniformgrid \"Lescale\" values must be finite and not negative");
@@ -140,11 +153,10 @@ int32_t read_uniform_grid(const ParamSet& params, const Mat4& world_from_medium,
                           const DirectiveContext& ctx) {
   const std::vector<Float> density = params.get_floats("density");
   if (density.empty()) ctx.fail("uniformgrid medium needs \"float density\" values");
-  const int32_t nx = params.get_int("nx", 1), ny = params.get_int("ny", 1), nz = params.get_int("nz", 1);
-  if (nx < 1 || ny < 1 || nz < 1) ctx.fail("uniformgrid \"nx\", \"ny\" and \"nz\" must be positive");
+  int32_t nx, ny, nz;
+  read_dims(params, "uniformgrid", ctx, &nx, &ny, &nz);
   const uint64_t n = static_cast<uint64_t>(nx) * static_cast<uint64_t>(ny) * static_cast<uint64_t>(nz);
-  if (n != density.size())
-    ctx.fail("uniformgrid has " + std::to_string(density.size()) + " density values; nx*ny*nz = " + std::to_string(n));
+  check_count(density.size(), n, "uniformgrid", "density", ctx);
   for (Float d : density)
     if (!(d >= 0.f) || !std::isfinite(d)) ctx.fail("uniformgrid densities must be finite and not negative");
   Vec3 p0, p1;
@@ -187,8 +199,8 @@ int32_t read_cloud(const ParamSet& params, const Mat4& world_from_medium, const 
 // sigma_a, as in pbrt-v4). The majorant cells bound the extinction of any
 // wavelength: an RGB's spectrum stays below twice its largest component.
 int32_t read_rgb_grid(const ParamSet& params, const Mat4& world_from_medium, Medium* m, const DirectiveContext& ctx) {
-  const int32_t nx = params.get_int("nx", 1), ny = params.get_int("ny", 1), nz = params.get_int("nz", 1);
-  if (nx < 1 || ny < 1 || nz < 1) ctx.fail("rgbgrid \"nx\", \"ny\" and \"nz\" must be positive");
+  int32_t nx, ny, nz;
+  read_dims(params, "rgbgrid", ctx, &nx, &ny, &nz);
   const uint64_t n = static_cast<uint64_t>(nx) * static_cast<uint64_t>(ny) * static_cast<uint64_t>(nz);
   const std::vector<Rgb> sigma_a = params.get_rgbs("sigma_a"), sigma_s = params.get_rgbs("sigma_s"),
                          le = params.get_rgbs("Le");
@@ -197,8 +209,7 @@ int32_t read_rgb_grid(const ParamSet& params, const Mat4& world_from_medium, Med
   const std::pair<const char*, const std::vector<Rgb>*> grids[3] = {{"sigma_a", &sigma_a}, {"sigma_s", &sigma_s}, {"Le", &le}};
   for (const auto& [name, values] : grids) {
     if (values->empty()) continue;
-    if (values->size() != n)
-      ctx.fail("rgbgrid has " + std::to_string(values->size()) + " \"" + name + "\" values; nx*ny*nz = " + std::to_string(n));
+    check_count(values->size(), n, "rgbgrid", std::string("\"") + name + "\"", ctx);
     for (const Rgb& v : *values)
       if (!valid_coefficient(v)) ctx.fail(std::string("rgbgrid \"") + name + "\" values must be finite and not negative");
   }
@@ -295,7 +306,7 @@ int32_t read_nanovdb(const ParamSet& params, const Mat4& world_from_medium, Medi
     g.majorants.max_density = {0.f};  // an empty grid: no collision anywhere
   }
   read_temperature_mapping(params, "nanovdb", &g, ctx);
-  if (temperature.found && le_scale > 0.f) {
+  if (temperature.found) {  // (read only where Lescale > 0)
     g.temperature = std::move(temperature.lattice);
     g.temperature.lattice_from_world = g.temperature.lattice_from_world * medium_from_world;
     g.blackbody_scale = le_scale;
@@ -318,7 +329,7 @@ bool medium_preset(const std::string& name, Rgb* sigma_a, Rgb* sigma_s) {
   return false;
 }
 
-std::optional<Medium> make_medium(const std::string& type, const ParamSet& params, const Mat4& world_from_medium,
+Medium make_medium(const std::string& type, const ParamSet& params, const Mat4& world_from_medium,
                                   const DirectiveContext& ctx) {
   if (type != "homogeneous" && type != "uniformgrid" && type != "nanovdb" && type != "cloud" && type != "rgbgrid")
     ctx.fail("unknown medium type \"" + type + "\"");

@@ -1,19 +1,17 @@
 // pbrt-v4 MakeNamedMedium: "homogeneous" media (sigma_a, sigma_s, scale, g,
-// Le, Lescale, and pbrt's measured "preset" names) and "uniformgrid" ones
-// (the same, scaled by a density grid over a box).
+// Le, Lescale, and pbrt's measured "preset" names) and the grid media
+// "uniformgrid", "rgbgrid", "nanovdb" and "cloud".
 #pragma once
 
-#include <optional>
 #include <string>
 
 #include "scene/pbrt_context.h"
 
 namespace tessera {
 
-// A uniformgrid's densities are added to ctx.scene.grids, its box placed by
-// world_from_medium (the CTM). nullopt (with a warning) for rgbgrid, cloud
-// and nanovdb, which are not simulated: shapes bounding them enclose vacuum.
-std::optional<Medium> make_medium(const std::string& type, const ParamSet& params, const Mat4& world_from_medium,
+// A grid medium's lattices are added to ctx.scene.grids, its box placed by
+// world_from_medium (the CTM). Unknown types and bad values are errors.
+Medium make_medium(const std::string& type, const ParamSet& params, const Mat4& world_from_medium,
                                   const DirectiveContext& ctx);
 
 // A preset's scattering and absorption coefficients in mm^-1, as pbrt-v4's

@@ -460,13 +460,10 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     if (state_.ctm_end != state_.ctm) warn("a moving medium is not supported; it stays where it starts");
     // Before WorldBegin the CTM is world-space: place the medium in render space too.
     const Mat4 render_from_medium(world_begun_ ? state_.ctm : render_from_world_ * state_.ctm);
-    if (std::optional<Medium> m = make_medium(type, ps, render_from_medium, context(at, including_dir))) {
-      if (scene_.media.size() >= static_cast<size_t>(INT16_MAX)) fail(at, "too many media (at most 32767)");
-      scene_.media.push_back(*m);
-      names_.media[name] = static_cast<int32_t>(scene_.media.size() - 1);
-    } else {
-      names_.media[name] = -1;
-    }
+    const Medium m = make_medium(type, ps, render_from_medium, context(at, including_dir));
+    if (scene_.media.size() >= static_cast<size_t>(INT16_MAX)) fail(at, "too many media (at most 32767)");
+    scene_.media.push_back(m);
+    names_.media[name] = static_cast<int32_t>(scene_.media.size() - 1);
     ps.report_unused(warnings);
   } else if (d == "MediumInterface") {
     // One name: the same medium on both sides; two: inside, then outside.
