@@ -15,7 +15,7 @@ TESSERA_HOST_DEVICE inline bool alpha_ignores_hit(const SceneView& s, uint32_t t
                                                   const Vec3& d) {
   const TextureSlot& slot = s.triangle_alpha[tri];
   Float a = slot.value.x;
-  if (slot.texture >= 0) a = eval_slot(s, slot, triangle_uv(s, tri, b1, b2)).x;
+  if (slot.texture >= 0) a = eval_slot(s, slot, texture_point(make_surface_hit(s, tri, b1, b2))).x;
   if (a >= 1.f) return false;
   if (!(a > 0.f)) return true;
   const uint64_t h = mix_bits(hash_vec3(o) ^ (hash_vec3(d) * 0xd1b54a32d192ed03ull) ^

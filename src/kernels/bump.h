@@ -2,8 +2,9 @@
 // normals from a material's "displacement" float texture or "normalmap"
 // image. Bump: the normal of the surface displaced along its normal by
 // d(u, v), from finite differences of d; without ray differentials the step
-// is pbrt-v4's fallback, 0.0005 in u and v, and the d * dn/du term (curvature
-// of interpolated normals) is left out. Normal map: the image's RGB as a
+// is pbrt-v4's fallback, 0.0005 in u and v (the point moved along dp/du,
+// dp/dv by as much), and the d * dn/du term (curvature of interpolated
+// normals) is left out. Normal map: the image's RGB as a
 // tangent-space normal (2 rgb - 1) in the frame (dp/du, n).
 #pragma once
 
@@ -38,9 +39,12 @@ TESSERA_HOST_DEVICE inline Vec3 bumped_shading_normal(const SceneView& s, int32_
   constexpr Float kDelta = 0.0005f;
   Vec3 dpdu, dpdv;
   shading_derivatives(s, h, &dpdu, &dpdv);
-  const Float d = eval_texture(s, bump, h.uv).x;
-  const Float du = eval_texture(s, bump, h.uv + Vec2(kDelta, 0.f)).x;
-  const Float dv = eval_texture(s, bump, h.uv + Vec2(0.f, kDelta)).x;
+  // pbrt-v4 shifts both the uv and the point (along the shading dp/du, dp/dv),
+  // so that 3D textures bump too.
+  const TexturePoint at = texture_point(h);
+  const Float d = eval_texture(s, bump, at).x;
+  const Float du = eval_texture(s, bump, TexturePoint{h.p + kDelta * dpdu, h.ng, h.uv + Vec2(kDelta, 0.f)}).x;
+  const Float dv = eval_texture(s, bump, TexturePoint{h.p + kDelta * dpdv, h.ng, h.uv + Vec2(0.f, kDelta)}).x;
   const Vec3 bu = dpdu + ((du - d) / kDelta) * h.ns, bv = dpdv + ((dv - d) / kDelta) * h.ns;
   return faced_shading_normal(glm::cross(bu, bv), h);
 }

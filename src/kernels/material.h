@@ -12,19 +12,36 @@ struct TextureSlot {
   Rgb value{0.f};        // constant (float parameters use value.x)
 };
 
-enum class TextureType : uint32_t { Constant = 0, Image, Scale, Checkerboard, Mix, Bilerp };
+enum class TextureType : uint32_t {
+  Constant = 0, Image, Scale, Checkerboard, Mix, Bilerp, Dots, DirectionMix, FBm, Wrinkled, Windy, Marble
+};
 
-// pbrt-v4 "uv" mapping: st = (su * u + du, sv * v + dv).
+// Where a texture reads its coordinates (pbrt-v4's TextureMapping2D and
+// TextureMapping3D). UV: st = (su * u + du, sv * v + dv). The others map the
+// hit point p through texture_from_render (the inverse of the CTM at the
+// Texture directive): Spherical and Cylindrical by its angles about the
+// texture-space origin, Planar by st = (du + p . vs, dv + p . vt), Point3D
+// (the 3D textures: fbm, wrinkled, windy, marble, 3D checkerboard) by p itself.
+enum class TextureMapping : uint32_t { UV = 0, Spherical, Cylindrical, Planar, Point3D };
+
 struct Texture {
   TextureType type = TextureType::Constant;
   Rgb value{0.f};            // Constant
   int32_t image = -1;        // Image: index into the scene's images
+  TextureMapping mapping = TextureMapping::UV;
   Float su = 1.f, sv = 1.f, du = 0.f, dv = 0.f;
-  Float scale = 1.f;         // Image: multiplier (pbrt "scale")
+  Mat4 texture_from_render{1.f};
+  Vec3 vs{1.f, 0.f, 0.f}, vt{0.f, 1.f, 0.f};  // Planar
+  Float scale = 1.f;         // Image: multiplier (pbrt "scale"); Marble: frequency
   bool invert = false;       // Image: 1 - value (pbrt "invert")
-  TextureSlot a, b;          // Scale: a * b ("tex" * "scale"); Checkerboard, Mix: tex1, tex2
+  TextureSlot a, b;          // Scale: a * b ("tex" * "scale"); Checkerboard, Mix, DirectionMix: tex1, tex2;
+                             // Dots: inside, outside the dots
   TextureSlot amount;        // Mix: (1 - amount) tex1 + amount tex2
   Rgb corners[4] = {Rgb(0.f), Rgb(1.f), Rgb(0.f), Rgb(1.f)};  // Bilerp: v00, v01, v10, v11 at (s, t) corners
+  int32_t octaves = 8;       // FBm, Wrinkled, Marble
+  Float omega = 0.5f;        // FBm, Wrinkled, Marble: pbrt "roughness", each octave's weight relative to the last
+  Float variation = 0.2f;    // Marble
+  Vec3 dir{0.f, 1.f, 0.f};   // DirectionMix: unit, render space; amount |n . dir| of tex1
 };
 
 // Linear RGB texels, row 0 is the top row of the file.

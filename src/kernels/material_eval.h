@@ -24,7 +24,7 @@ TESSERA_HOST_DEVICE inline const Material* resolve_material(const SceneView& s, 
                                                             const Vec3& wo) {
   const Material* m = &s.materials[material];
   for (int guard = 0; m->type == MaterialType::Mix && guard < 16; ++guard) {
-    Float amount = (Spec & kSpecTextures) ? eval_slot(s, m->amount, h.uv).x : m->amount.value.x;
+    Float amount = (Spec & kSpecTextures) ? eval_slot(s, m->amount, texture_point(h)).x : m->amount.value.x;
     int32_t pick;
     if (amount <= 0.f) pick = m->mix[0];  // pbrt-v4 MixMaterial::ChooseMaterial
     else if (amount >= 1.f) pick = m->mix[1];
@@ -49,14 +49,14 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
     m = resolve_material<Spec>(s, material, h, wo);
     if (m->type == MaterialType::Interface) return false;
   }
-  Rgb refl = (Spec & kSpecTextures) ? eval_slot(s, m->reflectance, h.uv) : m->reflectance.value;
+  Rgb refl = (Spec & kSpecTextures) ? eval_slot(s, m->reflectance, texture_point(h)) : m->reflectance.value;
   BsdfParams b;
   b.alpha_x = m->alpha_x;
   b.alpha_y = m->alpha_y;
   b.bump = m->bump;
   b.normal_map = m->normal_map;
   if ((Spec & kSpecTextures) && m->textured_roughness) {
-    Float ru = eval_slot(s, m->roughness_u, h.uv).x, rv = eval_slot(s, m->roughness_v, h.uv).x;
+    Float ru = eval_slot(s, m->roughness_u, texture_point(h)).x, rv = eval_slot(s, m->roughness_v, texture_point(h)).x;
     ru = ru > 0.f && ru < 1e30f ? ru : 0.f;  // NaN, Inf or negative texels: smooth
     rv = rv > 0.f && rv < 1e30f ? rv : 0.f;
     b.alpha_x = m->remap_roughness ? glm::sqrt(ru) : ru;  // pbrt-v4's RoughnessToAlpha
@@ -100,7 +100,7 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
       break;
     case MaterialType::DiffuseTransmission: {
       b.type = BsdfType::DiffuseTransmission;
-      const Rgb t = (Spec & kSpecTextures) ? eval_slot(s, m->transmittance, h.uv) : m->transmittance.value;
+      const Rgb t = (Spec & kSpecTextures) ? eval_slot(s, m->transmittance, texture_point(h)) : m->transmittance.value;
       // pbrt-v4 scales the spectra, then clamps.
       b.reflectance = glm::clamp(m->scale * spectral_albedo(s.spectral, wl, refl), Rgb(0.f), Rgb(1.f));
       b.transmittance = glm::clamp(m->scale * spectral_albedo(s.spectral, wl, t), Rgb(0.f), Rgb(1.f));

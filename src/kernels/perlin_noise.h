@@ -79,4 +79,30 @@ TESSERA_HOST_DEVICE inline Vec3 perlin_noise_gradient(const Vec3& p) {
          kDelta;
 }
 
+// pbrt-v4's FBm and Turbulence: octaves of noise at frequencies 1, 1.99,
+// 1.99^2, ... weighted 1, omega, omega^2, ... (turbulence sums |noise|).
+// pbrt-v4 drops the octaves finer than the ray differentials' footprint;
+// without ray differentials every one of max_octaves is summed, which is
+// pbrt-v4's value for a footprint of zero (turbulence then adds its
+// stand-in for the first dropped octave, 0.2 times its weight, as pbrt-v4 does).
+TESSERA_HOST_DEVICE inline Float fbm_noise(const Vec3& p, Float omega, int32_t max_octaves) {
+  Float sum = 0.f, lambda = 1.f, o = 1.f;
+  for (int32_t i = 0; i < max_octaves; ++i) {
+    sum += o * perlin_noise(lambda * p);
+    lambda *= 1.99f;
+    o *= omega;
+  }
+  return sum;
+}
+
+TESSERA_HOST_DEVICE inline Float turbulence_noise(const Vec3& p, Float omega, int32_t max_octaves) {
+  Float sum = 0.f, lambda = 1.f, o = 1.f;
+  for (int32_t i = 0; i < max_octaves; ++i) {
+    sum += o * glm::abs(perlin_noise(lambda * p));
+    lambda *= 1.99f;
+    o *= omega;
+  }
+  return sum + o * 0.2f;
+}
+
 }  // namespace tessera

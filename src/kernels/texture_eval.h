@@ -1,7 +1,10 @@
 // Evaluating textures at a surface point (point sampling; no ray differentials yet).
 #pragma once
 
+#include "procedural_texture.h"
 #include "scene_view.h"
+#include "surface.h"
+#include "texture_mapping.h"
 #include "vecmath.h"
 
 namespace tessera {
@@ -38,47 +41,78 @@ TESSERA_HOST_DEVICE inline Rgb image_lookup_nearest_equal_area(const ImageView& 
   return glm::max(img.texels[static_cast<size_t>(y) * img.width + x], Rgb(0.f));  // pbrt clamps negatives
 }
 
+// pbrt-v4's checkerboard weight of tex2 at a point (0 or 1: point sampled),
+// from the parity of the integer cells, computed in float so that huge or
+// NaN coordinates cannot overflow a cast.
+TESSERA_HOST_DEVICE inline bool checker_odd(Float cells_sum) {
+  const Float half = cells_sum * 0.5f;
+  return half != glm::floor(half);
+}
+
 // Textures may nest (scale of a checkerboard of images...). The recursion
 // terminates because the loader only lets a texture reference earlier ones.
-TESSERA_HOST_DEVICE inline Rgb eval_texture(const SceneView& s, int32_t tex_index, Vec2 uv) {
+TESSERA_HOST_DEVICE inline Rgb eval_texture(const SceneView& s, int32_t tex_index, const TexturePoint& tp) {
   const Texture& t = s.textures[tex_index];
-  Vec2 st(t.su * uv.x + t.du, t.sv * uv.y + t.dv);
+  auto slot = [&](const TextureSlot& slot) { return slot.texture >= 0 ? eval_texture(s, slot.texture, tp) : slot.value; };
   switch (t.type) {
     case TextureType::Constant:
       return t.value;
     case TextureType::Image: {
-      Rgb v = image_bilerp(s.images[t.image], st) * t.scale;
+      Rgb v = image_bilerp(s.images[t.image], texture_st(t, tp)) * t.scale;
       return t.invert ? glm::max(Rgb(0.f), Rgb(1.f) - v) : v;
     }
-    case TextureType::Scale: {
-      Rgb a = t.a.texture >= 0 ? eval_texture(s, t.a.texture, uv) : t.a.value;
-      Rgb b = t.b.texture >= 0 ? eval_texture(s, t.b.texture, uv) : t.b.value;
-      return a * b;
+    case TextureType::Scale: {  // pbrt-v4: a zero scale does not evaluate the texture
+      const Rgb b = slot(t.b);
+      return b == Rgb(0.f) ? b : slot(t.a) * b;
     }
     case TextureType::Checkerboard: {
-      // Parity of floor(s) + floor(t), computed in float so huge or NaN st cannot overflow a cast.
-      Float sum = glm::floor(st.x) + glm::floor(st.y);
-      Float half = sum * 0.5f;
-      int64_t parity = (half == glm::floor(half)) ? 0 : 1;
-      const TextureSlot& pick = (parity % 2 == 0) ? t.a : t.b;
-      return pick.texture >= 0 ? eval_texture(s, pick.texture, uv) : pick.value;
+      bool odd;
+      if (t.mapping == TextureMapping::Point3D) {
+        const Vec3 q = texture_space_point(t, tp.p);
+        odd = checker_odd(glm::floor(q.x) + glm::floor(q.y) + glm::floor(q.z));
+      } else {
+        const Vec2 st = texture_st(t, tp);
+        odd = checker_odd(glm::floor(st.x) + glm::floor(st.y));
+      }
+      return slot(odd ? t.b : t.a);
     }
     case TextureType::Mix: {  // pbrt-v4 MixTexture: a component with weight 0 is not evaluated
-      const Float amt = (t.amount.texture >= 0 ? eval_texture(s, t.amount.texture, uv) : t.amount.value).x;
+      const Float amt = slot(t.amount).x;
       Rgb v(0.f);
-      if (amt != 1.f) v += (1.f - amt) * (t.a.texture >= 0 ? eval_texture(s, t.a.texture, uv) : t.a.value);
-      if (amt != 0.f) v += amt * (t.b.texture >= 0 ? eval_texture(s, t.b.texture, uv) : t.b.value);
+      if (amt != 1.f) v += (1.f - amt) * slot(t.a);
+      if (amt != 0.f) v += amt * slot(t.b);
       return v;
     }
-    case TextureType::Bilerp:  // corners v00, v01, v10, v11 at (s, t) = (0,0), (0,1), (1,0), (1,1)
+    case TextureType::DirectionMix: {  // pbrt-v4: |n . dir| of tex1, the rest tex2
+      const Float amt = glm::abs(glm::dot(tp.n, t.dir));
+      Rgb v(0.f);
+      if (amt != 0.f) v += amt * slot(t.a);
+      if (amt != 1.f) v += (1.f - amt) * slot(t.b);
+      return v;
+    }
+    case TextureType::Bilerp: {  // corners v00, v01, v10, v11 at (s, t) = (0,0), (0,1), (1,0), (1,1)
+      const Vec2 st = texture_st(t, tp);
       return (1.f - st.x) * (1.f - st.y) * t.corners[0] + (1.f - st.x) * st.y * t.corners[1] +
              st.x * (1.f - st.y) * t.corners[2] + st.x * st.y * t.corners[3];
+    }
+    case TextureType::Dots:
+      return slot(inside_polka_dot(texture_st(t, tp)) ? t.a : t.b);
+    case TextureType::FBm:
+      return Rgb(fbm_noise(texture_space_point(t, tp.p), t.omega, t.octaves));
+    case TextureType::Wrinkled:
+      return Rgb(turbulence_noise(texture_space_point(t, tp.p), t.omega, t.octaves));
+    case TextureType::Windy:
+      return Rgb(windy_value(texture_space_point(t, tp.p)));
+    case TextureType::Marble:
+      return marble_value(t.scale * texture_space_point(t, tp.p), t.variation, t.omega, t.octaves);
   }
   return Rgb(0.f);
 }
 
-TESSERA_HOST_DEVICE inline Rgb eval_slot(const SceneView& s, const TextureSlot& slot, Vec2 uv) {
-  return slot.texture >= 0 ? eval_texture(s, slot.texture, uv) : slot.value;
+TESSERA_HOST_DEVICE inline Rgb eval_slot(const SceneView& s, const TextureSlot& slot, const TexturePoint& tp) {
+  return slot.texture >= 0 ? eval_texture(s, slot.texture, tp) : slot.value;
 }
+
+TESSERA_HOST_DEVICE inline TexturePoint texture_point(const SurfaceHit& h) { return TexturePoint{h.p, h.ng, h.uv}; }
 
 }  // namespace tessera

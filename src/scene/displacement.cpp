@@ -96,7 +96,7 @@ void displace_mesh(MeshDesc& m, const Mat4& world_from_object, Float edge_length
   }
   m.indices = std::move(out);
   for (size_t i = 0; i < m.p.size(); ++i) {
-    const Float d = displacement(m.uv[i]);
+    const Float d = displacement(m.p[i], m.n[i], m.uv[i]);
     if (!std::isfinite(d)) fail("the texture's value is not finite");
     m.p[i] += d * m.n[i];
   }
@@ -109,6 +109,8 @@ HostTextures::HostTextures(const SceneDesc& scene) {
   view_.images = images_.data();
 }
 
-Float HostTextures::eval(const TextureSlot& slot, Vec2 uv) const { return eval_slot(view_, slot, uv).x; }
+Float HostTextures::eval(const TextureSlot& slot, const Vec3& p, const Vec3& n, Vec2 uv) const {
+  return eval_slot(view_, slot, TexturePoint{p, n, uv}).x;
+}
 
 }  // namespace tessera

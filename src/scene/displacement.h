@@ -11,8 +11,9 @@
 
 namespace tessera {
 
-// A float texture's value at a vertex, in object space.
-using DisplacementFn = std::function<Float(Vec2 uv)>;
+// A float texture's value at a vertex: its object-space point and normal
+// (where pbrt-v4 evaluates displacement) and its uv.
+using DisplacementFn = std::function<Float(const Vec3& p, const Vec3& n, Vec2 uv)>;
 
 // Displaces an object-space mesh in place (quads already split). Throws
 // SceneError(reason) when the mesh has no uv (pbrt-v4 requires them), the
@@ -30,7 +31,7 @@ std::vector<Vec3> vertex_normals(const std::vector<Vec3>& p, const std::vector<u
 class HostTextures {
  public:
   explicit HostTextures(const SceneDesc& scene);
-  Float eval(const TextureSlot& slot, Vec2 uv) const;
+  Float eval(const TextureSlot& slot, const Vec3& p, const Vec3& n, Vec2 uv) const;
 
  private:
   std::vector<ImageView> images_;

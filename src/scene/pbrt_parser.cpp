@@ -381,7 +381,9 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     std::string kind = read_string(tokens, pos, at);
     std::string cls = read_string(tokens, pos, at);
     ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_);
-    make_named_texture(name, kind, cls, ps, context(at, including_dir));
+    // Before WorldBegin the CTM is world-space: the texture's space goes to render space too.
+    const DMat4 render_from_texture = world_begun_ ? state_.ctm : render_from_world_ * state_.ctm;
+    make_named_texture(name, kind, cls, ps, render_from_texture, context(at, including_dir));
     ps.report_unused(warnings);
   } else if (d == "LightSource") {
     std::string type = read_string(tokens, pos, at);
@@ -552,7 +554,7 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
     if (it == names_.float_textures.end()) fail(at, "unknown float texture \"" + name + "\" for \"displacement\"");
     auto textures = std::make_shared<HostTextures>(scene_);
     const TextureSlot slot{it->second, Rgb(0.f)};
-    return [textures, slot](Vec2 uv) { return textures->eval(slot, uv); };
+    return [textures, slot](const Vec3& p, const Vec3& n, Vec2 uv) { return textures->eval(slot, p, n, uv); };
   };
   std::optional<MeshDesc> mesh = make_shape_mesh(type, params, ctx);
   if (!mesh) {

@@ -1,6 +1,7 @@
 #include "scene/pbrt_textures.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "scene/image_io.h"
@@ -26,14 +27,59 @@ int32_t add_texture(const DirectiveContext& ctx, const Texture& t) {
   return static_cast<int32_t>(ctx.scene.textures.size() - 1);
 }
 
-// "uv" mapping parameters shared by imagemap and checkerboard.
-void read_uv_mapping(Texture& t, const ParamSet& params, const DirectiveContext& ctx) {
-  std::string mapping = params.get_string("mapping", "uv");
-  if (mapping != "uv") ctx.warn("texture mapping \"" + mapping + "\" is not supported; using \"uv\"");
+// The texture's space seen from render space: the inverse of the CTM at the
+// Texture directive (pbrt-v4's textureFromRender), needed by every mapping
+// but uv.
+Mat4 texture_from_render(const glm::dmat4& render_from_texture, const DirectiveContext& ctx) {
+  const Mat4 m(glm::inverse(render_from_texture));
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) ctx.fail("the texture's transformation is singular; its mapping needs its inverse");
+  return m;
+}
+
+// pbrt-v4's TextureMapping2D::Create: "uv" (uscale, vscale, udelta, vdelta),
+// "spherical", "cylindrical" or "planar" (v1, v2, udelta, vdelta).
+void read_mapping_2d(Texture& t, const ParamSet& params, const glm::dmat4& render_from_texture,
+                     const DirectiveContext& ctx) {
+  const std::string mapping = params.get_string("mapping", "uv");
+  if (mapping == "spherical" || mapping == "cylindrical" || mapping == "planar") {
+    t.mapping = mapping == "spherical"     ? TextureMapping::Spherical
+                : mapping == "cylindrical" ? TextureMapping::Cylindrical
+                                           : TextureMapping::Planar;
+    t.texture_from_render = texture_from_render(render_from_texture, ctx);
+    if (t.mapping == TextureMapping::Planar) {
+      t.vs = params.get_point3("v1").value_or(Vec3(1.f, 0.f, 0.f));
+      t.vt = params.get_point3("v2").value_or(Vec3(0.f, 1.f, 0.f));
+      t.du = params.get_float("udelta", 0.f);
+      t.dv = params.get_float("vdelta", 0.f);
+    }
+    return;
+  }
+  if (mapping != "uv") ctx.warn("2D texture mapping \"" + mapping + "\" unknown; using \"uv\" (as pbrt-v4 does)");
   t.su = params.get_float("uscale", 1.f);
   t.sv = params.get_float("vscale", 1.f);
   t.du = params.get_float("udelta", 0.f);
   t.dv = params.get_float("vdelta", 0.f);
+}
+
+// pbrt-v4's TextureMapping3D: the point in the texture's space.
+void set_mapping_3d(Texture& t, const glm::dmat4& render_from_texture, const DirectiveContext& ctx) {
+  t.mapping = TextureMapping::Point3D;
+  t.texture_from_render = texture_from_render(render_from_texture, ctx);
+}
+
+// "octaves" and "roughness" of the noise textures. Octaves past 32 have
+// frequencies beyond float resolution at any useful scale: clamped.
+void read_octaves(Texture& t, const ParamSet& params, const DirectiveContext& ctx) {
+  constexpr int kMaxOctaves = 32;
+  const int octaves = params.get_int("octaves", 8);
+  if (octaves < 0) ctx.fail("\"octaves\" must not be negative, got " + std::to_string(octaves));
+  if (octaves > kMaxOctaves)
+    ctx.warn("\"octaves\" " + std::to_string(octaves) + " clamped to " + std::to_string(kMaxOctaves) +
+             " (finer octaves are below float resolution)");
+  t.octaves = std::min(octaves, kMaxOctaves);
+  t.omega = params.get_float("roughness", 0.5f);
 }
 
 // A texture parameter that may be a value or a texture name, of either kind.
@@ -104,9 +150,14 @@ Float constant_float(const ParamSet& params, const std::string& name, Float fall
 }
 
 void make_named_texture(const std::string& name, const std::string& kind, const std::string& texture_class,
-                        const ParamSet& params, const DirectiveContext& ctx) {
+                        const ParamSet& params, const glm::dmat4& render_from_texture, const DirectiveContext& ctx) {
   const bool spectrum = kind == "spectrum" || kind == "color";
   if (!spectrum && kind != "float") ctx.fail("texture kind must be \"float\" or \"spectrum\", got \"" + kind + "\"");
+  // pbrt-v4 defines the noise textures for one kind only.
+  const bool float_only = texture_class == "fbm" || texture_class == "wrinkled" || texture_class == "windy";
+  if ((float_only && spectrum) || (texture_class == "marble" && !spectrum))
+    ctx.fail("\"" + texture_class + "\" is not a " + kind + " texture in pbrt-v4 (it is a " +
+             (float_only ? "float" : "spectrum") + " texture)");
   Texture t;
   if (texture_class == "constant") {
     t.type = TextureType::Constant;
@@ -118,7 +169,7 @@ void make_named_texture(const std::string& name, const std::string& kind, const 
     t.image = image_index(filename, params.get_string("encoding", "sRGB"), !spectrum, ctx);
     t.scale = params.get_float("scale", 1.f);
     t.invert = params.get_bool("invert", false);
-    read_uv_mapping(t, params, ctx);
+    read_mapping_2d(t, params, render_from_texture, ctx);
     // Filtering and wrapping: we always bilinear-filter and repeat.
     params.get_string("filter", "bilinear");
     params.get_float("maxanisotropy", 8.f);
@@ -130,15 +181,26 @@ void make_named_texture(const std::string& name, const std::string& kind, const 
     t.b = float_slot(params, "scale", 1.f, ctx);
   } else if (texture_class == "checkerboard") {
     t.type = TextureType::Checkerboard;
-    if (params.get_int("dimension", 2) != 2) ctx.warn("3D checkerboard textures are not supported; using 2D");
+    const int dimension = params.get_int("dimension", 2);
+    if (dimension != 2 && dimension != 3)
+      ctx.fail(std::to_string(dimension) + " dimensional checkerboard texture not supported (2 or 3)");
     t.a = any_slot(params, "tex1", spectrum, Rgb(1.f), ctx);
     t.b = any_slot(params, "tex2", spectrum, Rgb(0.f), ctx);
-    read_uv_mapping(t, params, ctx);
+    if (dimension == 3) set_mapping_3d(t, render_from_texture, ctx);
+    else read_mapping_2d(t, params, render_from_texture, ctx);
   } else if (texture_class == "mix") {
     t.type = TextureType::Mix;
     t.a = any_slot(params, "tex1", spectrum, Rgb(0.f), ctx);
     t.b = any_slot(params, "tex2", spectrum, Rgb(1.f), ctx);
     t.amount = float_slot(params, "amount", 0.5f, ctx);
+  } else if (texture_class == "directionmix") {
+    t.type = TextureType::DirectionMix;
+    t.a = any_slot(params, "tex1", spectrum, Rgb(0.f), ctx);
+    t.b = any_slot(params, "tex2", spectrum, Rgb(1.f), ctx);
+    const glm::dvec3 dir = glm::dmat3(render_from_texture) * glm::dvec3(params.get_point3("dir").value_or(Vec3(0.f, 1.f, 0.f)));
+    const double len = glm::length(dir);
+    if (!(len > 0.0) || !std::isfinite(len)) ctx.fail("directionmix \"dir\" must be a non-zero, finite direction");
+    t.dir = Vec3(dir / len);
   } else if (texture_class == "bilerp") {
     t.type = TextureType::Bilerp;
     const char* names[4] = {"v00", "v01", "v10", "v11"};
@@ -146,7 +208,28 @@ void make_named_texture(const std::string& name, const std::string& kind, const 
     for (int i = 0; i < 4; ++i)
       t.corners[i] = spectrum ? params.get_rgb(names[i]).value_or(Rgb(defaults[i]))
                               : Rgb(params.get_float(names[i], defaults[i]));
-    read_uv_mapping(t, params, ctx);
+    read_mapping_2d(t, params, render_from_texture, ctx);
+  } else if (texture_class == "dots") {
+    // pbrt-v4's DotsTexture constructor takes (outside, inside) but its
+    // Create passes ("inside", "outside"): the dots show "outside" and the
+    // rest "inside". We draw what pbrt-v4 draws.
+    t.type = TextureType::Dots;
+    t.a = any_slot(params, "outside", spectrum, Rgb(0.f), ctx);
+    t.b = any_slot(params, "inside", spectrum, Rgb(1.f), ctx);
+    read_mapping_2d(t, params, render_from_texture, ctx);
+  } else if (texture_class == "fbm" || texture_class == "wrinkled") {
+    t.type = texture_class == "fbm" ? TextureType::FBm : TextureType::Wrinkled;
+    read_octaves(t, params, ctx);
+    set_mapping_3d(t, render_from_texture, ctx);
+  } else if (texture_class == "windy") {
+    t.type = TextureType::Windy;
+    set_mapping_3d(t, render_from_texture, ctx);
+  } else if (texture_class == "marble") {
+    t.type = TextureType::Marble;
+    read_octaves(t, params, ctx);
+    t.scale = params.get_float("scale", 1.f);
+    t.variation = params.get_float("variation", 0.2f);
+    set_mapping_3d(t, render_from_texture, ctx);
   } else {
     ctx.warn("unsupported texture class \"" + texture_class + "\"; using a constant 0.5");
     t.type = TextureType::Constant;

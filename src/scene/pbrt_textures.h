@@ -10,9 +10,10 @@
 namespace tessera {
 
 // Texture "name" "float"|"spectrum" "class" ...: appends to scene.textures and
-// registers the name. Unsupported classes warn and become a constant 0.5.
+// registers the name. render_from_texture: the CTM at the directive. Unsupported
+// classes (ptex) warn and become a constant 0.5.
 void make_named_texture(const std::string& name, const std::string& kind, const std::string& texture_class,
-                        const ParamSet& params, const DirectiveContext& ctx);
+                        const ParamSet& params, const glm::dmat4& render_from_texture, const DirectiveContext& ctx);
 
 // A spectrum parameter: "texture name" → named texture (unknown → SceneError),
 // else rgb/spectrum/blackbody constant, else `fallback`.

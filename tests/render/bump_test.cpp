@@ -53,6 +53,28 @@ TEST(Bump, LinearDisplacementTiltsTheNormalByItsSlope) {
   std::filesystem::remove_all(dir);
 }
 
+// A displacement read through the hit point, not its uv (a planar mapping,
+// like pbrt-v4's 3D textures): pbrt-v4 moves the point along dp/du and
+// dp/dv as it steps u and v, so the slope in space becomes a slope in u.
+TEST(Bump, PointMappedDisplacementTiltsTheNormalToo) {
+  // d = 0.5 x; the quad is 2 x 2 with u along x, so d rises by 1 per unit u.
+  const std::string scene =
+      "WorldBegin\n"
+      "Texture \"x\" \"float\" \"bilerp\" \"string mapping\" \"planar\" \"float v10\" 1 \"float v11\" 1 "
+      "\"float v01\" 0\n"
+      "Texture \"d\" \"float\" \"scale\" \"texture tex\" \"x\" \"float scale\" 0.5\n"
+      "Material \"diffuse\" \"texture displacement\" \"d\"\n"
+      "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  2 0 0  2 2 0  0 2 0 ] "
+      "\"integer indices\" [ 0 1 2 0 2 3 ] \"point2 uv\" [ 0 0 1 0 1 1 0 1 ]\n";
+  SceneData data(load_pbrt_string(scene, "<bump>", "."));
+  const SceneView& s = data.view();
+  const SurfaceHit h = make_surface_hit(s, 0, 0.3f, 0.2f);
+  const Vec3 n = bumped_shading_normal(s, s.materials[s.triangles[0].material].bump, h);
+  // cross(dpdu + 1 n, dpdv) = cross((2, 0, 1), (0, 2, 0)) = (-2, 0, 4).
+  EXPECT_NEAR(n.y, 0.f, 1e-4f);
+  EXPECT_NEAR(n.x / n.z, -0.5f, 2e-3f);
+}
+
 TEST(Bump, NormalMapRgbIsATangentSpaceNormal) {
   const auto dir = std::filesystem::temp_directory_path() / "tessera_normal_map_test";
   std::filesystem::create_directories(dir);

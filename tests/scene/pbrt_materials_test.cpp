@@ -144,16 +144,16 @@ TEST(PbrtTextures, MixAndBilerpEvaluateAsPbrtV4s) {
   EXPECT_EQ(s.textures[1].type, TextureType::Mix);
   const HostTextures t(s);
   // The amount rises with s (v10 = v11 = 1): tex1 at s = 0, tex2 at s = 1.
-  EXPECT_FLOAT_EQ(t.eval(TextureSlot{0, Rgb(0.f)}, Vec2(0.25f, 0.7f)), 0.25f);
-  EXPECT_FLOAT_EQ(t.eval(TextureSlot{1, Rgb(0.f)}, Vec2(0.f, 0.3f)), 2.f);
-  EXPECT_FLOAT_EQ(t.eval(TextureSlot{1, Rgb(0.f)}, Vec2(0.75f, 0.3f)), 3.5f);
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{0, Rgb(0.f)}, Vec3(0.f), Vec3(0.f, 0.f, 1.f), Vec2(0.25f, 0.7f)), 0.25f);
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{1, Rgb(0.f)}, Vec3(0.f), Vec3(0.f, 0.f, 1.f), Vec2(0.f, 0.3f)), 2.f);
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{1, Rgb(0.f)}, Vec3(0.f), Vec3(0.f, 0.f, 1.f), Vec2(0.75f, 0.3f)), 3.5f);
   // pbrt-v4's defaults: tex1 0, tex2 1, amount 0.5.
-  EXPECT_FLOAT_EQ(t.eval(TextureSlot{2, Rgb(0.f)}, Vec2(0.3f, 0.3f)), 0.5f);
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{2, Rgb(0.f)}, Vec3(0.f), Vec3(0.f, 0.f, 1.f), Vec2(0.3f, 0.3f)), 0.5f);
   EXPECT_TRUE(s.warnings.empty());
 }
 
 TEST(PbrtTextures, UnsupportedClassWarnsConstantHalf) {
-  SceneDesc s = load_world(std::string("Texture \"n\" \"float\" \"fbm\" \"integer octaves\" 4\n") + kTriangle);
+  SceneDesc s = load_world(std::string("Texture \"n\" \"float\" \"ptex\" \"string filename\" \"a.ptx\"\n") + kTriangle);
   ASSERT_EQ(s.textures.size(), 1u);
   EXPECT_VEC3_NEAR(s.textures[0].value, Vec3(0.5f), 1e-6f);
   ASSERT_EQ(s.warnings.size(), 1u);
