@@ -96,7 +96,7 @@ void displace_mesh(MeshDesc& m, const Mat4& world_from_object, Float edge_length
   }
   m.indices = std::move(out);
   for (size_t i = 0; i < m.p.size(); ++i) {
-    const Float d = displacement(m.p[i], m.n[i], m.uv[i]);
+    const Float d = displacement(m.p[i], m.uv[i]);
     if (!std::isfinite(d)) fail("the texture's value is not finite");
     m.p[i] += d * m.n[i];
   }

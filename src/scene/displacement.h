@@ -11,9 +11,9 @@
 
 namespace tessera {
 
-// A float texture's value at a vertex: its object-space point and normal
-// (where pbrt-v4 evaluates displacement) and its uv.
-using DisplacementFn = std::function<Float(const Vec3& p, const Vec3& n, Vec2 uv)>;
+// A float texture's value at a vertex: its object-space point (where pbrt-v4
+// evaluates displacement) and its uv.
+using DisplacementFn = std::function<Float(const Vec3& p, Vec2 uv)>;
 
 // Displaces an object-space mesh in place (quads already split). Throws
 // SceneError(reason) when the mesh has no uv (pbrt-v4 requires them), the

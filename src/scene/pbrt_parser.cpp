@@ -554,7 +554,8 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
     if (it == names_.float_textures.end()) fail(at, "unknown float texture \"" + name + "\" for \"displacement\"");
     auto textures = std::make_shared<HostTextures>(scene_);
     const TextureSlot slot{it->second, Rgb(0.f)};
-    return [textures, slot](const Vec3& p, const Vec3& n, Vec2 uv) { return textures->eval(slot, p, n, uv); };
+    // pbrt-v4 sets only p and uv of the context it displaces with: the normal is 0.
+    return [textures, slot](const Vec3& p, Vec2 uv) { return textures->eval(slot, p, Vec3(0.f), uv); };
   };
   std::optional<MeshDesc> mesh = make_shape_mesh(type, params, ctx);
   if (!mesh) {
