@@ -70,7 +70,8 @@ std::vector<Param> parse_param_list(TokenStream& tokens, size_t& pos) {
         // Integers are read as int: a value beyond its range would convert with undefined behaviour.
         if (p.type == "integer" && !(std::abs(v.number) <= 2147483647.0))
           fail(v.where(), "integer '" + v.text + "' for \"" + decl.text + "\" is out of range");
-        p.numbers.push_back(v.number);
+        if (p.type == "integer") p.integers.push_back(static_cast<int32_t>(v.number));
+        else p.numbers.push_back(static_cast<Float>(v.number));
       }
     };
     if (!tokens.has(pos)) fail(p.where, "missing value for parameter \"" + decl.text + "\"");
@@ -96,9 +97,10 @@ std::vector<Param> parse_param_list(TokenStream& tokens, size_t& pos) {
       take(tokens[pos++]);
     }
 
-    if (numeric && p.numbers.size() % width != 0)
+    const size_t count = p.numbers.size() + p.integers.size();
+    if (numeric && count % width != 0)
       fail(p.where, "\"" + decl.text + "\" needs a multiple of " + std::to_string(width) + " values, got " +
-                        std::to_string(p.numbers.size()));
+                        std::to_string(count));
     if (p.type == "spectrum") {
       if (!p.strings.empty() && (p.strings.size() != 1 || !p.numbers.empty()))
         fail(p.where, "\"" + decl.text + "\" takes one named spectrum or wavelength/value pairs");
@@ -138,12 +140,12 @@ const Param* ParamSet::find_any(const std::string& name) const {
 
 Float ParamSet::get_float(const std::string& name, Float fallback) const {
   const Param* p = find(name, {"float"});
-  return p && !p->numbers.empty() ? static_cast<Float>(p->numbers[0]) : fallback;
+  return p && !p->numbers.empty() ? p->numbers[0] : fallback;
 }
 
 int ParamSet::get_int(const std::string& name, int fallback) const {
   const Param* p = find(name, {"integer"});
-  return p && !p->numbers.empty() ? static_cast<int>(p->numbers[0]) : fallback;
+  return p && !p->integers.empty() ? p->integers[0] : fallback;
 }
 
 bool ParamSet::get_bool(const std::string& name, bool fallback) const {
@@ -159,21 +161,18 @@ std::string ParamSet::get_string(const std::string& name, const std::string& fal
 std::optional<Vec3> ParamSet::get_point3(const std::string& name) const {
   const Param* p = find(name, {"point3", "vector3", "normal3"});
   if (!p || p->numbers.size() < 3) return std::nullopt;
-  return Vec3(static_cast<Float>(p->numbers[0]), static_cast<Float>(p->numbers[1]), static_cast<Float>(p->numbers[2]));
+  return Vec3(p->numbers[0], p->numbers[1], p->numbers[2]);
 }
 
 std::vector<Float> ParamSet::get_floats(const std::string& name) const {
-  std::vector<Float> out;
-  if (const Param* p = find(name, {"float"}))
-    for (double v : p->numbers) out.push_back(static_cast<Float>(v));
-  return out;
+  const Param* p = find(name, {"float"});
+  return p ? p->numbers : std::vector<Float>{};
 }
 
-std::vector<int> ParamSet::get_ints(const std::string& name) const {
-  std::vector<int> out;
-  if (const Param* p = find(name, {"integer"}))
-    for (double v : p->numbers) out.push_back(static_cast<int>(v));
-  return out;
+const std::vector<int32_t>& ParamSet::get_ints(const std::string& name) const {
+  static const std::vector<int32_t> kNone;
+  const Param* p = find(name, {"integer"});
+  return p ? p->integers : kNone;
 }
 
 std::vector<std::string> ParamSet::get_strings(const std::string& name) const {
@@ -186,8 +185,8 @@ std::vector<Vec3> as_vec3s(const Param* p) {
   std::vector<Vec3> out;
   if (!p) return out;
   for (size_t i = 0; i + 2 < p->numbers.size(); i += 3)
-    out.emplace_back(static_cast<Float>(p->numbers[i]), static_cast<Float>(p->numbers[i + 1]),
-                     static_cast<Float>(p->numbers[i + 2]));
+    out.emplace_back(p->numbers[i], p->numbers[i + 1],
+                     p->numbers[i + 2]);
   return out;
 }
 }  // namespace
@@ -202,7 +201,7 @@ std::vector<Vec2> ParamSet::get_point2s(const std::string& name) const {
   if (!p) return out;
   if (p->numbers.size() % 2 != 0) fail(p->where, "\"" + p->type + " " + name + "\" needs pairs of values");
   for (size_t i = 0; i + 1 < p->numbers.size(); i += 2)
-    out.emplace_back(static_cast<Float>(p->numbers[i]), static_cast<Float>(p->numbers[i + 1]));
+    out.emplace_back(p->numbers[i], p->numbers[i + 1]);
   return out;
 }
 
@@ -212,19 +211,19 @@ std::optional<Rgb> ParamSet::get_rgb(const std::string& name, bool allow_float) 
   if (!p) return std::nullopt;
   if (p->type == "rgb") {
     if (p->numbers.size() != 3) fail(p->where, "\"rgb " + name + "\" takes exactly 3 values");
-    return Rgb(static_cast<Float>(p->numbers[0]), static_cast<Float>(p->numbers[1]), static_cast<Float>(p->numbers[2]));
+    return Rgb(p->numbers[0], p->numbers[1], p->numbers[2]);
   }
   if (p->type == "float") {
     if (p->numbers.empty()) fail(p->where, "\"float " + name + "\" has no value");
-    return Rgb(static_cast<Float>(p->numbers[0]));
+    return Rgb(p->numbers[0]);
   }
-  if (p->type == "blackbody") return blackbody_rgb(static_cast<Float>(p->numbers[0]));
+  if (p->type == "blackbody") return blackbody_rgb(p->numbers[0]);
   // spectrum
   if (!p->strings.empty()) {
     if (auto rgb = named_spectrum_rgb(p->strings[0])) return *rgb;
     fail(p->where, "unknown named spectrum \"" + p->strings[0] + "\"");
   }
-  std::vector<Float> pairs(p->numbers.begin(), p->numbers.end());
+  const std::vector<Float>& pairs = p->numbers;
   if (warnings)
     warnings->push_back(p->where + ": \"spectrum " + name + "\" given as samples" +
                         (p->file.empty() ? std::string() : " (file '" + p->file + "')") + "; using an approximate RGB");
@@ -236,8 +235,8 @@ std::vector<Rgb> ParamSet::get_rgbs(const std::string& name) const {
   const Param* p = find(name, {"rgb"});
   if (!p) return out;
   for (size_t i = 0; i + 2 < p->numbers.size(); i += 3)
-    out.emplace_back(static_cast<Float>(p->numbers[i]), static_cast<Float>(p->numbers[i + 1]),
-                     static_cast<Float>(p->numbers[i + 2]));
+    out.emplace_back(p->numbers[i], p->numbers[i + 1],
+                     p->numbers[i + 2]);
   return out;
 }
 

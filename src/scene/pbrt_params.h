@@ -15,7 +15,10 @@ namespace tessera {
 struct Param {
   std::string type;  // as written, e.g. "point3", "rgb", "texture"
   std::string name;
-  std::vector<double> numbers;       // numeric types, spectrum sample pairs
+  // Numbers as pbrt-v4 keeps them: "integer" values as int, the rest
+  // (point3, rgb, spectrum sample pairs...) as Float.
+  std::vector<Float> numbers;
+  std::vector<int32_t> integers;
   std::vector<std::string> strings;  // string, texture, named spectrum
   std::vector<bool> bools;
   std::string where;  // "file:line" of the declaration
@@ -36,7 +39,9 @@ class ParamSet {
   std::string get_string(const std::string& name, const std::string& fallback) const;
   std::optional<Vec3> get_point3(const std::string& name) const;  // also "point", "vector3"...
   std::vector<Float> get_floats(const std::string& name) const;
-  std::vector<int> get_ints(const std::string& name) const;
+  // The values of an "integer" array, read in place (a mesh's indices are
+  // millions); empty if absent.
+  const std::vector<int32_t>& get_ints(const std::string& name) const;
   std::vector<std::string> get_strings(const std::string& name) const;
   std::vector<Vec3> get_point3s(const std::string& name) const;
   std::vector<Vec3> get_normals(const std::string& name) const;

@@ -161,9 +161,10 @@ DirectiveContext PbrtParser::context(const Token& at, const std::string& includi
   return DirectiveContext{scene_, names_, at.where(), including_dir, search_dir_};
 }
 
-void PbrtParser::parse_text(const std::string& text, const std::string& file_name, const std::string& including_dir) {
-  TokenStream tokens(text, file_name);
+int PbrtParser::parse_stream(std::istream& in, const std::string& file_name, const std::string& including_dir) {
+  TokenStream tokens(in, file_name);
   parse_tokens(tokens, including_dir);
+  return tokens.last_line();
 }
 
 void PbrtParser::parse_tokens(TokenStream& tokens, const std::string& including_dir) {
@@ -278,10 +279,8 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     std::ifstream in(path, std::ios::binary);
     if (!in) fail(at, d + " file '" + path + "' not found or unreadable");
     if (include_depth_ >= kMaxIncludeDepth) fail(at, d + " nested too deeply (recursive include?)");
-    std::stringstream text;
-    text << in.rdbuf();
     ++include_depth_;
-    parse_text(text.str(), path, directory_of(path));
+    parse_stream(in, path, directory_of(path));
     --include_depth_;
   } else if (d == "WorldBegin") {
     if (world_begun_) fail(at, "WorldBegin appears twice");

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <map>
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -17,8 +18,9 @@ class PbrtParser {
   // `search_dir`: the main file's directory, the fallback for relative names.
   explicit PbrtParser(std::string search_dir);
 
-  // Parses one file's text (Include/Import recurse into here). Throws SceneError.
-  void parse_text(const std::string& text, const std::string& file_name, const std::string& including_dir);
+  // Parses one file, read from `in` in chunks (Include/Import recurse into
+  // here). Returns its last line. Throws SceneError.
+  int parse_stream(std::istream& in, const std::string& file_name, const std::string& including_dir);
 
   // Checks for a missing WorldBegin and an empty scene, reporting `file:last_line`.
   SceneDesc finish(const std::string& file_name, int last_line);

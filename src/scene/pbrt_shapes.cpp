@@ -20,14 +20,14 @@ void warn(const ShapeContext& ctx, const std::string& message) {
 }
 
 // Indices must be triangles (or patches of `per_face`) within the vertex list.
-std::vector<uint32_t> checked_indices(const std::vector<int>& raw, size_t vertex_count, size_t per_face,
+std::vector<uint32_t> checked_indices(const std::vector<int32_t>& raw, size_t vertex_count, size_t per_face,
                                       const std::string& shape, const ShapeContext& ctx) {
   if (raw.size() % per_face != 0)
     fail(ctx, shape + " \"indices\" count " + std::to_string(raw.size()) + " is not a multiple of " +
                   std::to_string(per_face));
   std::vector<uint32_t> out;
   out.reserve(raw.size());
-  for (int i : raw) {
+  for (int32_t i : raw) {
     if (i < 0 || static_cast<size_t>(i) >= vertex_count)
       fail(ctx, shape + " index " + std::to_string(i) + " out of range (" + std::to_string(vertex_count) +
                     " vertices)");
@@ -50,12 +50,10 @@ MeshDesc triangle_mesh(const ParamSet& params, const ShapeContext& ctx) {
   MeshDesc m;
   m.p = params.get_point3s("P");
   if (m.p.empty()) fail(ctx, "trianglemesh needs \"point3 P\"");
-  std::vector<int> raw = params.get_ints("indices");
-  if (raw.empty()) {
-    if (m.p.size() != 3) fail(ctx, "trianglemesh needs \"integer indices\" unless it has exactly 3 vertices");
-    raw = {0, 1, 2};
-  }
-  m.indices = checked_indices(raw, m.p.size(), 3, "trianglemesh", ctx);
+  static const std::vector<int32_t> kOneTriangle = {0, 1, 2};
+  const std::vector<int32_t>& given = params.get_ints("indices");
+  if (given.empty() && m.p.size() != 3) fail(ctx, "trianglemesh needs \"integer indices\" unless it has exactly 3 vertices");
+  m.indices = checked_indices(given.empty() ? kOneTriangle : given, m.p.size(), 3, "trianglemesh", ctx);
   m.uv = params.get_point2s("uv");
   if (m.uv.empty()) m.uv = params.get_point2s("st");  // pbrt-v3 name
   m.n = params.get_normals("N");
@@ -68,12 +66,10 @@ MeshDesc triangle_mesh(const ParamSet& params, const ShapeContext& ctx) {
 MeshDesc bilinear_mesh(const ParamSet& params, const ShapeContext& ctx) {
   std::vector<Vec3> p = params.get_point3s("P");
   if (p.empty()) fail(ctx, "bilinearmesh needs \"point3 P\"");
-  std::vector<int> raw = params.get_ints("indices");
-  if (raw.empty()) {
-    if (p.size() != 4) fail(ctx, "bilinearmesh needs \"integer indices\" unless it has exactly 4 vertices");
-    raw = {0, 1, 2, 3};
-  }
-  std::vector<uint32_t> quads = checked_indices(raw, p.size(), 4, "bilinearmesh", ctx);
+  static const std::vector<int32_t> kOneQuad = {0, 1, 2, 3};
+  const std::vector<int32_t>& given = params.get_ints("indices");
+  if (given.empty() && p.size() != 4) fail(ctx, "bilinearmesh needs \"integer indices\" unless it has exactly 4 vertices");
+  std::vector<uint32_t> quads = checked_indices(given.empty() ? kOneQuad : given, p.size(), 4, "bilinearmesh", ctx);
   MeshDesc m;
   m.p = std::move(p);
   m.uv = params.get_point2s("uv");
@@ -124,7 +120,7 @@ MeshDesc ply_mesh(const ParamSet& params, const ShapeContext& ctx) {
 MeshDesc loop_subdiv_mesh(const ParamSet& params, const ShapeContext& ctx) {
   std::vector<Vec3> p = params.get_point3s("P");
   if (p.empty()) fail(ctx, "loopsubdiv needs \"point3 P\"");
-  std::vector<int> raw = params.get_ints("indices");
+  const std::vector<int32_t>& raw = params.get_ints("indices");
   if (raw.empty()) fail(ctx, "loopsubdiv needs \"integer indices\"");
   const int levels = params.get_int("levels", 3);
   if (levels < 0) fail(ctx, "loopsubdiv \"levels\" must not be negative");

@@ -1,5 +1,6 @@
 #include "scene/pbrt_tokenizer.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -33,20 +34,44 @@ bool is_pbrt_directive_name(const std::string& word) {
   return false;
 }
 
+bool TokenStream::more() {
+  if (i_ < buf_.size()) return true;
+  buf_.resize(kChunk);
+  in_.read(buf_.data(), static_cast<std::streamsize>(kChunk));
+  buf_.resize(static_cast<size_t>(in_.gcount()));
+  i_ = 0;
+  if (in_.bad()) throw SceneError(file_ + ":" + std::to_string(line_) + ": cannot read the file");
+  if (buf_.empty()) return false;
+  empty_ = false;
+  ends_with_newline_ = buf_.back() == '\n';
+  return true;
+}
+
+template <typename Stop>
+void TokenStream::take_until(std::string* out, Stop stop) {
+  while (more()) {
+    const size_t start = i_;
+    while (i_ < buf_.size() && !stop(buf_[i_])) ++i_;
+    if (out) out->append(buf_, start, i_ - start);
+    if (i_ < buf_.size()) return;
+  }
+}
+
+int TokenStream::last_line() const { return std::max(1, empty_ || ends_with_newline_ ? line_ - 1 : line_); }
+
 bool TokenStream::produce() {
-  const size_t n = text_.size();
   auto fail = [&](int at_line, const std::string& problem) {
     throw SceneError(file_ + ":" + std::to_string(at_line) + ": " + problem);
   };
-  while (i_ < n) {
-    char c = text_[i_];
+  while (more()) {
+    char c = buf_[i_];
     if (c == '\n') {
       ++line_;
       ++i_;
     } else if (std::isspace(static_cast<unsigned char>(c))) {
       ++i_;
     } else if (c == '#') {
-      while (i_ < n && text_[i_] != '\n') ++i_;
+      take_until(nullptr, [](char d) { return d == '\n'; });  // a comment is the rest of its line
     } else if (c == '[' || c == ']') {
       window_.push_back({c == '[' ? TokenKind::OpenBracket : TokenKind::CloseBracket, std::string(1, c), 0., &file_, line_});
       ++i_;
@@ -56,16 +81,16 @@ bool TokenStream::produce() {
       std::string s;
       ++i_;
       bool closed = false;
-      while (i_ < n) {
-        char d = text_[i_++];
+      while (more()) {
+        char d = buf_[i_++];
         if (d == '"') {
           closed = true;
           break;
         }
         // pbrt strings cannot span lines; a newline means the quote was never closed.
         if (d == '\n') break;
-        if (d == '\\' && i_ < n) {
-          char e = text_[i_++];
+        if (d == '\\' && more()) {
+          char e = buf_[i_++];
           switch (e) {
             case 'n': s += '\n'; break;
             case 't': s += '\t'; break;
@@ -79,9 +104,8 @@ bool TokenStream::produce() {
       window_.push_back({TokenKind::String, std::move(s), 0., &file_, start_line});
       return true;
     } else {
-      size_t start = i_;
-      while (i_ < n && !is_delimiter(text_[i_])) ++i_;
-      std::string word = text_.substr(start, i_ - start);
+      std::string word;
+      take_until(&word, is_delimiter);
       if (starts_number(word[0])) {
         errno = 0;
         char* end = nullptr;

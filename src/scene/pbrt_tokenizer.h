@@ -3,6 +3,7 @@
 #pragma once
 
 #include <deque>
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -23,19 +24,18 @@ struct Token {
 };
 
 // The tokens of one file, made as the parser asks for them and dropped once
-// it has moved past them (release_before): a mesh of millions of numbers is
-// never held as millions of tokens. Indices count from the file's first
-// token. Throws SceneError, when the parser reaches it, for an unterminated
-// string or a malformed/non-finite number ("1.2.3", "1e999"). Words that are
-// not directives (e.g. "nan") are left to the parser, which knows whether a
-// number was expected. `text` and `file` must outlive the stream and its
-// tokens.
+// it has moved past them (release_before), from text read in chunks: a mesh
+// of millions of numbers is never held as its text nor as millions of
+// tokens. Indices count from the file's first token. Throws SceneError, when
+// the parser reaches it, for an unterminated string or a malformed/non-finite
+// number ("1.2.3", "1e999"). Words that are not directives (e.g. "nan") are
+// left to the parser, which knows whether a number was expected. `in` and
+// `file` must outlive the stream and its tokens.
 class TokenStream {
  public:
-  TokenStream(const std::string& text, const std::string& file) : text_(text), file_(file) {}
-  // Temporaries would leave the stream and its tokens pointing at freed strings.
-  TokenStream(std::string&&, const std::string&) = delete;
-  TokenStream(const std::string&, std::string&&) = delete;
+  TokenStream(std::istream& in, const std::string& file) : in_(in), file_(file) {}
+  // A temporary name would leave the tokens pointing at a freed string.
+  TokenStream(std::istream&, std::string&&) = delete;
   // Whether token `index` exists (making tokens up to it). False past the
   // end, and for tokens already released.
   bool has(size_t index);
@@ -43,13 +43,24 @@ class TokenStream {
   const Token& operator[](size_t index);
   // Drops the tokens before `index`.
   void release_before(size_t index);
+  // The file's last line (its line count, at least 1), once has() has
+  // returned false at the end.
+  int last_line() const;
 
  private:
+  static constexpr size_t kChunk = size_t(1) << 20;
   bool produce();  // appends the next token; false at the end of the text
+  bool more();     // whether a character is left, reading the next chunk if need be
+  // Consumes the characters up to the first one `stop` accepts (or the
+  // end), appending them to `out` unless it is null.
+  template <typename Stop>
+  void take_until(std::string* out, Stop stop);
 
-  const std::string& text_;
+  std::istream& in_;
   const std::string& file_;
-  size_t i_ = 0;  // next character
+  std::string buf_;  // the current chunk
+  size_t i_ = 0;     // next character in buf_
+  bool ends_with_newline_ = false, empty_ = true;
   int line_ = 1;
   size_t first_ = 0;  // index of window_.front()
   std::deque<Token> window_;
