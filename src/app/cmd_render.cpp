@@ -429,7 +429,7 @@ int run_render_farm(const RenderArgs& a) {
     if (widened && master)
       std::fprintf(stderr, "tessera: farm: rank 0 is alone on its machine; using all its cores (mpirun had bound it to fewer)\n");
     EmbreeScene embree(*m.scene);
-    const int32_t threads = render_threads(m.opt, t->ranks_on_this_machine());
+      const int32_t threads = render_threads(m.opt, t->ranks_on_this_machine());
     if (!master) {
       const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide != nullptr);
       run_farm_worker(*t, m.scene->view(), embree, make_tile_settings(m.opt, spec, m.guide != nullptr), m.guide.get(),

@@ -7,7 +7,20 @@
 #include "app/commands.h"
 #include "scene/scene_desc.h"
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 int main(int argc, char** argv) {
+#if defined(__GLIBC__)
+  // Buffers from 256 KiB up are mapped from the system and returned to it
+  // when freed. By default glibc raises this threshold to the size of each
+  // mapped buffer freed, so that after the first large free while a scene
+  // was read the next arrays came from its heap, which it rarely returns: a
+  // big mesh peaked higher and kept its transient arrays resident for the
+  // whole render. Rendering speed does not depend on it (measured).
+  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
+#endif
   CLI::App app{"tessera " TESSERA_VERSION " - path tracing with learned guiding (pbrt-v4 scenes, OpenEXR out)"};
   app.set_version_flag("--version", TESSERA_VERSION);
   app.require_subcommand(0, 1);

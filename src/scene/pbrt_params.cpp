@@ -31,6 +31,33 @@ int numeric_width(const std::string& t) {
 
 bool is_string_type(const std::string& t) { return t == "string" || t == "texture"; }
 
+// Values appended in blocks of 1 MiB (large enough that the allocator maps
+// each from the system and returns it when freed), released as one array.
+template <typename T>
+class BlockArray {
+ public:
+  void push_back(T v) {
+    if (blocks_.empty() || blocks_.back().size() == kBlock) blocks_.emplace_back().reserve(kBlock);
+    blocks_.back().push_back(v);
+  }
+  std::vector<T> release() {
+    size_t n = 0;
+    for (const std::vector<T>& b : blocks_) n += b.size();
+    std::vector<T> out;
+    out.reserve(n);
+    for (std::vector<T>& b : blocks_) {
+      out.insert(out.end(), b.begin(), b.end());
+      b = {};
+    }
+    blocks_.clear();
+    return out;
+  }
+
+ private:
+  static constexpr size_t kBlock = (size_t(1) << 20) / sizeof(T);
+  std::vector<std::vector<T>> blocks_;
+};
+
 }  // namespace
 
 std::vector<Param> parse_param_list(TokenStream& tokens, size_t& pos) {
@@ -51,6 +78,11 @@ std::vector<Param> parse_param_list(TokenStream& tokens, size_t& pos) {
     if (!numeric && !is_string_type(p.type) && p.type != "bool" && p.type != "spectrum")
       fail(p.where, "unknown parameter type '" + p.type + "' in \"" + decl.text + "\"");
 
+    // Numbers are gathered in blocks, then copied once into arrays of exactly
+    // their size: a growing vector would hold up to twice a mesh's array,
+    // and three times while it moves.
+    BlockArray<Float> numbers;
+    BlockArray<int32_t> integers;
     // Each value as it is read: one token, or a bracketed array of them,
     // released as it goes (a mesh's array is millions of tokens).
     auto take = [&](const Token& v) {
@@ -70,8 +102,8 @@ std::vector<Param> parse_param_list(TokenStream& tokens, size_t& pos) {
         // Integers are read as int: a value beyond its range would convert with undefined behaviour.
         if (p.type == "integer" && !(std::abs(v.number) <= 2147483647.0))
           fail(v.where(), "integer '" + v.text + "' for \"" + decl.text + "\" is out of range");
-        if (p.type == "integer") p.integers.push_back(static_cast<int32_t>(v.number));
-        else p.numbers.push_back(static_cast<Float>(v.number));
+        if (p.type == "integer") integers.push_back(static_cast<int32_t>(v.number));
+        else numbers.push_back(static_cast<Float>(v.number));
       }
     };
     if (!tokens.has(pos)) fail(p.where, "missing value for parameter \"" + decl.text + "\"");
@@ -97,6 +129,8 @@ std::vector<Param> parse_param_list(TokenStream& tokens, size_t& pos) {
       take(tokens[pos++]);
     }
 
+    p.numbers = numbers.release();
+    p.integers = integers.release();
     const size_t count = p.numbers.size() + p.integers.size();
     if (numeric && count % width != 0)
       fail(p.where, "\"" + decl.text + "\" needs a multiple of " + std::to_string(width) + " values, got " +
@@ -136,6 +170,14 @@ const Param* ParamSet::find_any(const std::string& name) const {
       return &p;
     }
   return nullptr;
+}
+
+void ParamSet::release(const std::string& name) const {
+  for (const Param& p : params_)
+    if (p.name == name) {
+      p.numbers = {};
+      p.integers = {};
+    }
 }
 
 Float ParamSet::get_float(const std::string& name, Float fallback) const {

@@ -17,8 +17,10 @@ struct Param {
   std::string name;
   // Numbers as pbrt-v4 keeps them: "integer" values as int, the rest
   // (point3, rgb, spectrum sample pairs...) as Float.
-  std::vector<Float> numbers;
-  std::vector<int32_t> integers;
+  // Mutable so that a shape can free a mesh's arrays as soon as it has
+  // converted them (ParamSet::release).
+  mutable std::vector<Float> numbers;
+  mutable std::vector<int32_t> integers;
   std::vector<std::string> strings;  // string, texture, named spectrum
   std::vector<bool> bools;
   std::string where;  // "file:line" of the declaration
@@ -53,6 +55,9 @@ class ParamSet {
   std::vector<Rgb> get_rgbs(const std::string& name) const;
   // Name of a "texture" parameter, if given.
   std::optional<std::string> get_texture(const std::string& name) const;
+  // Frees the numbers of parameter `name` once they have been read (a
+  // mesh's "P" and "indices": its arrays are then never held twice over).
+  void release(const std::string& name) const;
   // The declaration of `name` whatever its type (marks it used).
   const Param* find_any(const std::string& name) const;
 

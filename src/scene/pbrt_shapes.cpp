@@ -49,11 +49,13 @@ void drop_if_mismatched(std::vector<T>& data, size_t vertex_count, const char* n
 MeshDesc triangle_mesh(const ParamSet& params, const ShapeContext& ctx) {
   MeshDesc m;
   m.p = params.get_point3s("P");
+  params.release("P");
   if (m.p.empty()) fail(ctx, "trianglemesh needs \"point3 P\"");
   static const std::vector<int32_t> kOneTriangle = {0, 1, 2};
   const std::vector<int32_t>& given = params.get_ints("indices");
   if (given.empty() && m.p.size() != 3) fail(ctx, "trianglemesh needs \"integer indices\" unless it has exactly 3 vertices");
   m.indices = checked_indices(given.empty() ? kOneTriangle : given, m.p.size(), 3, "trianglemesh", ctx);
+  params.release("indices");
   m.uv = params.get_point2s("uv");
   if (m.uv.empty()) m.uv = params.get_point2s("st");  // pbrt-v3 name
   m.n = params.get_normals("N");
