@@ -7,13 +7,16 @@
 #include "kernels/effects.h"
 #include "scene/scene_effects.h"
 #include "scene/spectral_choice.h"
+#include "scene/system_memory.h"
 #include "worker/scene_data.h"
 
 namespace tessera {
 namespace {
 
 int run_info(const std::string& path) {
+  const std::optional<uint64_t> start = resident_bytes();
   SceneDesc desc = load_scene_or_builtin(path);
+  const std::optional<uint64_t> read_peak = peak_resident_bytes();
   const size_t materials = desc.materials.size(), textures = desc.textures.size(), meshes = desc.meshes.size();
   std::map<std::string, int> light_kinds;
   for (const Light& l : desc.lights) {
@@ -21,6 +24,7 @@ int run_info(const std::string& path) {
     ++light_kinds[names[static_cast<int>(l.type)]];
   }
   SceneData scene(std::move(desc));
+  const std::optional<uint64_t> built = resident_bytes();
   const SceneView& v = scene.view();
   std::printf("scene:          %s\n", scene.desc().source.c_str());
   std::printf("resolution:     %dx%d, %d spp, max depth %d\n", v.camera.width, v.camera.height, scene.desc().spp,
@@ -56,6 +60,12 @@ int run_info(const std::string& path) {
   const std::string why = spectral_reason(scene.desc());
   std::printf("transport:      %s\n", why.empty() ? "rgb (--spectral auto)" : ("spectral (--spectral auto: " + why + ")").c_str());
   std::printf("warnings:       %zu\n", scene.desc().warnings.size());
+  // Above what the process held before reading: what reading the files took
+  // at its peak, and what the built scene keeps (its BVH comes on top when rendering).
+  if (start && read_peak && built)
+    std::printf("memory:         reading peaked at %s, the built scene holds %s\n",
+                format_bytes(*read_peak > *start ? *read_peak - *start : 0).c_str(),
+                format_bytes(*built > *start ? *built - *start : 0).c_str());
   return 0;
 }
 

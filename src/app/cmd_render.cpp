@@ -153,6 +153,7 @@ struct MasterSetup {
   std::optional<Checkpoint> resume;
   uint64_t options_fingerprint = 0;
   SnapshotPolicy snapshots;
+  std::string light_paths_obstacle;  // why a bidirectional integrator's light paths cannot be traced ("" if they can)
 };
 
 MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
@@ -176,6 +177,7 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   check_scene_memory(triangles, vertices);
   if (!a.snapshot_every.empty()) m.snapshots = parse_snapshot_policy(a.snapshot_every);
   if (scene_bytes) *scene_bytes = encode_scene(desc);
+  m.light_paths_obstacle = light_paths_obstacle(desc);  // reads the meshes, which SceneData empties
   m.scene = std::make_unique<SceneData>(std::move(desc));
   m.guide = make_guide(a.guide, *m.scene, &m.guide_why);
   // The default must not cost: a trial decides whether the guide pays.
@@ -214,7 +216,7 @@ void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks, int32_t machi
   if (m.opt.light_paths) {
     std::fprintf(stderr, "tessera: caustics of area, point and spot lights seen through specular surfaces: traced from the lights\n");
   } else if (wants_bidirectional(scene.desc())) {
-    const std::string obstacle = light_paths_obstacle(scene.desc());
+    const std::string& obstacle = m.light_paths_obstacle;
     std::fprintf(stderr, "tessera: integrator \"%s\": caustics from path tracing alone (%s)\n",
                  scene.desc().integrator.c_str(), obstacle.empty() ? "--light-paths off" : obstacle.c_str());
   }

@@ -9,15 +9,9 @@
 #include <optional>
 #include <string>
 
-namespace tessera {
+#include "scene/system_memory.h"
 
-// Memory free now: the smaller of the system's available memory
-// (/proc/meminfo MemAvailable) and what the address-space limit (ulimit -v)
-// leaves; nullopt when neither can be read.
-std::optional<uint64_t> available_memory_bytes();
-// All the memory this process could have: physical memory plus swap, or what
-// ulimit -v leaves if that is less.
-std::optional<uint64_t> memory_limit_bytes();
+namespace tessera {
 
 struct FilmMemory {
   uint64_t film = 0;     // per-pixel accumulators (and light-path splats), every copy held at once
@@ -44,8 +38,5 @@ uint64_t scene_build_memory(uint64_t triangles, uint64_t vertices);
 // The same refusal and warning as check_film_memory, for the scene's
 // triangles, before its arrays and BVH are built.
 void check_scene_memory(uint64_t triangles, uint64_t vertices);
-
-// "1.5 GB"
-std::string format_bytes(uint64_t bytes);
 
 }  // namespace tessera

@@ -47,7 +47,7 @@ class BlockArray {
     out.reserve(n);
     for (std::vector<T>& b : blocks_) {
       out.insert(out.end(), b.begin(), b.end());
-      b = {};
+      std::vector<T>().swap(b);  // frees the block now (assigning {} would keep its capacity)
     }
     blocks_.clear();
     return out;
@@ -175,8 +175,8 @@ const Param* ParamSet::find_any(const std::string& name) const {
 void ParamSet::release(const std::string& name) const {
   for (const Param& p : params_)
     if (p.name == name) {
-      p.numbers = {};
-      p.integers = {};
+      std::vector<Float>().swap(p.numbers);  // assigning {} would keep the capacity
+      std::vector<int32_t>().swap(p.integers);
     }
 }
 

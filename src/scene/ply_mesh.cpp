@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "scene/scene_desc.h"
+#include "scene/system_memory.h"
 
 namespace tessera {
 namespace {
@@ -173,27 +174,87 @@ PlyHeader parse_header(const std::string& bytes, const PlyFailure& fail) {
   return h;
 }
 
+// The bytes of a PLY file: all in memory, or read through zlib in chunks
+// (plain files pass through zlib unchanged) from a file whose total size is
+// known before its body is read, so that every count is still checked
+// against the bytes left before anything is allocated for it.
+class PlyBytes {
+ public:
+  // A whole file in memory, from `offset` on.
+  PlyBytes(const std::string& bytes, size_t offset)
+      : data_(bytes.data()), pos_(offset), end_(bytes.size()), left_(offset < bytes.size() ? bytes.size() - offset : 0) {}
+  // A file being read: `prefix` holds its bytes from `offset` on as far as
+  // read so far, `left` counts every byte from `offset` to the end.
+  PlyBytes(gzFile file, std::string prefix, size_t offset, uint64_t left, size_t chunk, const PlyFailure& fail)
+      : file_(file), window_(std::move(prefix)), pos_(offset), left_(left), chunk_(chunk), fail_(&fail) {
+    data_ = window_.data();
+    end_ = window_.size();
+  }
+
+  // Makes n bytes available at data(); false when fewer than n are left.
+  bool ensure(size_t n) {
+    if (end_ - pos_ >= n) return true;
+    if (left_ < n || !file_) return false;
+    refill(n);
+    return true;
+  }
+  const char* data() const { return data_ + pos_; }
+  size_t available() const { return end_ - pos_; }
+  void skip(size_t n) {
+    pos_ += n;
+    left_ -= n;
+  }
+  uint64_t left() const { return left_; }
+
+ private:
+  // Keeps the unread bytes and reads at least up to n of them (a chunk if more are left).
+  void refill(size_t n) {
+    window_.erase(0, pos_);
+    pos_ = 0;
+    const size_t want = static_cast<size_t>(std::min<uint64_t>(left_, std::max(n, chunk_)));
+    size_t have = window_.size();
+    window_.resize(want);
+    while (have < want) {
+      const int got = gzread(file_, window_.data() + have, static_cast<unsigned>(std::min<size_t>(want - have, 1u << 30)));
+      if (got <= 0) (*fail_)("the file changed or could not be read while it was parsed");
+      have += static_cast<size_t>(got);
+    }
+    data_ = window_.data();
+    end_ = window_.size();
+  }
+
+  gzFile file_ = nullptr;
+  std::string window_;
+  const char* data_ = nullptr;
+  size_t pos_ = 0, end_ = 0;
+  uint64_t left_ = 0;  // bytes from data() to the end of the file
+  size_t chunk_ = 0;
+  const PlyFailure* fail_ = nullptr;
+};
+
 // Reads values of the body in order; every read checks the bytes left.
 class BodyReader {
  public:
-  BodyReader(const std::string& bytes, size_t offset, PlyFormat format, const PlyFailure& fail)
-      : data_(bytes.data()), pos_(offset), end_(bytes.size()), format_(format), fail_(fail) {}
+  BodyReader(PlyBytes& bytes, PlyFormat format, const PlyFailure& fail) : in_(bytes), format_(format), fail_(fail) {}
 
   double read(PlyType type) { return format_ == PlyFormat::Ascii ? read_ascii() : read_binary(type); }
 
-  size_t bytes_left() const { return pos_ < end_ ? end_ - pos_ : 0; }
+  uint64_t bytes_left() const { return in_.left(); }
 
   // The fewest bytes one value of `type` can occupy: ASCII values need a
   // character and (but for the last) a separator.
   size_t min_value_bytes(PlyType type) const { return format_ == PlyFormat::Ascii ? 1 : type_size(type); }
 
  private:
+  // No number in a PLY body needs this many characters.
+  static constexpr size_t kMaxNumberChars = 512;
+
   double read_binary(PlyType type) {
     const size_t n = type_size(type);
-    if (bytes_left() < n) fail_("file is truncated (the body ends inside a value)");
+    if (!in_.ensure(n)) fail_("file is truncated (the body ends inside a value)");
     unsigned char b[8];
-    std::memcpy(b, data_ + pos_, n);
-    pos_ += n;
+    std::memcpy(b, in_.data(), n);
+    in_.skip(n);
     if (format_ == PlyFormat::BinaryBigEndian)
       for (size_t i = 0; i < n / 2; ++i) std::swap(b[i], b[n - 1 - i]);
     switch (type) {
@@ -210,21 +271,29 @@ class BodyReader {
   }
 
   double read_ascii() {
-    while (pos_ < end_ && is_space(data_[pos_])) ++pos_;
-    if (pos_ >= end_) fail_("file is truncated (fewer values than the header declares)");
-    size_t start = pos_;
-    while (pos_ < end_ && !is_space(data_[pos_])) ++pos_;
+    for (;;) {
+      if (!in_.ensure(1)) fail_("file is truncated (fewer values than the header declares)");
+      if (!is_space(*in_.data())) break;
+      in_.skip(1);
+    }
+    // The number's characters, made available as one run (at most kMaxNumberChars).
+    size_t len = 0;
+    for (;;) {
+      while (len < in_.available() && !is_space(in_.data()[len])) ++len;
+      if (len < in_.available() || len >= kMaxNumberChars || !in_.ensure(len + 1)) break;
+    }
+    const char* start = in_.data();
     double v = 0;
-    auto [ptr, ec] = std::from_chars(data_ + start, data_ + pos_, v);
-    if (ec != std::errc() || ptr != data_ + pos_)
-      fail_("malformed number '" + std::string(data_ + start, std::min<size_t>(pos_ - start, 32)) + "' in the body");
+    auto [ptr, ec] = std::from_chars(start, start + len, v);
+    if (ec != std::errc() || ptr != start + len || len >= kMaxNumberChars)
+      fail_("malformed number '" + std::string(start, std::min<size_t>(len, 32)) + "' in the body");
+    in_.skip(len);
     return v;
   }
 
   static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
 
-  const char* data_;
-  size_t pos_, end_;
+  PlyBytes& in_;
   PlyFormat format_;
   const PlyFailure& fail_;
 };
@@ -316,6 +385,9 @@ void read_faces(const PlyElement& e, BodyReader& in, PlyMesh& out, uint64_t vert
   for (const PlyProperty& p : e.properties)
     have_indices |= p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index");
   if (!have_indices) fail("face element has no 'vertex_indices' list");
+  // Room for a triangle per face: no growth (and no transient copy) for a
+  // triangle mesh. A triangle takes at least 4 bytes of the file.
+  out.indices.reserve(3 * static_cast<size_t>(std::min<uint64_t>(e.count, in.bytes_left() / 4 + 1)));
   for (uint64_t f = 0; f < e.count; ++f) {
     for (const PlyProperty& p : e.properties) {
       if (!p.is_list) {
@@ -345,11 +417,22 @@ void read_faces(const PlyElement& e, BodyReader& in, PlyMesh& out, uint64_t vert
   }
 }
 
-}  // namespace
+// Refuses a mesh whose arrays cannot fit in memory before reading its body:
+// positions (normals, uv) per vertex, a triangle per face.
+void check_arrays_fit(const PlyElement& vertex, const PlyElement& face, const PlyFailure& fail) {
+  bool has_normals = false, has_uv = false;
+  vertex_slots(vertex, has_normals, has_uv, fail);
+  const double per_vertex = sizeof(Vec3) * (1 + has_normals) + (has_uv ? sizeof(Vec2) : 0);
+  const double need = static_cast<double>(vertex.count) * per_vertex + static_cast<double>(face.count) * 3 * sizeof(uint32_t);
+  const uint64_t bytes = need < 1.8e19 ? static_cast<uint64_t>(need) : UINT64_MAX;
+  if (exceeds_memory_limit(bytes))
+    fail("its " + std::to_string(vertex.count) + " vertices and " + std::to_string(face.count) + " faces need about " +
+         format_bytes(bytes) + ", more than the " + format_bytes(memory_limit_bytes().value_or(0)) +
+         " of memory this process may use");
+}
 
-PlyMesh parse_ply_mesh(const std::string& bytes, const std::string& name) {
-  const PlyFailure fail(name);
-  const PlyHeader header = parse_header(bytes, fail);
+// The body after the header, read from `bytes`.
+PlyMesh read_body(const PlyHeader& header, PlyBytes& bytes, const PlyFailure& fail) {
   const PlyElement* vertex = nullptr;
   const PlyElement* face = nullptr;
   for (const PlyElement& e : header.elements) {
@@ -358,9 +441,12 @@ PlyMesh parse_ply_mesh(const std::string& bytes, const std::string& name) {
   }
   if (!vertex || vertex->count == 0) fail("no vertices");
   if (!face || face->count == 0) fail("no faces");
-
   PlyMesh out;
-  BodyReader in(bytes, header.body_offset, header.format, fail);
+  BodyReader in(bytes, header.format, fail);
+  // A damaged count is a truncated file; a count the file holds may still be
+  // more than memory holds.
+  for (const PlyElement& e : header.elements) check_count_fits(e, in, fail);
+  check_arrays_fit(*vertex, *face, fail);
   for (const PlyElement& e : header.elements) {
     check_count_fits(e, in, fail);
     if (&e == vertex) {
@@ -379,32 +465,78 @@ PlyMesh parse_ply_mesh(const std::string& bytes, const std::string& name) {
   return out;
 }
 
-PlyMesh load_ply_mesh(const std::string& path) {
+// The start of a file being read, up to and including its end_header line
+// (or all of it, or kMaxHeaderBytes: parse_header then says what is wrong).
+constexpr size_t kMaxHeaderBytes = size_t(16) << 20;
+
+std::string read_header_bytes(gzFile file, const PlyFailure& fail) {
+  std::string prefix;
+  for (;;) {
+    const size_t old = prefix.size();
+    prefix.resize(old + 65536);
+    const int got = gzread(file, prefix.data() + old, 65536);
+    if (got < 0) fail("decompression failed");
+    prefix.resize(old + static_cast<size_t>(got));
+    if (got == 0 || prefix.size() >= kMaxHeaderBytes) return prefix;
+    // A line that starts with end_header, complete.
+    for (size_t at = prefix.find("\nend_header", old >= 11 ? old - 11 : 0); at != std::string::npos;
+         at = prefix.find("\nend_header", at + 1))
+      if (prefix.find('\n', at + 1) != std::string::npos) return prefix;
+  }
+}
+
+// The size of the file's content: its size, or its decompressed size
+// (decompressed once to count it, at most kMaxPlyBytes).
+uint64_t content_size(gzFile file, const std::string& path, const PlyFailure& fail) {
+  if (gzdirect(file)) {
+    std::error_code ec;
+    const uint64_t size = std::filesystem::file_size(path, ec);
+    if (ec) fail(ec.message());
+    return size;
+  }
+  uint64_t size = 0;
+  std::vector<char> scratch(size_t(1) << 20);
+  for (;;) {
+    const int n = gzread(file, scratch.data(), static_cast<unsigned>(scratch.size()));
+    if (n < 0) {
+      int code = 0;
+      fail(std::string("decompression failed: ") + gzerror(file, &code));
+    }
+    if (n == 0) break;
+    size += static_cast<uint64_t>(n);
+    if (size > kMaxPlyBytes) fail("larger than " + std::to_string(kMaxPlyBytes >> 30) + " GiB");
+  }
+  if (gzrewind(file) != 0) fail("cannot rewind the file");
+  return size;
+}
+
+}  // namespace
+
+PlyMesh parse_ply_mesh(const std::string& bytes, const std::string& name) {
+  const PlyFailure fail(name);
+  const PlyHeader header = parse_header(bytes, fail);
+  PlyBytes body(bytes, header.body_offset);
+  return read_body(header, body, fail);
+}
+
+PlyMesh load_ply_mesh(const std::string& path, size_t chunk_bytes) {
   const PlyFailure fail(path);
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) fail("not a regular file");
   // gzread passes uncompressed files through unchanged, so one path serves both.
   gzFile file = gzopen(path.c_str(), "rb");
   if (!file) fail(std::strerror(errno));
-  std::string bytes;
-  char buffer[1 << 16];
-  for (;;) {
-    const int n = gzread(file, buffer, sizeof buffer);
-    if (n < 0) {
-      int code = 0;
-      std::string reason = gzerror(file, &code);
-      gzclose(file);
-      fail("decompression failed: " + reason);
-    }
-    if (n == 0) break;
-    if (bytes.size() + static_cast<size_t>(n) > kMaxPlyBytes) {
-      gzclose(file);
-      fail("larger than " + std::to_string(kMaxPlyBytes >> 30) + " GiB");
-    }
-    bytes.append(buffer, static_cast<size_t>(n));
-  }
-  gzclose(file);
-  return parse_ply_mesh(bytes, path);
+  struct Closer {
+    gzFile f;
+    ~Closer() { gzclose(f); }
+  } closer{file};
+  const uint64_t size = content_size(file, path, fail);
+  std::string prefix = read_header_bytes(file, fail);
+  const PlyHeader header = parse_header(prefix, fail);
+  if (header.body_offset > size) fail("the file changed while it was read");
+  PlyBytes body(file, std::move(prefix), header.body_offset, size - header.body_offset, std::max<size_t>(chunk_bytes, 1),
+                fail);
+  return read_body(header, body, fail);
 }
 
 }  // namespace tessera

@@ -28,7 +28,9 @@ struct PlyMesh {
 PlyMesh parse_ply_mesh(const std::string& bytes, const std::string& name);
 
 // Reads `path` (gzip-compressed or not: the content decides, as zlib does)
-// and parses it. Throws SceneError as parse_ply_mesh.
-PlyMesh load_ply_mesh(const std::string& path);
+// and parses it as it reads, chunk_bytes at a time: the file is never held
+// whole (a compressed one is decompressed twice, first to learn its size).
+// Throws SceneError as parse_ply_mesh.
+PlyMesh load_ply_mesh(const std::string& path, size_t chunk_bytes = size_t(1) << 20);
 
 }  // namespace tessera

@@ -65,8 +65,27 @@ void SceneData::flatten_meshes() {
   // Per-triangle media only for scenes that have any (the camera's included).
   has_media_ = (effects_ & kEffectMedia) != 0;
   bool moves = false;
-  for (const MeshDesc& m : desc_.meshes) moves |= !m.p_end.empty();
+  size_t vertices = 0, triangles = 0;
   for (const MeshDesc& m : desc_.meshes) {
+    moves |= !m.p_end.empty();
+    vertices += m.p.size();
+    triangles += m.indices.size() / 3;
+  }
+  // Sized once: grown by doubling, the arrays would hold up to twice their
+  // size, and three times while they move.
+  positions_.reserve(vertices);
+  normals_.reserve(vertices);
+  uvs_.reserve(vertices);
+  if (moves) {
+    positions_end_.reserve(vertices);
+    normals_end_.reserve(vertices);
+  }
+  indices_.reserve(3 * triangles);
+  face_normals_.reserve(triangles);
+  triangles_.reserve(triangles);
+  if (has_alpha_) triangle_alpha_.reserve(triangles);
+  if (has_media_) triangle_media_.reserve(triangles);
+  for (MeshDesc& m : desc_.meshes) {
     const uint32_t base = static_cast<uint32_t>(positions_.size());
     const bool has_n = !m.n.empty(), has_uv = !m.uv.empty();
     for (size_t i = 0; i < m.p.size(); ++i) {
@@ -116,6 +135,14 @@ void SceneData::flatten_meshes() {
       if (has_alpha_) triangle_alpha_.push_back(m.alpha);
       if (has_media_) triangle_media_.push_back(m.media);
     }
+    // The flat arrays now hold the mesh: its own are not kept for the render
+    // (swapped with empty ones: assigning {} would keep their capacity).
+    std::vector<Vec3>().swap(m.p);
+    std::vector<Vec3>().swap(m.n);
+    std::vector<Vec2>().swap(m.uv);
+    std::vector<uint32_t>().swap(m.indices);
+    std::vector<Vec3>().swap(m.p_end);
+    std::vector<Vec3>().swap(m.n_end);
   }
 }
 

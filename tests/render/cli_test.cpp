@@ -345,6 +345,29 @@ TEST_F(CliTest, InfoPrintsEffects) {
   EXPECT_NE(r.output.find("36 triangles"), std::string::npos) << r.output;
 }
 
+// A PLY mesh whose arrays cannot fit is refused from its header, before its
+// body is read: 30 million vertices (a sparse file of 360 MB that takes no
+// disk) under an address-space limit that leaves about 250 MB.
+TEST_F(CliTest, PlyMeshTooLargeForMemoryFailsBeforeReading) {
+  const uint64_t vertices = 30000000;
+  {
+    std::ofstream f(dir_ / "huge.ply", std::ios::binary);
+    f << "ply\nformat binary_little_endian 1.0\nelement vertex " << vertices
+      << "\nproperty float x\nproperty float y\nproperty float z\nelement face 1"
+         "\nproperty list uchar int vertex_indices\nend_header\n";
+    f.seekp(static_cast<std::streamoff>(f.tellp()) + static_cast<std::streamoff>(vertices * 12));
+    const char face[13] = {3};
+    f.write(face, sizeof face);
+  }
+  const std::string scene = write("huge.pbrt", "Camera \"perspective\"\nWorldBegin\n"
+                                               "LightSource \"point\" \"point3 from\" [0 3 0] \"rgb I\" [10 10 10]\n"
+                                               "Shape \"plymesh\" \"string filename\" \"huge.ply\"\n");
+  const RunResult r = testing::run_shell("ulimit -v 800000; " + std::string(TESSERA_BINARY) + " info " + scene);
+  expect_one_line_error(r, "huge.pbrt:4: cannot read PLY");
+  EXPECT_NE(r.output.find("its 30000000 vertices and 1 faces need about 343 MB, more than the"), std::string::npos)
+      << r.output;
+}
+
 // A scene whose triangles cannot fit once their arrays and BVH are built is
 // refused before building them, naming the count and what it needs. An
 // 8-million-triangle binary PLY (150 MB, loaded in about 300 MB) under an

@@ -142,6 +142,60 @@ TEST(PlyMesh, GzipCompressedFilesReadAsTheirContent) {
   EXPECT_THROW(load_ply_mesh(dir.file("cut.ply.gz")), SceneError);
 }
 
+// Files are read chunk by chunk: with chunks of a few bytes every value and
+// the header's end straddle chunk boundaries, and the mesh is the same as
+// read whole, plain or compressed; the errors are the same too.
+TEST(PlyMesh, ReadInChunksGivesWhatTheWholeFileGives) {
+  TempDir dir;
+  for (Encoding e : {Encoding::Ascii, Encoding::Little, Encoding::Big}) {
+    const std::string bytes = write_ply(SmallMesh{}, e);
+    const std::string plain = dir.write("m" + std::to_string(static_cast<int>(e)) + ".ply", bytes);
+    const std::string gz = gzip(bytes, dir.file("m" + std::to_string(static_cast<int>(e)) + ".ply.gz"));
+    for (size_t chunk : {size_t(1), size_t(3), size_t(7), size_t(64), size_t(1) << 20}) {
+      SCOPED_TRACE(std::to_string(static_cast<int>(e)) + " chunk " + std::to_string(chunk));
+      expect_small_mesh(load_ply_mesh(plain, chunk));
+      expect_small_mesh(load_ply_mesh(gz, chunk));
+    }
+    // Every truncation of the file on disk fails as it does in memory.
+    const size_t last = e == Encoding::Ascii ? bytes.rfind(' ') : bytes.size();
+    for (size_t len = 0; len < last; len += 5) {
+      SCOPED_TRACE(len);
+      dir.write("cut.ply", bytes.substr(0, len));
+      EXPECT_THROW(load_ply_mesh(dir.file("cut.ply"), 4), SceneError);
+    }
+  }
+}
+
+TEST(PlyMesh, HeaderEndFoundOnlyAtTheStartOfALine) {
+  TempDir dir;
+  std::string bytes = write_ply(SmallMesh{}, Encoding::Little);
+  // A comment mentioning end_header, and a header longer than one read.
+  bytes.insert(bytes.find("comment"), "comment end_header is not here\ncomment " + std::string(200000, 'x') + "\n");
+  expect_small_mesh(load_ply_mesh(dir.write("long.ply", bytes), 5));
+  // No end_header at all, in a file longer than the header is allowed to be.
+  std::string endless = "ply\nformat ascii 1.0\n";
+  while (endless.size() < (size_t(17) << 20)) endless += "comment " + std::string(1000, 'y') + "\n";
+  try {
+    load_ply_mesh(dir.write("endless.ply", endless));
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("no end_header"), std::string::npos) << e.what();
+  }
+}
+
+// An over-long number in an ASCII body is malformed, whatever the chunking.
+TEST(PlyMesh, OverlongAsciiNumberIsMalformed) {
+  TempDir dir;
+  std::string bytes = header(Encoding::Ascii, 1, 1) + std::string(2000, '1') + " 0 0 0 0 1 0 0\n3 0 0 0\n";
+  EXPECT_NE(parse_error(bytes).find("malformed number '111"), std::string::npos);
+  try {
+    load_ply_mesh(dir.write("long.ply", bytes), 16);
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("malformed number '111"), std::string::npos) << e.what();
+  }
+}
+
 TEST(PlyMesh, EveryTruncationIsAnErrorNotACrash) {
   for (Encoding e : {Encoding::Ascii, Encoding::Little, Encoding::Big}) {
     const std::string whole = write_ply(SmallMesh{}, e);
