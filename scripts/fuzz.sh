@@ -1,16 +1,18 @@
 #!/usr/bin/env bash
 # Fuzzes the scene loader (tokenizer, parser, loader, PLY and image readers;
-# tests/fuzz/fuzz_scene_loader.cpp, seeded with the shipped and test scenes)
-# or the NanoVDB reader (tests/fuzz/fuzz_nanovdb_reader.cpp, seeded with
-# tests/fuzz/nvdb_corpus): builds the target with clang, libFuzzer, ASan and
-# UBSan in build-fuzz/ and runs it.
+# tests/fuzz/fuzz_scene_loader.cpp, seeded with the shipped and test scenes),
+# the NanoVDB reader (tests/fuzz/fuzz_nanovdb_reader.cpp, seeded with
+# tests/fuzz/nvdb_corpus) or the PLY reader, whole against chunked
+# (tests/fuzz/fuzz_ply_reader.cpp, seeded with tests/fuzz/ply_corpus): builds
+# the target with clang, libFuzzer, ASan and UBSan in build-fuzz/ and runs it.
 #
-#   scripts/fuzz.sh [SECONDS] [JOBS] [scene|nanovdb]   (defaults: 600 s, every core, scene)
+#   scripts/fuzz.sh [SECONDS] [JOBS] [scene|nanovdb|ply]   (defaults: 600 s, every core, scene)
 #
 # Each job fuzzes for SECONDS; the corpus grows in out/fuzz/corpus (for
-# nanovdb: out/fuzz/nvdb_corpus), inputs that crash, hang (over 10 s) or
-# exceed 2 GB land in out/fuzz/findings/ (copy them to tests/fuzz/corpus/ or
-# tests/fuzz/nvdb_corpus/ once fixed: the suite replays those folders).
+# nanovdb: out/fuzz/nvdb_corpus, for ply: out/fuzz/ply_corpus), inputs that
+# crash, hang (over 10 s) or exceed 2 GB land in out/fuzz/findings/ (copy
+# them to the matching tests/fuzz/ folder once fixed: the suite replays
+# those folders).
 # Exit status 0 when nothing was found, 1 when something was, 2 on setup errors.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +22,8 @@ target=${3:-scene}
 case "$target" in
   scene) exe=fuzz_scene_loader; corpus=corpus; max_len=65536 ;;
   nanovdb) exe=fuzz_nanovdb_reader; corpus=nvdb_corpus; max_len=262144 ;;
-  *) echo "fuzz.sh: unknown target '$target' (scene or nanovdb)" >&2; exit 2 ;;
+  ply) exe=fuzz_ply_reader; corpus=ply_corpus; max_len=65536 ;;
+  *) echo "fuzz.sh: unknown target '$target' (scene, nanovdb or ply)" >&2; exit 2 ;;
 esac
 command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (apt-get install clang)" >&2; exit 2; }
 flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fsanitize=fuzzer-no-link -fno-omit-frame-pointer"
