@@ -11,11 +11,12 @@
 
 namespace tessera {
 
+// time: the ray's (a moving triangle's texture point is where it is then).
 TESSERA_HOST_DEVICE inline bool alpha_ignores_hit(const SceneView& s, uint32_t tri, Float b1, Float b2, const Vec3& o,
-                                                  const Vec3& d) {
+                                                  const Vec3& d, Float time) {
   const TextureSlot& slot = s.triangle_alpha[tri];
   Float a = slot.value.x;
-  if (slot.texture >= 0) a = eval_slot(s, slot, texture_point(make_surface_hit(s, tri, b1, b2))).x;
+  if (slot.texture >= 0) a = eval_slot(s, slot, texture_point(make_surface_hit(s, tri, b1, b2, time))).x;
   if (a >= 1.f) return false;
   if (!(a > 0.f)) return true;
   const uint64_t h = mix_bits(hash_vec3(o) ^ (hash_vec3(d) * 0xd1b54a32d192ed03ull) ^

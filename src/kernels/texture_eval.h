@@ -41,11 +41,12 @@ TESSERA_HOST_DEVICE inline Rgb image_lookup_nearest_equal_area(const ImageView& 
   return glm::max(img.texels[static_cast<size_t>(y) * img.width + x], Rgb(0.f));  // pbrt clamps negatives
 }
 
-// pbrt-v4's checkerboard weight of tex2 at a point (0 or 1: point sampled),
-// from the parity of the integer cells, computed in float so that huge or
-// NaN coordinates cannot overflow a cast.
-TESSERA_HOST_DEVICE inline bool checker_odd(Float cells_sum) {
-  const Float half = cells_sum * 0.5f;
+// Whether the integer cell holding x is odd, from floor(x) in float (no cast
+// to overflow; NaN and cells beyond float's integers read even), so that a
+// checkerboard's parity is the XOR of its axes' (a sum of cell indices would
+// round at 2^24).
+TESSERA_HOST_DEVICE inline bool odd_cell(Float x) {
+  const Float half = glm::floor(x) * 0.5f;
   return half != glm::floor(half);
 }
 
@@ -66,13 +67,14 @@ TESSERA_HOST_DEVICE inline Rgb eval_texture(const SceneView& s, int32_t tex_inde
       return b == Rgb(0.f) ? b : slot(t.a) * b;
     }
     case TextureType::Checkerboard: {
+      // pbrt-v4's checkerboard, point sampled: tex2 where the cells' parities differ.
       bool odd;
       if (t.mapping == TextureMapping::Point3D) {
         const Vec3 q = texture_space_point(t, tp.p);
-        odd = checker_odd(glm::floor(q.x) + glm::floor(q.y) + glm::floor(q.z));
+        odd = (odd_cell(q.x) != odd_cell(q.y)) != odd_cell(q.z);
       } else {
         const Vec2 st = texture_st(t, tp);
-        odd = checker_odd(glm::floor(st.x) + glm::floor(st.y));
+        odd = odd_cell(st.x) != odd_cell(st.y);
       }
       return slot(odd ? t.b : t.a);
     }

@@ -1,5 +1,6 @@
 #include "scene/pbrt_params.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -31,13 +32,18 @@ int numeric_width(const std::string& t) {
 
 bool is_string_type(const std::string& t) { return t == "string" || t == "texture"; }
 
-// Values appended in blocks of 1 MiB (large enough that the allocator maps
-// each from the system and returns it when freed), released as one array.
+// Values appended in blocks that double from a few values up to 1 MiB
+// (a one-number parameter costs no more than before; a mesh's arrays come in
+// blocks the allocator maps from the system and returns when freed),
+// released as one array.
 template <typename T>
 class BlockArray {
  public:
   void push_back(T v) {
-    if (blocks_.empty() || blocks_.back().size() == kBlock) blocks_.emplace_back().reserve(kBlock);
+    if (blocks_.empty() || blocks_.back().size() == blocks_.back().capacity()) {
+      const size_t next = blocks_.empty() ? 16 : std::min(kBlock, 2 * blocks_.back().capacity());
+      blocks_.emplace_back().reserve(next);
+    }
     blocks_.back().push_back(v);
   }
   std::vector<T> release() {

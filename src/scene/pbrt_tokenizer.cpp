@@ -36,8 +36,8 @@ bool is_pbrt_directive_name(const std::string& word) {
 
 bool TokenStream::more() {
   if (i_ < buf_.size()) return true;
-  buf_.resize(kChunk);
-  in_.read(buf_.data(), static_cast<std::streamsize>(kChunk));
+  buf_.resize(chunk_);
+  in_.read(buf_.data(), static_cast<std::streamsize>(chunk_));
   buf_.resize(static_cast<size_t>(in_.gcount()));
   i_ = 0;
   if (in_.bad()) throw SceneError(file_ + ":" + std::to_string(line_) + ": cannot read the file");

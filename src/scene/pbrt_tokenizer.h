@@ -33,9 +33,12 @@ struct Token {
 // `file` must outlive the stream and its tokens.
 class TokenStream {
  public:
-  TokenStream(std::istream& in, const std::string& file) : in_(in), file_(file) {}
+  static constexpr size_t kDefaultChunk = size_t(1) << 20;
+  // chunk: bytes read at a time (tests use a few, so that tokens straddle chunks).
+  TokenStream(std::istream& in, const std::string& file, size_t chunk = kDefaultChunk)
+      : in_(in), file_(file), chunk_(chunk > 0 ? chunk : 1) {}
   // A temporary name would leave the tokens pointing at a freed string.
-  TokenStream(std::istream&, std::string&&) = delete;
+  TokenStream(std::istream&, std::string&&, size_t = kDefaultChunk) = delete;
   // Whether token `index` exists (making tokens up to it). False past the
   // end, and for tokens already released.
   bool has(size_t index);
@@ -48,7 +51,6 @@ class TokenStream {
   int last_line() const;
 
  private:
-  static constexpr size_t kChunk = size_t(1) << 20;
   bool produce();  // appends the next token; false at the end of the text
   bool more();     // whether a character is left, reading the next chunk if need be
   // Consumes the characters up to the first one `stop` accepts (or the
@@ -58,6 +60,7 @@ class TokenStream {
 
   std::istream& in_;
   const std::string& file_;
+  size_t chunk_;
   std::string buf_;  // the current chunk
   size_t i_ = 0;     // next character in buf_
   bool ends_with_newline_ = false, empty_ = true;

@@ -187,6 +187,8 @@ class PlyBytes {
   // read so far, `left` counts every byte from `offset` to the end.
   PlyBytes(gzFile file, std::string prefix, size_t offset, uint64_t left, size_t chunk, const PlyFailure& fail)
       : file_(file), window_(std::move(prefix)), pos_(offset), left_(left), chunk_(chunk), fail_(&fail) {
+    // Bytes past the size measured (a file growing while it is read) are not the file's.
+    window_.resize(static_cast<size_t>(std::min<uint64_t>(window_.size(), offset + left)));
     data_ = window_.data();
     end_ = window_.size();
   }
@@ -471,6 +473,7 @@ constexpr size_t kMaxHeaderBytes = size_t(16) << 20;
 
 std::string read_header_bytes(gzFile file, const PlyFailure& fail) {
   std::string prefix;
+  size_t from = 0;  // where a line starting with end_header may begin
   for (;;) {
     const size_t old = prefix.size();
     prefix.resize(old + 65536);
@@ -479,9 +482,9 @@ std::string read_header_bytes(gzFile file, const PlyFailure& fail) {
     prefix.resize(old + static_cast<size_t>(got));
     if (got == 0 || prefix.size() >= kMaxHeaderBytes) return prefix;
     // A line that starts with end_header, complete.
-    for (size_t at = prefix.find("\nend_header", old >= 11 ? old - 11 : 0); at != std::string::npos;
-         at = prefix.find("\nend_header", at + 1))
-      if (prefix.find('\n', at + 1) != std::string::npos) return prefix;
+    const size_t at = prefix.find("\nend_header", from);
+    if (at != std::string::npos && prefix.find('\n', at + 1) != std::string::npos) return prefix;
+    from = at != std::string::npos ? at : prefix.size() - std::min<size_t>(prefix.size(), 10);
   }
 }
 

@@ -30,7 +30,8 @@ PlyMesh parse_ply_mesh(const std::string& bytes, const std::string& name);
 // Reads `path` (gzip-compressed or not: the content decides, as zlib does)
 // and parses it as it reads, chunk_bytes at a time: the file is never held
 // whole (a compressed one is decompressed twice, first to learn its size).
-// Throws SceneError as parse_ply_mesh.
+// A header is read up to 16 MiB: no end_header by then is an error. Throws
+// SceneError as parse_ply_mesh.
 PlyMesh load_ply_mesh(const std::string& path, size_t chunk_bytes = size_t(1) << 20);
 
 }  // namespace tessera

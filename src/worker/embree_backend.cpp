@@ -27,7 +27,7 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
     const Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
                  RTCRayN_dir_z(args->ray, args->N, i));
     if (alpha_ignores_hit(*view, RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i),
-                          RTCHitN_v(args->hit, args->N, i), o, d))
+                          RTCHitN_v(args->hit, args->N, i), o, d, RTCRayN_time(args->ray, args->N, i)))
       args->valid[i] = 0;
   }
 }

@@ -346,10 +346,10 @@ TEST_F(CliTest, InfoPrintsEffects) {
 }
 
 // A PLY mesh whose arrays cannot fit is refused from its header, before its
-// body is read: 30 million vertices (a sparse file of 360 MB that takes no
-// disk) under an address-space limit that leaves about 250 MB.
+// body is read: 100 million vertices (a sparse file of 1.2 GB that takes no
+// disk) under an address-space limit of 800 MB.
 TEST_F(CliTest, PlyMeshTooLargeForMemoryFailsBeforeReading) {
-  const uint64_t vertices = 30000000;
+  const uint64_t vertices = 100000000;
   {
     std::ofstream f(dir_ / "huge.ply", std::ios::binary);
     f << "ply\nformat binary_little_endian 1.0\nelement vertex " << vertices
@@ -364,7 +364,7 @@ TEST_F(CliTest, PlyMeshTooLargeForMemoryFailsBeforeReading) {
                                                "Shape \"plymesh\" \"string filename\" \"huge.ply\"\n");
   const RunResult r = testing::run_shell("ulimit -v 800000; " + std::string(TESSERA_BINARY) + " info " + scene);
   expect_one_line_error(r, "huge.pbrt:4: cannot read PLY");
-  EXPECT_NE(r.output.find("its 30000000 vertices and 1 faces need about 343 MB, more than the"), std::string::npos)
+  EXPECT_NE(r.output.find("its 100000000 vertices and 1 faces need about 1.1 GB, more than the"), std::string::npos)
       << r.output;
 }
 
