@@ -43,6 +43,11 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
                   "Guided roulette: a path the guide expects to bring at least 1/W of its predicted light always "
                   "survives. Smaller W: shorter paths, less time per sample, more noise per sample (default 2)")
       ->check(CLI::Range(0.01, 100.0));
+  cmd->add_option("--guide-max-ratio", a.max_ratio,
+                  "A path samples its BSDF alone once guided sampling has raised its weight R times over: keeps very "
+                  "deep paths from heavy-tailed weights. Larger R: guiding at more vertices, more variance in deep "
+                  "paths (default " + std::to_string(static_cast<int>(kMaxGuideRatio)) + ")")
+      ->check(CLI::Range(1.0, 1e30));
   cmd->add_option("--guide-nee", a.nee,
                   "Next-event estimation of guided renders: learned (cells whose shadow rays bring little trace "
                   "them less often) or always (every vertex)")
@@ -55,6 +60,7 @@ void apply_guide_render_options(const GuideArgs& a, RenderOptions* opt) {
   opt->guide_learn = {static_cast<uint32_t>(a.learn_spp), static_cast<uint32_t>(a.learn_every), a.learn_taper == "on"};
   opt->guide_roulette = a.roulette == "guided";
   opt->guide_roulette_window = static_cast<float>(a.roulette_window);
+  opt->guide_max_ratio = static_cast<float>(a.max_ratio);
 }
 
 bool guiding_helps(uint32_t effects) {

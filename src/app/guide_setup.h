@@ -27,6 +27,7 @@ struct GuideArgs {
   std::string learn_taper = "on";  // on | off
   std::string roulette = "guided";  // guided | throughput
   double roulette_window = kGuidedRouletteWindow;
+  double max_ratio = kMaxGuideRatio;
   std::string nee = "learned";      // learned | always: next-event estimation's probability per cell
   std::string in, out;
 };

@@ -154,6 +154,11 @@ TESSERA_HOST_DEVICE inline void guide_record_mix(const GuideView& g, int32_t cel
 // also kill paths (down to a floor of 0.2) was no better, and with a floor of
 // 0.05 paths the field had not learned about yet came back 20-fold as fireflies.
 constexpr Float kGuidedRouletteWindow = 2.f;
+
+// The most a path's guided sampling may raise its weight against BSDF
+// sampling before the rest of the path samples its BSDF alone (integrator.h,
+// guide_ratio).
+constexpr Float kMaxGuideRatio = 8.f;
 TESSERA_HOST_DEVICE inline Float guided_survival(const GuideView& g, int32_t cell, uint32_t bin, Float throughput,
                                                  Float path_expected, Float window) {
   const Float expected = throughput * guide_value(g, cell, bin);

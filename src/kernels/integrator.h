@@ -27,6 +27,7 @@ struct PathCounters {
   uint64_t interface_skips = 0;
   uint64_t guidable_vertices = 0;  // vertices where the guide could be used (no delta lobe)
   uint64_t guided_samples = 0;     // directions drawn from the guide
+  uint64_t guide_withheld_vertices = 0;  // guidable vertices left to the BSDF: the path's guide ratio was too high
   uint64_t guide_updates = 0;      // direction targets accepted by the guide
   uint64_t guided_roulette = 0;    // roulette decisions the guide's prediction took part in
   uint64_t nee_skipped = 0;        // vertices that skipped next-event estimation (GuideView::nee_prob)
@@ -51,6 +52,9 @@ struct PathSettings {
   // predicted radiance always survives (see guided_survival): smaller windows
   // give shorter paths, less time per sample and more noise per sample.
   Float guided_roulette_window = kGuidedRouletteWindow;
+  // A path samples its BSDF alone once guiding has raised its weight this
+  // many times over (see guide_ratio in trace_path).
+  Float max_guide_ratio = kMaxGuideRatio;
   // The light tracer (light_paths.h) delivers the emission of paths whose
   // first vertex scatters non-specularly and whose later vertices are all
   // delta-only surfaces: the path tracer leaves it out.
@@ -180,6 +184,15 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   bool first_vertex_connectable = false;
   bool last_vertex_delta_only = false;
   Float prev_scatter_pdf = 0.f;  // pdf of the last sampled direction (the mixture's when guided)
+  // How much guiding has scaled the path's weight against BSDF sampling:
+  // the product over guided vertices of bsdf_pdf / mixture_pdf. Each factor
+  // is 1 on average, but over hundreds of guided vertices their product is
+  // lognormal-like (docs/guiding.md, an albedo-1 enclosure at depth 1000):
+  // unbiased, too heavy-tailed to trust. A path whose
+  // ratio has passed settings.max_guide_ratio samples its BSDF alone from
+  // then on, a choice made from its past only, so the estimate stays
+  // unbiased and the ratio stays bounded (by that times one vertex's factor).
+  Float guide_ratio = 1.f;
   Vec3 prev_p(0.f);  // last scattering point: MIS on emitter hits measures from it, as NEE does
   bool prev_in_medium = false;  // whether it was in a medium (sample_light's in_medium)
   int32_t prev_cell = -1;  // guide cell of the last scattering point (its light selection)
@@ -389,8 +402,12 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     if (depth++ == settings.max_depth) break;
     if (wo_l.z == 0.f) break;
     // Probability of drawing this vertex's direction from the guide (0: BSDF only).
-    const Float guide_p = kGuide && !delta_lobe ? guide_probability(g, cell, bsdf, (Spec & kSpecNonDiffuse) == 0) : 0.f;
+    // Not once guiding has raised the path's weight max_guide_ratio-fold (see guide_ratio).
+    const Float guide_p = kGuide && !delta_lobe && guide_ratio <= settings.max_guide_ratio
+                              ? guide_probability(g, cell, bsdf, (Spec & kSpecNonDiffuse) == 0)
+                              : 0.f;
     const bool guided_vertex = guide_p > 0.f;
+    if (kGuide && !delta_lobe && guide_ratio > settings.max_guide_ratio) ++c.guide_withheld_vertices;
 
     // The direction's random numbers are drawn before next-event estimation so
     // that the guide's alias entry can be fetched while the shadow ray is traced.
@@ -542,6 +559,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     }
     beta *= weight;
     rr_beta *= bsdf_pdf > 0.f ? bs.f * (abs_cos_theta(bs.wi) / bsdf_pdf) : weight;
+    if (guided_vertex) guide_ratio *= bsdf_pdf / scatter_pdf;
     prev_scatter_pdf = scatter_pdf;
     prev_cell = cell;
     specular_bounce = (bs.lobe & kLobeSpecular) != 0;

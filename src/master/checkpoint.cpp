@@ -46,6 +46,7 @@ uint64_t render_options_fingerprint(const RenderOptions& o, int32_t width, int32
     << o.force_full_specialisation;
   if (o.guide_trial) s << " trial";
   if (o.guide_roulette_window != kGuidedRouletteWindow) s << " window " << o.guide_roulette_window;
+  if (o.guide_max_ratio != kMaxGuideRatio) s << " max-ratio " << o.guide_max_ratio;
   // Checkpoints from before the taper learned every K-th sample throughout.
   if (o.guide_learn.taper) s << " taper";
   if (o.sampler.kind == SamplerKind::Sobol) s << " sobol";

@@ -36,6 +36,7 @@ TileSettings make_tile_settings(const RenderOptions& opt, uint32_t specialisatio
   ts.learn = opt.guide_learn;
   ts.path.guided_roulette = guiding && opt.guide_roulette;
   ts.path.guided_roulette_window = opt.guide_roulette_window;
+  ts.path.max_guide_ratio = opt.guide_max_ratio;
   ts.path.light_traced_caustics = opt.light_paths;
   return ts;
 }
@@ -125,6 +126,7 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
   stats.guide_learn = opt.guide_learn;
   stats.guide_roulette = guide != nullptr && opt.guide_roulette;
   stats.guide_roulette_window = opt.guide_roulette_window;
+  stats.guide_max_ratio = opt.guide_max_ratio;
 
   const uint64_t pixels = static_cast<uint64_t>(w) * h;
   Progress progress(opt.progress, opt.spp > 0 ? pixels * opt.spp : 0, opt.time_budget_s);

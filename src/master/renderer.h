@@ -32,6 +32,7 @@ struct RenderOptions {
   GuideLearnSchedule guide_learn;
   bool guide_roulette = true;   // guide-driven Russian roulette (guided renders)
   float guide_roulette_window = kGuidedRouletteWindow;  // its window (PathSettings::guided_roulette_window)
+  float guide_max_ratio = kMaxGuideRatio;  // PathSettings::max_guide_ratio
   bool force_full_specialisation = false;  // benchmark switch: ignore the effects set
   // --guide auto: guided and unguided passes are compared once the guide has
   // learned, and the render goes on with the cheaper (master/guide_trial.h).
@@ -81,6 +82,7 @@ struct RenderStats {
   GuideLearnSchedule guide_learn;  // the learning schedule the render ran with
   bool guide_roulette = false;     // whether guide-driven roulette was on
   float guide_roulette_window = 0.f;  // and its window
+  float guide_max_ratio = 0.f;        // PathSettings::max_guide_ratio
   GuideTrial guide_trial;          // --guide auto's comparison of guided and unguided passes
 };
 

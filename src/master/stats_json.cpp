@@ -77,6 +77,7 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
     j["guide_learn_taper"] = (s.guide_learn.taper ? "on" : "off");
     j["guide_roulette"] = (s.guide_roulette ? "guided" : "throughput");
     if (s.guide_roulette) j["guide_roulette_window"] = (s.guide_roulette_window);
+    j["guide_max_ratio"] = s.guide_max_ratio;
     j["guided_roulette_fraction"] = (
           c.path.vertices > 0 ? double(c.path.guided_roulette) / double(c.path.vertices) : 0.0);
     j["guide_mix_learned_cells"] = (s.guide.mix_learned_cells);
@@ -94,6 +95,8 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
           c.path.vertices > 0 ? double(c.path.nee_skipped) / double(c.path.vertices) : 0.0);
     j["guided_sample_fraction"] = (
           c.path.guidable_vertices > 0 ? double(c.path.guided_samples) / double(c.path.guidable_vertices) : 0.0);
+    const uint64_t could_guide = c.path.guidable_vertices + c.path.guide_withheld_vertices;
+    j["guide_withheld_fraction"] = could_guide > 0 ? double(c.path.guide_withheld_vertices) / double(could_guide) : 0.0;
   }
   // Per pass: how learning changes the paths.
   nlohmann::ordered_json passes = nlohmann::ordered_json::array();

@@ -71,6 +71,7 @@ struct TileCounters {
     path.interface_skips += o.path.interface_skips;
     path.guidable_vertices += o.path.guidable_vertices;
     path.guided_samples += o.path.guided_samples;
+    path.guide_withheld_vertices += o.path.guide_withheld_vertices;
     path.guide_updates += o.path.guide_updates;
     path.guided_roulette += o.path.guided_roulette;
     path.nee_skipped += o.path.nee_skipped;

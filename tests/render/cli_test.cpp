@@ -338,6 +338,23 @@ TEST_F(CliTest, GuideNextEventOption) {
   EXPECT_NE(bad.output.find("--guide-nee"), std::string::npos) << bad.output;
 }
 
+// --guide-max-ratio R: paths whose guided weight passed R sample their BSDF
+// alone; R = 1 leaves every vertex after the first guided one to the BSDF.
+TEST_F(CliTest, GuideMaxRatioOption) {
+  const std::string scene = testing::source_dir() + "/scenes/door-ajar.pbrt";
+  auto stats_of = [&](const std::string& args, const std::string& name) {
+    return render_stats(scene + " --res 32x24 --spp 32 --seed 3 --guide qtable " + args, name);
+  };
+  const std::string standard = stats_of("", "standard.json"), tight = stats_of("--guide-max-ratio 1", "tight.json");
+  EXPECT_EQ(json_number(standard, "guide_max_ratio"), 8.0) << standard;
+  EXPECT_EQ(json_number(tight, "guide_max_ratio"), 1.0) << tight;
+  EXPECT_GT(json_number(tight, "guide_withheld_fraction"), json_number(standard, "guide_withheld_fraction") + 0.1)
+      << standard << tight;
+  RunResult bad = run("render --guide-max-ratio 0.5");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--guide-max-ratio"), std::string::npos) << bad.output;
+}
+
 TEST_F(CliTest, InfoPrintsEffects) {
   RunResult r = run("info");
   EXPECT_EQ(r.exit_code, 0);

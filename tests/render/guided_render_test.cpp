@@ -20,19 +20,19 @@ using namespace tessera::testing;
 // Unguided renders compared with guided ones use another seed (independent estimates).
 constexpr uint64_t kUnguidedSeed = 1000003;
 
-SceneDesc furnace(double rho, int max_depth) {
+SceneDesc furnace(double rho, int max_depth, int res = 16) {
   char buf[1024];
   std::snprintf(buf, sizeof buf, R"(
 LookAt 0 0 0  0 0 1  0 1 0
 Camera "perspective" "float fov" [ 60 ]
-Film "rgb" "integer xresolution" [ 16 ] "integer yresolution" [ 16 ]
+Film "rgb" "integer xresolution" [ %d ] "integer yresolution" [ %d ]
 Sampler "independent" "integer pixelsamples" [ 256 ]
 Integrator "path" "integer maxdepth" [ %d ]
 WorldBegin
 Material "diffuse" "rgb reflectance" [ %g %g %g ]
 AreaLightSource "diffuse" "rgb L" [ 1 1 1 ] "bool twosided" true
 Shape "sphere" "float radius" [ 10 ]
-)", max_depth, rho, rho, rho);
+)", res, res, max_depth, rho, rho, rho);
   return load_pbrt_string(buf, "<furnace>", ".");
 }
 
@@ -68,6 +68,31 @@ double relative_variance_per_sample(const Film& film) {
     }
   }
   return sum / (3.0 * static_cast<double>(film.pixels.size()));
+}
+
+// An albedo-1 enclosure at depth 1000: every sample of an unguided render is
+// exactly 1001. Each guided vertex multiplies a path's weight by
+// bsdf_pdf / mixture_pdf, 1 on average; over hundreds of vertices the
+// product is unbiased but heavy-tailed, and a path whose product has passed
+// the cap (RenderOptions::guide_max_ratio) samples its BSDF alone from then
+// on. Capped, the render is still unbiased and its variance per sample a
+// fraction of the uncapped one's.
+TEST(GuidedFurnace, DepthThousandKeepsItsWeightsBounded) {
+  GuidedScene s(furnace(1.0, 1000, 8));
+  double variance[2];
+  for (int capped = 0; capped < 2; ++capped) {
+    GuideField guide = s.make_guide(config_with(GuideTarget::ExpectedSarsa));
+    RenderOptions opt;
+    if (!capped) opt.guide_max_ratio = 1e30f;
+    const RenderResult r = s.run(&guide, opt);
+    variance[capped] = relative_variance_per_sample(r.film);
+    const ChannelStats m = channel_stats(r.film);
+    EXPECT_NEAR(m.mean[0], 1001.0, 4.0 * m.se[0]) << "capped " << capped;
+    EXPECT_EQ(r.stats.counters.rejected_nonfinite, 0u);
+    EXPECT_GT(r.stats.counters.path.guided_samples, 0u);
+    EXPECT_EQ(r.stats.counters.path.guide_withheld_vertices > 0, capped == 1);
+  }
+  EXPECT_LT(variance[1], variance[0] / 2.0) << "capped " << variance[1] << ", uncapped " << variance[0];
 }
 
 // A ground and a ball under a uniform sky: the light is almost all direct,
