@@ -387,7 +387,7 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
   } else if (d == "LightSource") {
     std::string type = read_string(tokens, pos, at);
     ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
-    if (state_.ctm_end != state_.ctm) warn("a moving light is not supported; it stays where it starts");
+    if (state_.ctm_end != state_.ctm) warn("a moving light stays where it starts (pbrt-v4 uses its start transform too)");
     if (auto light = make_light(type, ps, ctm, context(at, including_dir))) {
       if (!open_instance_.empty()) warn("lights inside ObjectBegin are not instanced; added once");
       light->medium = state_.media.outside;  // resolved with the other medium names in resolve_media()
@@ -458,7 +458,7 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     std::string type = ps.get_string("type", "");
     if (type.empty()) fail(at, "MakeNamedMedium \"" + name + "\" needs \"string type\"");
     if (names_.media.count(name)) warn("named medium \"" + name + "\" redefined");
-    if (state_.ctm_end != state_.ctm) warn("a moving medium is not supported; it stays where it starts");
+    if (state_.ctm_end != state_.ctm) warn("a moving medium stays where it starts (pbrt-v4 uses its start transform too)");
     // Before WorldBegin the CTM is world-space: place the medium in render space too.
     const Mat4 render_from_medium(world_begun_ ? state_.ctm : render_from_world_ * state_.ctm);
     const Medium m = make_medium(type, ps, render_from_medium, context(at, including_dir));
