@@ -188,10 +188,10 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   // the product over guided vertices of bsdf_pdf / mixture_pdf. Each factor
   // is 1 on average, but over hundreds of guided vertices their product is
   // lognormal-like (docs/guiding.md, an albedo-1 enclosure at depth 1000):
-  // unbiased, too heavy-tailed to trust. A path whose
-  // ratio has passed settings.max_guide_ratio samples its BSDF alone from
-  // then on, a choice made from its past only, so the estimate stays
-  // unbiased and the ratio stays bounded (by that times one vertex's factor).
+  // unbiased, too heavy-tailed to trust. A path whose ratio has passed
+  // settings.max_guide_ratio samples its BSDF alone from then on, a choice
+  // made from its past only, so the estimate stays unbiased and the ratio
+  // stays bounded (by that times one vertex's factor).
   Float guide_ratio = 1.f;
   Vec3 prev_p(0.f);  // last scattering point: MIS on emitter hits measures from it, as NEE does
   bool prev_in_medium = false;  // whether it was in a medium (sample_light's in_medium)

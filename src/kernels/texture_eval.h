@@ -54,7 +54,7 @@ TESSERA_HOST_DEVICE inline bool odd_cell(Float x) {
 // terminates because the loader only lets a texture reference earlier ones.
 TESSERA_HOST_DEVICE inline Rgb eval_texture(const SceneView& s, int32_t tex_index, const TexturePoint& tp) {
   const Texture& t = s.textures[tex_index];
-  auto slot = [&](const TextureSlot& slot) { return slot.texture >= 0 ? eval_texture(s, slot.texture, tp) : slot.value; };
+  auto slot = [&](const TextureSlot& v) { return v.texture >= 0 ? eval_texture(s, v.texture, tp) : v.value; };
   switch (t.type) {
     case TextureType::Constant:
       return t.value;

@@ -27,15 +27,20 @@ std::string write_ramp(const std::filesystem::path& dir) {
   return path;
 }
 
+// A 2 x 2 quad in z = 0, u along x (dp/du = (2, 0, 0), dp/dv = (0, 2, 0)),
+// after `world`'s textures and material.
+std::string quad_scene(const std::string& world) {
+  return "WorldBegin\n" + world +
+         "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  2 0 0  2 2 0  0 2 0 ] "
+         "\"integer indices\" [ 0 1 2 0 2 3 ] \"point2 uv\" [ 0 0 1 0 1 1 0 1 ]\n";
+}
+
 TEST(Bump, LinearDisplacementTiltsTheNormalByItsSlope) {
   const auto dir = std::filesystem::temp_directory_path() / "tessera_bump_test";
   const std::string ramp = write_ramp(dir);
-  // A 2 x 2 quad in z = 0, u along x: dp/du = (2, 0, 0), dp/dv = (0, 2, 0).
-  const std::string scene = "WorldBegin\nTexture \"ramp\" \"float\" \"imagemap\" \"string filename\" \"" + ramp +
-                            "\" \"string encoding\" \"linear\" \"float scale\" 0.5\n"
-                            "Material \"diffuse\" \"texture displacement\" \"ramp\"\n"
-                            "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  2 0 0  2 2 0  0 2 0 ] "
-                            "\"integer indices\" [ 0 1 2 0 2 3 ] \"point2 uv\" [ 0 0 1 0 1 1 0 1 ]\n";
+  const std::string scene = quad_scene("Texture \"ramp\" \"float\" \"imagemap\" \"string filename\" \"" + ramp +
+                                        "\" \"string encoding\" \"linear\" \"float scale\" 0.5\n"
+                                        "Material \"diffuse\" \"texture displacement\" \"ramp\"\n");
   SceneData data(load_pbrt_string(scene, "<bump>", "."));
   const SceneView& s = data.view();
   ASSERT_GE(s.materials[s.triangles[0].material].bump, 0);
@@ -58,14 +63,11 @@ TEST(Bump, LinearDisplacementTiltsTheNormalByItsSlope) {
 // dp/dv as it steps u and v, so the slope in space becomes a slope in u.
 TEST(Bump, PointMappedDisplacementTiltsTheNormalToo) {
   // d = 0.5 x; the quad is 2 x 2 with u along x, so d rises by 1 per unit u.
-  const std::string scene =
-      "WorldBegin\n"
+  const std::string scene = quad_scene(
       "Texture \"x\" \"float\" \"bilerp\" \"string mapping\" \"planar\" \"float v10\" 1 \"float v11\" 1 "
       "\"float v01\" 0\n"
       "Texture \"d\" \"float\" \"scale\" \"texture tex\" \"x\" \"float scale\" 0.5\n"
-      "Material \"diffuse\" \"texture displacement\" \"d\"\n"
-      "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  2 0 0  2 2 0  0 2 0 ] "
-      "\"integer indices\" [ 0 1 2 0 2 3 ] \"point2 uv\" [ 0 0 1 0 1 1 0 1 ]\n";
+      "Material \"diffuse\" \"texture displacement\" \"d\"\n");
   SceneData data(load_pbrt_string(scene, "<bump>", "."));
   const SceneView& s = data.view();
   const SurfaceHit h = make_surface_hit(s, 0, 0.3f, 0.2f);
@@ -84,9 +86,7 @@ TEST(Bump, NormalMapRgbIsATangentSpaceNormal) {
   bytes.append(reinterpret_cast<const char*>(rgb), sizeof rgb);
   const std::string path = (dir / "n.pfm").string();
   std::ofstream(path, std::ios::binary) << bytes;
-  const std::string scene = "WorldBegin\nMaterial \"diffuse\" \"string normalmap\" \"" + path +
-                            "\"\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0  2 0 0  2 2 0  0 2 0 ] "
-                            "\"integer indices\" [ 0 1 2 0 2 3 ] \"point2 uv\" [ 0 0 1 0 1 1 0 1 ]\n";
+  const std::string scene = quad_scene("Material \"diffuse\" \"string normalmap\" \"" + path + "\"\n");
   SceneData data(load_pbrt_string(scene, "<normalmap>", "."));
   const SceneView& s = data.view();
   const int32_t image = s.materials[s.triangles[0].material].normal_map;
