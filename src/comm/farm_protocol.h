@@ -9,7 +9,8 @@
 //   Request   worker -> master: the tiles it finished (pixel accumulators
 //             and counters) and a request for `capacity` more. A worker
 //             keeps kRequestsInFlight requests open so it never waits idle
-//             for its next tiles.
+//             for its next tiles. `interrupted`: the worker was signalled
+//             (the master stops the farm after this pass).
 //   Jobs      master -> worker: tiles to render, each with its pixel
 //             accumulators so far (so samples add in the same order as in
 //             a local render: the image is bit-identical); empty = none
@@ -67,9 +68,10 @@ struct TileRequest {
   uint32_t capacity = 0;
   std::vector<TileWork> results;
   TileCounters counters;  // of the results
+  bool interrupted = false;
   template <class Archive>
   void serialize(Archive& ar) {
-    ar(capacity, results, raw_value(counters));
+    ar(capacity, results, raw_value(counters), interrupted);
   }
 };
 

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "comm/farm_protocol.h"
+#include "master/interrupt.h"
 #include "master/ordered_splats.h"
 #include "worker/thread_guide_accumulators.h"
 
@@ -72,6 +73,7 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
       throw std::runtime_error("rank " + std::to_string(m.source) + ": " + decode<FarmError>(m.bytes).message);
     if (m.tag != kTagRequest) throw std::runtime_error("rank " + std::to_string(m.source) + ": unexpected message");
     TileRequest req = decode<TileRequest>(m.bytes);
+    if (req.interrupted) note_worker_interrupt();
     for (TileWork& w : req.results) {
       // Only a job this pass handed out, as it was handed out.
       if (w.job.index >= jobs.size() || std::memcmp(&w.job, &jobs[w.job.index], sizeof(TileJob)) != 0 ||

@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include "comm/farm_protocol.h"
+#include "master/interrupt.h"
 #include "worker/thread_guide_accumulators.h"
 
 namespace tessera {
@@ -15,7 +16,8 @@ namespace {
 // the next tiles are already here when the current ones are done.
 void render_pass_tiles(Transport& t, const SceneView& view, const EmbreeTracer& tracer, const TileSettings& settings,
                        tbb::task_arena& arena, uint32_t capacity) {
-  for (uint32_t k = 0; k < kRequestsInFlight; ++k) t.send(0, kTagRequest, encode(TileRequest{capacity, {}, {}}));
+  for (uint32_t k = 0; k < kRequestsInFlight; ++k)
+    t.send(0, kTagRequest, encode(TileRequest{capacity, {}, {}, interrupt_requested()}));
   uint32_t open = kRequestsInFlight;
   std::mutex mutex;
   ThreadGuideAccumulators guide_acc(settings);
@@ -40,6 +42,7 @@ void render_pass_tiles(Transport& t, const SceneView& view, const EmbreeTracer& 
       });
     });
     req.results = std::move(jobs.jobs);
+    req.interrupted = interrupt_requested();  // signalled: the master stops the farm after this pass
     t.send(0, kTagRequest, encode(req));
     ++open;
   }

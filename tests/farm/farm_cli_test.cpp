@@ -96,8 +96,13 @@ TEST_F(FarmCliTest, InterruptedFarmWritesTheImageSoFarAndResumes) {
   RunResult interrupted = run_shell(
       "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe --mca odls_base_sigkill_timeout 5 -np 2 " +
       std::string(TESSERA_BINARY) + " render " + args + " --time 120 -o " + path("interrupted.exr") + " --stats " +
-      path("interrupted.json") + " --checkpoint " + ck + " --sampler zsobol --threads 1 & P=$!; sleep 3; kill -INT $P; wait $P; echo done=$?");
+      path("interrupted.json") + " --checkpoint " + ck + " --sampler zsobol --threads 1 & P=$!; sleep 3; kill -INT $P; " +
+      "sleep 2; test -f " + path("interrupted.json") + " && echo written-early; wait $P; echo done=$?");
   ASSERT_NE(interrupted.output.find("done="), std::string::npos) << interrupted.output;
+  // Open MPI sends the ranks SIGCONT at once and SIGTERM only after the kill
+  // timeout (5 s here): the ranks stop on the SIGCONT, so the image is
+  // written well before the SIGTERM.
+  EXPECT_NE(interrupted.output.find("written-early"), std::string::npos) << interrupted.output;
   ASSERT_TRUE(fs::exists(path("interrupted.exr"))) << interrupted.output;
   const std::string stats = read_text(path("interrupted.json"));
   EXPECT_NE(stats.find("\"stop_reason\": \"interrupted\""), std::string::npos) << stats;

@@ -78,7 +78,12 @@ TEST_F(CliTest, UnwritableOutputsFailBeforeRendering) {
   expect_one_line_error(run(slow + "-o " + good + " --guide-out " + missing + "/g.guide"), "--guide-out '");
   fs::create_directories(dir_ / "folder.exr");
   expect_one_line_error(run(slow + "-o " + (dir_ / "folder.exr").string()), "is a folder");
+  // A folder that permission bits call writable, to root too, where no file can be made.
+  if (fs::is_directory("/proc/self"))
+    expect_one_line_error(run(slow + "-o " + good + " --stats /proc/self/s.json"), "--stats '/proc/self/s.json': folder");
   EXPECT_FALSE(fs::exists(good));
+  for (const auto& entry : fs::directory_iterator(dir_))  // the write checks leave nothing behind
+    EXPECT_EQ(entry.path().filename().string().rfind(".tessera-write-check", 0), std::string::npos) << entry.path();
 }
 
 // A film that cannot fit in memory is refused before rendering, naming the

@@ -111,6 +111,7 @@ TEST(Extremes, EveryVariantRendersSanelyAndAgreesAcrossGuideMethods) {
       {"size 1e-5", 1.0, 1e-5},
       {"moved 1e6", 1.0, 1.0, 1e6},
       {"light 1e-3 across", 1.0, 1.0, 0.0, 1e-3, 0, 0, false},
+      {"light 1e3 across (far past the room)", 1.0, 1.0, 0.0, 1e3, 0, 0, false},
       {"64 nested textures (the limit), 16 nested mixes", 1.0, 1.0, 0.0, 1.0, 63, 16},
   };
   ChannelStats plain;
