@@ -64,21 +64,24 @@ void SceneData::flatten_meshes() {
   for (const MeshDesc& m : desc_.meshes) has_alpha_ |= m.alpha.texture >= 0 || m.alpha.value.x < 1.f;
   // Per-triangle media only for scenes that have any (the camera's included).
   has_media_ = (effects_ & kEffectMedia) != 0;
-  bool moves = false;
+  bool moves = false, any_normals = false, any_uv = false;
   size_t vertices = 0, triangles = 0;
   for (const MeshDesc& m : desc_.meshes) {
     moves |= !m.p_end.empty();
+    any_normals |= !m.n.empty();
+    any_uv |= !m.uv.empty();
     vertices += m.p.size();
     triangles += m.indices.size() / 3;
   }
   // Sized once: grown by doubling, the arrays would hold up to twice their
-  // size, and three times while they move.
+  // size, and three times while they move. Per-vertex normals and uv only
+  // when some mesh has them (a triangle's flags say whether it reads them).
   positions_.reserve(vertices);
-  normals_.reserve(vertices);
-  uvs_.reserve(vertices);
+  if (any_normals) normals_.reserve(vertices);
+  if (any_uv) uvs_.reserve(vertices);
   if (moves) {
     positions_end_.reserve(vertices);
-    normals_end_.reserve(vertices);
+    if (any_normals) normals_end_.reserve(vertices);
   }
   indices_.reserve(3 * triangles);
   face_normals_.reserve(triangles);
@@ -90,17 +93,18 @@ void SceneData::flatten_meshes() {
     const bool has_n = !m.n.empty(), has_uv = !m.uv.empty();
     for (size_t i = 0; i < m.p.size(); ++i) {
       positions_.push_back(m.p[i]);
-      normals_.push_back(has_n ? m.n[i] : Vec3(0.f));
+      if (any_normals) normals_.push_back(has_n ? m.n[i] : Vec3(0.f));
       if (moves) {
         const bool moving = m.p_end.size() == m.p.size();
         positions_end_.push_back(moving ? m.p_end[i] : m.p[i]);
-        normals_end_.push_back(has_n ? (moving && m.n_end.size() == m.n.size() ? m.n_end[i] : m.n[i]) : Vec3(0.f));
+        if (any_normals)
+          normals_end_.push_back(has_n ? (moving && m.n_end.size() == m.n.size() ? m.n_end[i] : m.n[i]) : Vec3(0.f));
         if (moving) {
           bounds_.lo = glm::min(bounds_.lo, m.p_end[i]);
           bounds_.hi = glm::max(bounds_.hi, m.p_end[i]);
         }
       }
-      uvs_.push_back(has_uv ? m.uv[i] : Vec2(0.f));
+      if (any_uv) uvs_.push_back(has_uv ? m.uv[i] : Vec2(0.f));
       bounds_.lo = glm::min(bounds_.lo, m.p[i]);
       bounds_.hi = glm::max(bounds_.hi, m.p[i]);
     }
