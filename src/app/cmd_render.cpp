@@ -2,13 +2,13 @@
 // Runs locally, or as a farm when started by mpirun (rank 0 = master).
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <optional>
 #include <regex>
 #include <sstream>
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include "app/commands.h"
@@ -129,8 +129,8 @@ void check_writable(const std::string& path, const char* option) {
   if (fs::is_directory(path, ec)) throw std::runtime_error(what + "is a folder");
   // Permission bits do not say everything (root passes access() for /proc or
   // a read-only mount): create a file there, as the outputs will be.
-  const std::string probe = (dir / (".tessera-write-check-" + std::to_string(getpid()))).string();
-  const int fd = open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+  std::string probe = (dir / ".tessera-write-check-XXXXXX").string();
+  const int fd = mkstemp(probe.data());
   if (fd < 0)
     throw std::runtime_error(what + "folder '" + dir.string() + "' is not writable (" + std::strerror(errno) + ")");
   close(fd);
@@ -469,9 +469,9 @@ int run_render_farm(const RenderArgs& a) {
 // Ctrl-C or SIGTERM: the render stops after its pass and writes what it has
 // (master/interrupt.h); the exit status then says it was interrupted.
 int run_render(const RenderArgs& a) {
-  const bool farm = launched_by_mpirun();
-  install_interrupt_handlers(farm);
-  const int rc = farm ? run_render_farm(a) : run_render_local(a);
+  // Open MPI's launcher (not srun) starts its kill sequence with SIGCONT.
+  install_interrupt_handlers(std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr);
+  const int rc = launched_by_mpirun() ? run_render_farm(a) : run_render_local(a);
   return rc == 0 && interrupt_requested() ? 130 : rc;
 }
 

@@ -28,6 +28,24 @@ inline CLI::Validator positive_number() {
       "POSITIVE");
 }
 
+// A finite number in [lo, hi] (CLI11's Range lets NaN through).
+inline CLI::Validator finite_range(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& in) -> std::string {
+        size_t used = 0;
+        double v = 0;
+        try {
+          v = std::stod(in, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == in.size() && v >= lo && v <= hi) return {};
+        return "must be a number from " + CLI::detail::to_string(lo) + " to " + CLI::detail::to_string(hi) + ", got '" +
+               in + "'";
+      },
+      "NUMBER");
+}
+
 CommandRunner add_render_command(CLI::App& app);
 CommandRunner add_info_command(CLI::App& app);
 CommandRunner add_compare_command(CLI::App& app);

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "app/commands.h"
 #include "kernels/effects.h"
 #include "master/renderer.h"
 
@@ -15,11 +16,11 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
                   "Learned guiding: qtable (expected SARSA), qlearning (max rule), none; auto = the scene's effects decide")
       ->check(CLI::IsMember({"auto", "none", "qtable", "qlearning"}));
   cmd->add_option("--guide-budget", a.budget_mb, "Guide cache memory budget in MB (cells stop refining there)")
-      ->check(CLI::Range(0.1, 1048576.0));
+      ->check(finite_range(0.1, 1048576.0));
   cmd->add_option("--guide-mix", a.mix,
                   "Probability of sampling a direction from the guide instead of the BSDF, the same in every cell "
                   "(default: learned per cell)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(finite_range(0.0, 1.0));
   cmd->add_option("--guide-split", a.split, "Updates a cell takes before it splits (0 = 24 per direction bin)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
   cmd->add_option("--guide-grid", a.grid, "Direction bins per side of the equal-area square (bins = grid^2)")
@@ -42,12 +43,12 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
   cmd->add_option("--guide-roulette-window", a.roulette_window,
                   "Guided roulette: a path the guide expects to bring at least 1/W of its predicted light always "
                   "survives. Smaller W: shorter paths, less time per sample, more noise per sample (default 2)")
-      ->check(CLI::Range(0.01, 100.0));
+      ->check(finite_range(0.01, 100.0));
   cmd->add_option("--guide-max-ratio", a.max_ratio,
                   "A path samples its BSDF alone once guided sampling has raised its weight R times over: keeps very "
                   "deep paths from heavy-tailed weights. Larger R: guiding at more vertices, more variance in deep "
                   "paths (default " + std::to_string(static_cast<int>(kMaxGuideRatio)) + ")")
-      ->check(CLI::Range(1.0, 1e30));
+      ->check(finite_range(1.0, 1e30));
   cmd->add_option("--guide-nee", a.nee,
                   "Next-event estimation of guided renders: learned (cells whose shadow rays bring little trace "
                   "them less often) or always (every vertex)")

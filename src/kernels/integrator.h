@@ -403,11 +403,12 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     if (wo_l.z == 0.f) break;
     // Probability of drawing this vertex's direction from the guide (0: BSDF only).
     // Not once guiding has raised the path's weight max_guide_ratio-fold (see guide_ratio).
-    const Float guide_p = kGuide && !delta_lobe && guide_ratio <= settings.max_guide_ratio
-                              ? guide_probability(g, cell, bsdf, (Spec & kSpecNonDiffuse) == 0)
-                              : 0.f;
+    Float guide_p = kGuide && !delta_lobe ? guide_probability(g, cell, bsdf, (Spec & kSpecNonDiffuse) == 0) : 0.f;
+    if (guide_p > 0.f && !(guide_ratio <= settings.max_guide_ratio)) {
+      guide_p = 0.f;
+      ++c.guide_withheld_vertices;
+    }
     const bool guided_vertex = guide_p > 0.f;
-    if (kGuide && !delta_lobe && guide_ratio > settings.max_guide_ratio) ++c.guide_withheld_vertices;
 
     // The direction's random numbers are drawn before next-event estimation so
     // that the guide's alias entry can be fetched while the shadow ray is traced.

@@ -12,8 +12,9 @@ namespace {
 constexpr char kMagic[] = "tessera-checkpoint";
 // 2: per-pass error estimates; 3: next-event skip counter, guide cache v2; 4: medium
 // vertex counter, --guide auto's trial; 5: guide cache v4; 6: light-path splats;
-// 7: splats summed per light path, lights in their own medium
-constexpr uint32_t kVersion = 7;
+// 7: splats summed per light path, lights in their own medium; 8: counter of
+// vertices the guide ratio left to the BSDF
+constexpr uint32_t kVersion = 8;
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.
 uint64_t fnv1a(const std::string& s) {

@@ -6,9 +6,11 @@
 //
 // Under mpirun, Ctrl-C makes Open MPI 4.1 send every rank SIGCONT at once,
 // SIGTERM odls_base_sigkill_timeout seconds later and SIGKILL as long again
-// (docs/farm.md). So a rank under mpirun stops after the pass on SIGCONT,
-// without counting it as a signal: mpirun's SIGTERM is then the first, and
-// the farm has twice the timeout to finish and write. A signalled worker
+// (docs/farm.md). So a rank started by Open MPI stops after the pass on a
+// SIGCONT from its parent (mpirun or orted), without counting it as a
+// signal: mpirun's SIGTERM is then the first, and the farm has twice the
+// timeout to finish and write. A SIGCONT from anyone else (a scheduler
+// resuming a suspended job) is not a stop. A signalled worker
 // tells the master with its next tile request, and the master stops the
 // farm the same way. (SIGUSR1, which mpirun forwards, was tried: handling it
 // crashed ranks.)
@@ -16,8 +18,8 @@
 
 namespace tessera {
 
-// under_mpirun: SIGCONT also asks for the stop (see above).
-void install_interrupt_handlers(bool under_mpirun);
+// open_mpi: started by Open MPI's mpirun, whose SIGCONT asks for the stop (see above).
+void install_interrupt_handlers(bool open_mpi);
 // A first signal here, or a worker's (note_worker_interrupt).
 bool interrupt_requested();
 // A farm worker was signalled: stop after the pass, without counting as a

@@ -84,10 +84,10 @@ TEST_F(FarmCliTest, KilledRenderResumesBitIdenticallyOnOtherRankCounts) {
   EXPECT_TRUE(exr_channels(path("resumed.exr")) == exr_channels(path("whole.exr")));
 }
 
-// Ctrl-C to mpirun (it sends SIGTERM to every rank and kills them
-// odls_base_sigkill_timeout seconds later; 5 here): the master stops the
-// farm after the pass under way and writes the image so far and its
-// checkpoint; resumed on another rank count and with another --spp, it ends
+// Ctrl-C to mpirun (Open MPI sends every rank SIGCONT, SIGTERM
+// odls_base_sigkill_timeout seconds later, 5 here, and SIGKILL as long
+// again): the master stops the farm after the pass under way and writes the
+// image so far and its checkpoint; resumed on another rank count and with another --spp, it ends
 // as an uninterrupted render would. The scene is drawn with zsobol, whose
 // epoch --spp must not change for the resume to be accepted.
 TEST_F(FarmCliTest, InterruptedFarmWritesTheImageSoFarAndResumes) {
@@ -114,6 +114,26 @@ TEST_F(FarmCliTest, InterruptedFarmWritesTheImageSoFarAndResumes) {
   RunResult whole = run("render " + args + more + " -o " + path("whole.exr"));
   ASSERT_EQ(whole.exit_code, 0) << whole.output;
   EXPECT_TRUE(exr_channels(path("resumed.exr")) == exr_channels(path("whole.exr")));
+}
+
+// A worker signalled alone (as a scheduler may signal one node first): it
+// tells the master with its next tile request, and the master stops the
+// whole farm after the pass and writes the image so far. A worker that kept
+// the signal to itself would render on until --time runs out.
+TEST_F(FarmCliTest, SignalledWorkerStopsTheWholeFarm) {
+  const std::string out = path("worker-signalled.json");
+  RunResult r = run_shell(
+      "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe -np 2 " +
+      std::string(TESSERA_BINARY) + " render " + kDoor + " -q --no-preview --res 64x48 --seed 5 --time 60 --threads 1 -o " +
+      path("worker-signalled.exr") + " --stats " + out + " & P=$!; sleep 3; " +
+      "for p in $(pgrep -f 'tessera render'); do tr '\\0' '\\n' < /proc/$p/environ 2>/dev/null | " +
+      "grep -qx OMPI_COMM_WORLD_RANK=1 && kill -TERM $p; done; " +
+      "for i in $(seq 1 50); do test -f " + out + " && break; sleep 0.2; done; test -f " + out +
+      " && echo written-within-10s; wait $P; echo done=$?");
+  ASSERT_NE(r.output.find("done="), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("written-within-10s"), std::string::npos) << r.output;
+  const std::string stats = read_text(out);
+  EXPECT_NE(stats.find("\"stop_reason\": \"interrupted\""), std::string::npos) << stats;
 }
 
 TEST_F(FarmCliTest, BadCheckpointsAreRefusedAndLeaveOutputsAlone) {

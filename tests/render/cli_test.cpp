@@ -344,7 +344,8 @@ TEST_F(CliTest, GuideNextEventOption) {
 }
 
 // --guide-max-ratio R: paths whose guided weight passed R sample their BSDF
-// alone; R = 1 leaves every vertex after the first guided one to the BSDF.
+// alone; with R = 1 a path is guided only while the guide has not raised
+// its weight at all, so far more vertices are left to the BSDF. NaN is refused.
 TEST_F(CliTest, GuideMaxRatioOption) {
   const std::string scene = testing::source_dir() + "/scenes/door-ajar.pbrt";
   auto stats_of = [&](const std::string& args, const std::string& name) {
@@ -355,9 +356,11 @@ TEST_F(CliTest, GuideMaxRatioOption) {
   EXPECT_EQ(json_number(tight, "guide_max_ratio"), 1.0) << tight;
   EXPECT_GT(json_number(tight, "guide_withheld_fraction"), json_number(standard, "guide_withheld_fraction") + 0.1)
       << standard << tight;
-  RunResult bad = run("render --guide-max-ratio 0.5");
-  EXPECT_NE(bad.exit_code, 0);
-  EXPECT_NE(bad.output.find("--guide-max-ratio"), std::string::npos) << bad.output;
+  for (const char* value : {"0.5", "nan"}) {
+    RunResult bad = run(std::string("render --guide-max-ratio ") + value);
+    EXPECT_NE(bad.exit_code, 0) << value;
+    EXPECT_NE(bad.output.find("--guide-max-ratio"), std::string::npos) << bad.output;
+  }
 }
 
 TEST_F(CliTest, InfoPrintsEffects) {
