@@ -10,19 +10,25 @@ namespace tessera {
 
 using CommandRunner = std::function<int()>;
 
+// Whether `in` is one number and nothing else (NaN and Inf included: the
+// callers bound it).
+inline bool parse_number(const std::string& in, double* v) {
+  size_t used = 0;
+  try {
+    *v = std::stod(in, &used);
+  } catch (const std::exception&) {
+    return false;
+  }
+  return used == in.size();
+}
+
 // A finite number > 0; the error reads "must be a positive number, got 'X'"
 // (CLI11's PositiveNumber prints its whole double range).
 inline CLI::Validator positive_number() {
   return CLI::Validator(
       [](std::string& in) -> std::string {
-        size_t used = 0;
         double v = 0;
-        try {
-          v = std::stod(in, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (used == in.size() && v > 0 && v < 1e300) return {};
+        if (parse_number(in, &v) && v > 0 && v < 1e300) return {};
         return "must be a positive number, got '" + in + "'";
       },
       "POSITIVE");
@@ -32,14 +38,8 @@ inline CLI::Validator positive_number() {
 inline CLI::Validator finite_range(double lo, double hi) {
   return CLI::Validator(
       [lo, hi](std::string& in) -> std::string {
-        size_t used = 0;
         double v = 0;
-        try {
-          v = std::stod(in, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (used == in.size() && v >= lo && v <= hi) return {};
+        if (parse_number(in, &v) && v >= lo && v <= hi) return {};
         return "must be a number from " + CLI::detail::to_string(lo) + " to " + CLI::detail::to_string(hi) + ", got '" +
                in + "'";
       },
