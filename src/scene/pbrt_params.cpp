@@ -233,8 +233,7 @@ std::vector<Vec3> as_vec3s(const Param* p) {
   std::vector<Vec3> out;
   if (!p) return out;
   for (size_t i = 0; i + 2 < p->numbers.size(); i += 3)
-    out.emplace_back(p->numbers[i], p->numbers[i + 1],
-                     p->numbers[i + 2]);
+    out.emplace_back(p->numbers[i], p->numbers[i + 1], p->numbers[i + 2]);
   return out;
 }
 }  // namespace
@@ -283,8 +282,7 @@ std::vector<Rgb> ParamSet::get_rgbs(const std::string& name) const {
   const Param* p = find(name, {"rgb"});
   if (!p) return out;
   for (size_t i = 0; i + 2 < p->numbers.size(); i += 3)
-    out.emplace_back(p->numbers[i], p->numbers[i + 1],
-                     p->numbers[i + 2]);
+    out.emplace_back(p->numbers[i], p->numbers[i + 1], p->numbers[i + 2]);
   return out;
 }
 
