@@ -46,6 +46,13 @@ class CliTest : public ::testing::Test {
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return testing::read_text(stats);
   }
+  // The same for door-ajar guided by the Q-table at 32x24 (seed 3): where
+  // guided roulette, learned NEE and the guide ratio all have work to do.
+  std::string door_guided_stats(const std::string& args, const std::string& name, int spp = 64) {
+    return render_stats(testing::source_dir() + "/scenes/door-ajar.pbrt --res 32x24 --spp " + std::to_string(spp) +
+                            " --seed 3 --guide qtable " + args,
+                        name);
+  }
   fs::path dir_;
 };
 
@@ -308,10 +315,7 @@ TEST_F(CliTest, GuideRouletteOption) {
 // door-ajar, where guided roulette keeps light-carrying paths alive); the
 // stats record it; bad values are refused.
 TEST_F(CliTest, GuideRouletteWindowOption) {
-  const std::string scene = testing::source_dir() + "/scenes/door-ajar.pbrt";
-  auto stats_of = [&](const std::string& args, const std::string& name) {
-    return render_stats(scene + " --res 32x24 --spp 64 --seed 3 --guide qtable " + args, name);
-  };
+  auto stats_of = [&](const std::string& args, const std::string& name) { return door_guided_stats(args, name); };
   const std::string wide = stats_of("", "wide.json"), narrow = stats_of("--guide-roulette-window 0.25", "narrow.json");
   EXPECT_EQ(json_number(wide, "guide_roulette_window"), 2.0) << wide;
   EXPECT_EQ(json_number(narrow, "guide_roulette_window"), 0.25) << narrow;
@@ -324,10 +328,7 @@ TEST_F(CliTest, GuideRouletteWindowOption) {
 // --guide-nee learned (default) skips shadow rays where the guide learned
 // they bring little (door-ajar's room behind a door gap); always never does.
 TEST_F(CliTest, GuideNextEventOption) {
-  const std::string scene = testing::source_dir() + "/scenes/door-ajar.pbrt";
-  auto stats_of = [&](const std::string& args, const std::string& name) {
-    return render_stats(scene + " --res 32x24 --spp 64 --seed 3 --guide qtable " + args, name);
-  };
+  auto stats_of = [&](const std::string& args, const std::string& name) { return door_guided_stats(args, name); };
   const std::string learned = stats_of("", "learned.json"), always = stats_of("--guide-nee always", "always.json");
   EXPECT_NE(learned.find("\"guide_nee\": \"learned\""), std::string::npos) << learned;
   EXPECT_NE(always.find("\"guide_nee\": \"always\""), std::string::npos) << always;
@@ -347,10 +348,7 @@ TEST_F(CliTest, GuideNextEventOption) {
 // alone; with R = 1 a path is guided only while the guide has not raised
 // its weight at all, so far more vertices are left to the BSDF. NaN is refused.
 TEST_F(CliTest, GuideMaxRatioOption) {
-  const std::string scene = testing::source_dir() + "/scenes/door-ajar.pbrt";
-  auto stats_of = [&](const std::string& args, const std::string& name) {
-    return render_stats(scene + " --res 32x24 --spp 32 --seed 3 --guide qtable " + args, name);
-  };
+  auto stats_of = [&](const std::string& args, const std::string& name) { return door_guided_stats(args, name, 32); };
   const std::string standard = stats_of("", "standard.json"), tight = stats_of("--guide-max-ratio 1", "tight.json");
   EXPECT_EQ(json_number(standard, "guide_max_ratio"), 8.0) << standard;
   EXPECT_EQ(json_number(tight, "guide_max_ratio"), 1.0) << tight;
