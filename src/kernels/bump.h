@@ -52,7 +52,7 @@ TESSERA_HOST_DEVICE inline Vec3 bumped_shading_normal(const SceneView& s, int32_
 TESSERA_HOST_DEVICE inline Vec3 normal_mapped_shading_normal(const SceneView& s, int32_t image, const SurfaceHit& h) {
   Vec3 dpdu, dpdv;
   shading_derivatives(s, h, &dpdu, &dpdv);
-  const Rgb rgb = image_bilerp(s.images[image], h.uv);
+  const Rgb rgb = image_lookup(s.images[image], h.uv);
   const Vec3 local = 2.f * Vec3(rgb.x, rgb.y, rgb.z) - Vec3(1.f);
   const Float len = glm::length(local), ulen = glm::length(dpdu);
   if (!(len > 0.f) || !(ulen > 0.f)) return h.ns;

@@ -24,6 +24,12 @@ enum class TextureType : uint32_t {
 // (the 3D textures: fbm, wrinkled, windy, marble, 3D checkerboard) by p itself.
 enum class TextureMapping : uint32_t { UV = 0, Spherical, Cylindrical, Planar, Point3D };
 
+// Image textures' wrap modes and filters (pbrt-v4's WrapMode; "point" reads
+// the nearest texel, every other filter bilinearly: without ray
+// differentials pbrt-v4's trilinear and EWA filters read the finest level).
+enum class ImageWrap : uint32_t { Repeat = 0, Black, Clamp, OctahedralSphere };
+enum class ImageFilter : uint32_t { Bilinear = 0, Point };
+
 struct Texture {
   TextureType type = TextureType::Constant;
   Rgb value{0.f};            // Constant
@@ -34,6 +40,8 @@ struct Texture {
   Vec3 vs{1.f, 0.f, 0.f}, vt{0.f, 1.f, 0.f};  // Planar
   Float scale = 1.f;         // Image: multiplier (pbrt "scale"); Marble: frequency
   bool invert = false;       // Image: 1 - value (pbrt "invert")
+  ImageWrap wrap = ImageWrap::Repeat;        // Image
+  ImageFilter filter = ImageFilter::Bilinear;  // Image
   TextureSlot a, b;          // Scale: a * b ("tex" * "scale"); Checkerboard, Mix, DirectionMix: tex1, tex2;
                              // Dots: inside, outside the dots
   TextureSlot amount;        // Mix: (1 - amount) tex1 + amount tex2
@@ -76,6 +84,9 @@ struct Material {
   // (alpha = sqrt(roughness), pbrt-v4) when remap_roughness. Unused when both are constant.
   TextureSlot roughness_u{-1, Rgb(0.f)}, roughness_v{-1, Rgb(0.f)};
   bool textured_roughness = false;
+  // coatedconductor: the conductor's textured roughness, the same way.
+  TextureSlot base_roughness_u{-1, Rgb(0.f)}, base_roughness_v{-1, Rgb(0.f)};
+  bool textured_base_roughness = false;
   int32_t bump = -1;                         // "displacement" float texture (bump mapping), -1 = none
   int32_t normal_map = -1;                   // "normalmap" image (linear RGB), -1 = none; bump wins
   bool remap_roughness = true;

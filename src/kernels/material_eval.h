@@ -41,6 +41,17 @@ TESSERA_HOST_DEVICE inline const Material* resolve_material(const SceneView& s, 
 // In spectral mode (wl non-null) colours become values at the path's
 // wavelengths: reflectances as albedo spectra, conductors' eta and k as
 // unbounded spectra (spectral.h).
+// GGX alphas from roughness textures, remapped as pbrt-v4's RoughnessToAlpha
+// when the material asks.
+TESSERA_HOST_DEVICE inline void textured_alpha(const SceneView& s, const Material& m, const TextureSlot& u,
+                                               const TextureSlot& v, const SurfaceHit& h, Float* alpha_x, Float* alpha_y) {
+  Float ru = eval_slot(s, u, texture_point(h)).x, rv = eval_slot(s, v, texture_point(h)).x;
+  ru = ru > 0.f && ru < 1e30f ? ru : 0.f;  // NaN, Inf or negative texels: smooth
+  rv = rv > 0.f && rv < 1e30f ? rv : 0.f;
+  *alpha_x = m.remap_roughness ? glm::sqrt(ru) : ru;
+  *alpha_y = m.remap_roughness ? glm::sqrt(rv) : rv;
+}
+
 template <uint32_t Spec>
 TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t material, const SurfaceHit& h, const Vec3& wo,
                                              BsdfParams* out, Wavelengths* wl = nullptr) {
@@ -55,13 +66,8 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
   b.alpha_y = m->alpha_y;
   b.bump = m->bump;
   b.normal_map = m->normal_map;
-  if ((Spec & kSpecTextures) && m->textured_roughness) {
-    Float ru = eval_slot(s, m->roughness_u, texture_point(h)).x, rv = eval_slot(s, m->roughness_v, texture_point(h)).x;
-    ru = ru > 0.f && ru < 1e30f ? ru : 0.f;  // NaN, Inf or negative texels: smooth
-    rv = rv > 0.f && rv < 1e30f ? rv : 0.f;
-    b.alpha_x = m->remap_roughness ? glm::sqrt(ru) : ru;  // pbrt-v4's RoughnessToAlpha
-    b.alpha_y = m->remap_roughness ? glm::sqrt(rv) : rv;
-  }
+  if ((Spec & kSpecTextures) && m->textured_roughness)
+    textured_alpha(s, *m, m->roughness_u, m->roughness_v, h, &b.alpha_x, &b.alpha_y);
   b.ior = m->ior;
   if (wl && m->ior_spectrum >= 0) {
     // Dispersion: the index at the one wavelength the path goes on with
@@ -87,6 +93,8 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
       if (m->type == MaterialType::CoatedConductor) {
         b.base_alpha_x = m->base_alpha_x;
         b.base_alpha_y = m->base_alpha_y;
+        if ((Spec & kSpecTextures) && m->textured_base_roughness)
+          textured_alpha(s, *m, m->base_roughness_u, m->base_roughness_v, h, &b.base_alpha_x, &b.base_alpha_y);
         b.thickness = m->thickness;
         b.layer_max_depth = m->layer_max_depth;
         b.layer_samples = m->layer_samples;

@@ -1,6 +1,7 @@
 // Evaluating textures at a surface point (point sampling; no ray differentials yet).
 #pragma once
 
+#include "image_sampling.h"
 #include "procedural_texture.h"
 #include "scene_view.h"
 #include "surface.h"
@@ -8,38 +9,6 @@
 #include "vecmath.h"
 
 namespace tessera {
-
-TESSERA_HOST_DEVICE inline Rgb image_bilerp(const ImageView& img, Vec2 st) {
-  // pbrt-v4 flips t for image lookups and wraps with "repeat". Wrapping in
-  // float first keeps the integer conversions in range for any st (NaN -> 0).
-  st = st - glm::floor(st);
-  if (!(st.x >= 0.f && st.x <= 1.f)) st.x = 0.f;
-  if (!(st.y >= 0.f && st.y <= 1.f)) st.y = 0.f;
-  Float x = st.x * img.width - 0.5f, y = (1.f - st.y) * img.height - 0.5f;
-  Float fx = glm::floor(x), fy = glm::floor(y);
-  Float dx = x - fx, dy = y - fy;
-  auto texel = [&](int32_t ix, int32_t iy) {
-    ix %= img.width;
-    iy %= img.height;
-    if (ix < 0) ix += img.width;
-    if (iy < 0) iy += img.height;
-    return glm::max(img.texels[static_cast<size_t>(iy) * img.width + ix], Rgb(0.f));  // pbrt clamps negatives
-  };
-  int32_t ix = static_cast<int32_t>(fx), iy = static_cast<int32_t>(fy);
-  return (1.f - dx) * (1.f - dy) * texel(ix, iy) + dx * (1.f - dy) * texel(ix + 1, iy) +
-         (1.f - dx) * dy * texel(ix, iy + 1) + dx * dy * texel(ix + 1, iy + 1);
-}
-
-// Nearest-texel lookup in an equal-area octahedral environment map (pbrt-v4
-// ImageInfiniteLight::ImageLe): uv (0,0) is the top-left texel, no flip.
-TESSERA_HOST_DEVICE inline Rgb image_lookup_nearest_equal_area(const ImageView& img, Vec2 uv) {
-  Float fx = glm::clamp(uv.x, 0.f, 1.f) * img.width, fy = glm::clamp(uv.y, 0.f, 1.f) * img.height;
-  if (!(fx >= 0.f)) fx = 0.f;  // NaN
-  if (!(fy >= 0.f)) fy = 0.f;
-  int32_t x = glm::min(static_cast<int32_t>(fx), img.width - 1);
-  int32_t y = glm::min(static_cast<int32_t>(fy), img.height - 1);
-  return glm::max(img.texels[static_cast<size_t>(y) * img.width + x], Rgb(0.f));  // pbrt clamps negatives
-}
 
 // Whether the integer cell holding x is odd, from floor(x) in float (no cast
 // to overflow; NaN and cells beyond float's integers read even), so that a
@@ -59,7 +28,7 @@ TESSERA_HOST_DEVICE inline Rgb eval_texture(const SceneView& s, int32_t tex_inde
     case TextureType::Constant:
       return t.value;
     case TextureType::Image: {
-      Rgb v = image_bilerp(s.images[t.image], texture_st(t, tp)) * t.scale;
+      Rgb v = image_lookup(s.images[t.image], texture_st(t, tp), t.wrap, t.filter) * t.scale;
       return t.invert ? glm::max(Rgb(0.f), Rgb(1.f) - v) : v;
     }
     case TextureType::Scale: {  // pbrt-v4: a zero scale does not evaluate the texture

@@ -155,10 +155,11 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
       m.conductor_from_reflectance = true;
       m.reflectance = spectrum_slot(params, "reflectance", Rgb(1.f), ctx);
     }
-    if (m.textured_roughness) {
-      ctx.warn("a textured \"conductor.roughness\" is not supported; the conductor is smooth");
+    if (m.textured_roughness) {  // the interface's roughness goes in roughness_u/v
+      m.textured_base_roughness = true;
+      m.base_roughness_u = m.roughness_u;
+      m.base_roughness_v = m.roughness_v;
       m.textured_roughness = false;
-      m.alpha_x = m.alpha_y = 0.f;
     }
     m.type = MaterialType::CoatedConductor;
     m.base_alpha_x = m.alpha_x;

@@ -88,6 +88,23 @@ TextureSlot any_slot(const ParamSet& params, const std::string& name, bool spect
   return spectrum ? spectrum_slot(params, name, fallback, ctx) : float_slot(params, name, fallback.x, ctx);
 }
 
+// An image texture's "wrap" and "filter", with pbrt-v4's names; pbrt-v4
+// refuses unknown ones. Without ray differentials every filter but "point"
+// reads the finest level bilinearly (pbrt-v4's choice for a zero footprint).
+void read_image_lookup(Texture& t, const ParamSet& params, const DirectiveContext& ctx) {
+  const std::string wrap = params.get_string("wrap", "repeat");
+  if (wrap == "repeat") t.wrap = ImageWrap::Repeat;
+  else if (wrap == "black") t.wrap = ImageWrap::Black;
+  else if (wrap == "clamp") t.wrap = ImageWrap::Clamp;
+  else if (wrap == "octahedralsphere") t.wrap = ImageWrap::OctahedralSphere;
+  else ctx.fail("texture wrap mode \"" + wrap + "\" unknown (repeat, black, clamp or octahedralsphere)");
+  const std::string filter = params.get_string("filter", "bilinear");
+  if (filter == "point") t.filter = ImageFilter::Point;
+  else if (filter == "bilinear" || filter == "trilinear" || filter == "ewa" || filter == "EWA") t.filter = ImageFilter::Bilinear;
+  else ctx.fail("texture filter \"" + filter + "\" unknown (point, bilinear, trilinear or ewa)");
+  params.get_float("maxanisotropy", 8.f);
+}
+
 }  // namespace
 
 int32_t image_index(const std::string& filename, const std::string& encoding_name, bool grey,
@@ -170,11 +187,7 @@ void make_named_texture(const std::string& name, const std::string& kind, const 
     t.scale = params.get_float("scale", 1.f);
     t.invert = params.get_bool("invert", false);
     read_mapping_2d(t, params, render_from_texture, ctx);
-    // Filtering and wrapping: we always bilinear-filter and repeat.
-    params.get_string("filter", "bilinear");
-    params.get_float("maxanisotropy", 8.f);
-    std::string wrap = params.get_string("wrap", "repeat");
-    if (wrap != "repeat") ctx.warn("texture wrap mode \"" + wrap + "\" is not supported; using \"repeat\"");
+    read_image_lookup(t, params, ctx);
   } else if (texture_class == "scale") {
     t.type = TextureType::Scale;
     t.a = any_slot(params, "tex", spectrum, Rgb(1.f), ctx);

@@ -3,6 +3,8 @@
 
 #include <ImfRgbaFile.h>
 
+#include "kernels/effects.h"
+#include "kernels/material_eval.h"
 #include "scene/displacement.h"
 #include "scene/image_io.h"
 #include "scene/pbrt_materials.h"
@@ -92,6 +94,34 @@ TEST(PbrtMaterials, CoatedConductorKeepsItsCoatAndItsConductor) {
   // Only the scattering layer (albedo) is approximated, and said so.
   ASSERT_EQ(s.warnings.size(), 1u);
   EXPECT_NE(s.warnings[0].find("albedo"), std::string::npos) << s.warnings[0];
+}
+
+TEST(PbrtMaterials, CoatedConductorReadsATexturedConductorRoughness) {
+  // pbrt-v4 evaluates both roughnesses at the hit: the conductor's from a
+  // checkerboard (0.04 or 0.25, remapped to alpha 0.2 or 0.5), the coat's constant.
+  SceneDesc s = load_world(std::string("Texture \"r\" \"float\" \"checkerboard\" \"float tex1\" 0.04 \"float tex2\" 0.25\n"
+                                       "Material \"coatedconductor\" \"texture conductor.roughness\" \"r\" "
+                                       "\"float interface.roughness\" 0.01\n") + kTriangle);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  const Material& m = material_of_last_mesh(s);
+  ASSERT_TRUE(m.textured_base_roughness);
+  EXPECT_FALSE(m.textured_roughness);
+  SceneView view;
+  view.materials = s.materials.data();
+  view.num_materials = static_cast<uint32_t>(s.materials.size());
+  view.textures = s.textures.data();
+  SurfaceHit h{};
+  h.ng = h.ns = Vec3(0.f, 0.f, 1.f);
+  const auto alphas = [&](Vec2 uv) {
+    h.uv = uv;
+    BsdfParams b;
+    EXPECT_TRUE(resolve_bsdf<kSpecAll>(view, s.meshes.back().material, h, Vec3(0.f, 0.f, 1.f), &b));
+    EXPECT_FLOAT_EQ(b.alpha_x, 0.1f);  // the coat
+    EXPECT_FLOAT_EQ(b.base_alpha_x, b.base_alpha_y);
+    return b.base_alpha_x;
+  };
+  EXPECT_FLOAT_EQ(alphas(Vec2(0.25f, 0.25f)), 0.2f);
+  EXPECT_FLOAT_EQ(alphas(Vec2(1.25f, 0.25f)), 0.5f);
 }
 
 TEST(PbrtMaterials, DiffuseTransmission) {
@@ -186,6 +216,40 @@ TEST(PbrtTextures, ImagemapPngIsSrgbDecodedAndDeduplicated) {
   EXPECT_FLOAT_EQ(s.textures[0].scale, 2.f);
   EXPECT_TRUE(s.textures[0].invert);
   EXPECT_FLOAT_EQ(s.textures[0].du, 0.5f);
+}
+
+TEST(PbrtTextures, ImagemapWrapAndFilterAsPbrtV4) {
+  test::TempDir dir;
+  const unsigned char px[6] = {255, 255, 255, 0, 0, 0};
+  ASSERT_NE(stbi_write_png(dir.file("tex.png").c_str(), 2, 1, 3, px, 6), 0);
+  const std::string image = "\"imagemap\" \"string filename\" \"tex.png\" ";
+  SceneDesc s = load_world("Texture \"a\" \"float\" " + image + "\n" +
+                               "Texture \"b\" \"float\" " + image + "\"string wrap\" \"black\" \"string filter\" \"point\"\n" +
+                               "Texture \"c\" \"float\" " + image + "\"string wrap\" \"clamp\" \"string filter\" \"ewa\"\n" +
+                               "Texture \"d\" \"float\" " + image + "\"string wrap\" \"octahedralsphere\"\n" + kTriangle,
+                           dir.path());
+  ASSERT_EQ(s.textures.size(), 4u);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  EXPECT_EQ(s.textures[0].wrap, ImageWrap::Repeat);
+  EXPECT_EQ(s.textures[0].filter, ImageFilter::Bilinear);
+  EXPECT_EQ(s.textures[1].wrap, ImageWrap::Black);
+  EXPECT_EQ(s.textures[1].filter, ImageFilter::Point);
+  EXPECT_EQ(s.textures[2].wrap, ImageWrap::Clamp);
+  EXPECT_EQ(s.textures[3].wrap, ImageWrap::OctahedralSphere);
+  // Left of the image (s = -0.25): repeat reads the black right texel, clamp the white left one.
+  HostTextures t(s);
+  const Vec3 p(0.f), n(0.f, 0.f, 1.f);
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{0, Rgb(0.f)}, p, n, Vec2(-0.25f, 0.5f)), 0.f);
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{1, Rgb(0.f)}, p, n, Vec2(-0.25f, 0.5f)), 0.f);
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{2, Rgb(0.f)}, p, n, Vec2(-0.25f, 0.5f)), 1.f);
+  EXPECT_FLOAT_EQ(t.eval(TextureSlot{1, Rgb(0.f)}, p, n, Vec2(0.3f, 0.5f)), 1.f);  // nearest: the white texel
+  // pbrt-v4 refuses unknown names.
+  EXPECT_NE(test::load_error("WorldBegin\nTexture \"e\" \"float\" " + image + "\"string wrap\" \"mirror\"\n", dir.path())
+                .find("wrap mode \"mirror\" unknown"),
+            std::string::npos);
+  EXPECT_NE(test::load_error("WorldBegin\nTexture \"e\" \"float\" " + image + "\"string filter\" \"cubic\"\n", dir.path())
+                .find("filter \"cubic\" unknown"),
+            std::string::npos);
 }
 
 TEST(PbrtTextures, ExrImageLoadsLinear) {
