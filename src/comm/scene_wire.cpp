@@ -7,7 +7,7 @@ namespace tessera {
 template <class Archive>
 void serialize(Archive& ar, MeshDesc& m) {
   ar(raw(m.p), raw(m.n), raw(m.uv), raw(m.indices), m.material, m.flip_normals, m.area_light, raw_value(m.alpha), raw_value(m.media),
-     raw(m.p_end), raw(m.n_end), m.where);
+     raw(m.p_end), raw(m.n_end), m.triangles_per_shape, m.shape_area, m.where);
 }
 template <class Archive>
 void serialize(Archive& ar, ImageDesc& i) {

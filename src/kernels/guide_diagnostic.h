@@ -31,7 +31,7 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g
     const TriangleInfo& info = s.triangles[hit.triangle];
     if (info.light >= 0) {
       const Light& l = s.lights[info.light];
-      if (l.two_sided || glm::dot(h.ng, wo) > 0.f) return beta * l.L;
+      if (l.two_sided || glm::dot(h.ng, wo) > 0.f) return beta * area_light_radiance(s, l, h.uv);
     }
     BsdfParams bsdf;
     if (!resolve_bsdf<kSpec>(s, info.material, h, wo, &bsdf)) {

@@ -348,7 +348,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         if ((l.two_sided || cos_l > 0.f) && first_vertex_connectable && last_vertex_delta_only) {
           ++c.caustic_emission_skipped;
         } else if (l.two_sided || cos_l > 0.f) {
-          Le_hit = light_emission(s, wl, l, l.L);
+          Le_hit = light_emission(s, wl, l, area_light_radiance(s, l, h.uv));
           if (depth == 0 || specular_bounce || !settings.nee) {
             L += beta * Le_hit;
           } else {

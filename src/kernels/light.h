@@ -20,7 +20,9 @@ struct Light {
   uint32_t triangle = 0;       // Area: global triangle index in the scene
   Float area = 0.f;            // Area: triangle area (precomputed: used by every pdf)
   bool two_sided = false;      // Area
-  int32_t image = -1;          // Infinite: index into the scene's images (equal-area octahedral), -1 = constant L
+  // Infinite: index into the scene's images (equal-area octahedral); Area:
+  // an image over the shape's uv that L multiplies. -1 = L alone.
+  int32_t image = -1;
   Mat3 light_from_world{1.f};  // Infinite: into the light's frame (directions; normalise after)
   Mat3 world_from_light{1.f};  // Infinite: its inverse (set when the scene is built)
   // A blackbody emitter (pbrt-v4 "blackbody"): in spectral mode it emits

@@ -194,7 +194,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
       ray.d = Frame::from_z(n).to_world(local);
       ray.o = offset_ray_origin(h, ray.d);
       // Le cos / (pmf * (1 / area) * (cos / pi) / sides)
-      beta = light_emission(s, wl, l, l.L) * (kPi * l.area * sides / pmf);
+      beta = light_emission(s, wl, l, area_light_radiance(s, l, h.uv)) * (kPi * l.area * sides / pmf);
       if constexpr (kMedia) {
         // The shape's medium on the side the light leaves into.
         if (s.triangle_media) {

@@ -25,6 +25,14 @@ TESSERA_HOST_DEVICE inline Rgb environment_radiance(const SceneView& s, const Li
   return l.L * image_lookup_nearest_equal_area(s.images[l.image], equal_area_sphere_to_square(wl));
 }
 
+// What an area light emits at surface coordinates uv: L, times its image
+// where it has one (pbrt-v4's DiffuseAreaLight::L: the image at (u, 1 - v),
+// bilinear, clamped at the edges).
+TESSERA_HOST_DEVICE inline Rgb area_light_radiance(const SceneView& s, const Light& l, Vec2 uv) {
+  if (l.image < 0) return l.L;
+  return l.L * image_lookup(s.images[l.image], uv, ImageWrap::Clamp);
+}
+
 // Solid-angle pdf of sampling a point on an area light (triangle of area
 // `area`) at distance dist, seen under cos_l = dot(n_light, -w).
 TESSERA_HOST_DEVICE inline Float area_light_pdf(Float area, Float dist, Float cos_l) {
@@ -107,7 +115,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_
       Float cos_l = -glm::dot(n, ls.wi);
       if (!l.two_sided && cos_l <= 0.f) return false;
       ls.pdf = omega > 0.f ? 1.f / omega : area_light_pdf(l.area, dist, cos_l);
-      ls.L = l.L;
+      ls.L = area_light_radiance(s, l, h.uv);
       ls.p_light = offset_ray_origin(h, -ls.wi);
       break;
     }

@@ -23,6 +23,13 @@ Float blackbody_kelvin(const ParamSet& params, const std::string& name) {
   return p && p->type == "blackbody" && !p->numbers.empty() ? static_cast<Float>(p->numbers[0]) : 0.f;
 }
 
+// pbrt-v4 refuses lights whose images hold NaN or infinite texels.
+void require_finite_texels(const ImageDesc& img, const DirectiveContext& ctx) {
+  for (const Rgb& t : img.texels)
+    if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z))
+      ctx.fail("image '" + img.path + "' has NaN or infinite texels; a light needs finite ones");
+}
+
 }  // namespace
 
 std::optional<Light> make_light(const std::string& type, const ParamSet& params, const Mat4& world_from_light,
@@ -71,6 +78,7 @@ std::optional<Light> make_light(const std::string& type, const ParamSet& params,
       if (img.width != img.height)
         ctx.fail("infinite light image '" + img.path + "' is " + std::to_string(img.width) + "x" +
                  std::to_string(img.height) + "; it must be square (equal-area octahedral)");
+      require_finite_texels(img, ctx);
       l.L = Rgb(scale);
     } else {
       l.L = emission(params, "L") * scale;
@@ -90,11 +98,21 @@ std::optional<Light> make_light(const std::string& type, const ParamSet& params,
 AreaLightDesc make_area_light(const std::string& type, const ParamSet& params, const DirectiveContext& ctx) {
   if (type != "diffuse") ctx.warn("area light \"" + type + "\" is not supported; using \"diffuse\"");
   AreaLightDesc a;
-  a.L = emission(params, "L") * params.get_float("scale", 1.f);
+  const Float scale = params.get_float("scale", 1.f);
+  a.L = emission(params, "L") * scale;
   a.blackbody_kelvin = blackbody_kelvin(params, "L");
   a.two_sided = params.get_bool("twosided", false);
-  if (params.find_any("filename")) ctx.warn("image area lights (\"filename\") are not supported; using \"L\"");
-  if (params.find_any("power")) ctx.warn("area light \"power\" is not supported; ignored");
+  const std::string filename = params.get_string("filename", "");
+  if (!filename.empty()) {
+    if (params.find_any("L")) ctx.fail("area light takes either \"L\" or \"filename\", not both");
+    // pbrt-v4 reads the file in its own encoding (8-bit files are sRGB).
+    a.image = image_index(filename, "sRGB", false, ctx);
+    require_finite_texels(ctx.scene.images[a.image], ctx);
+    a.L = Rgb(scale);
+  }
+  const Float power = params.get_float("power", -1.f);
+  if (!std::isfinite(power)) ctx.fail("area light \"power\" must be finite");
+  a.power = power > 0.f ? power : 0.f;  // pbrt-v4: only a positive power rescales
   return a;
 }
 

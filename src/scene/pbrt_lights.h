@@ -15,7 +15,8 @@ namespace tessera {
 std::optional<Light> make_light(const std::string& type, const ParamSet& params, const Mat4& world_from_light,
                                 const DirectiveContext& ctx);
 
-// AreaLightSource "diffuse". Other types warn and still give a diffuse emitter.
+// AreaLightSource "diffuse" ("L" or an image "filename", "scale", "twosided",
+// "power"). Other types warn and still give a diffuse emitter.
 AreaLightDesc make_area_light(const std::string& type, const ParamSet& params, const DirectiveContext& ctx);
 
 }  // namespace tessera

@@ -83,6 +83,7 @@ MeshDesc bilinear_mesh(const ParamSet& params, const ShapeContext& ctx) {
     uint32_t p00 = quads[q], p10 = quads[q + 1], p01 = quads[q + 2], p11 = quads[q + 3];
     m.indices.insert(m.indices.end(), {p00, p10, p11, p00, p11, p01});
   }
+  m.triangles_per_shape = 2;
   return m;
 }
 
@@ -180,6 +181,8 @@ MeshDesc sphere_mesh(const ParamSet& params, const ShapeContext& ctx) {
     }
   }
   add_grid_triangles(m, kSphereThetaSteps, kSpherePhiSteps, top_pole, bottom_pole);
+  m.triangles_per_shape = 0;
+  m.shape_area = phimax * r * (z1 - z0);
   return m;
 }
 
@@ -207,6 +210,8 @@ MeshDesc cylinder_mesh(const ParamSet& params, const ShapeContext& ctx) {
     }
   }
   add_grid_triangles(m, kCylinderRings, kCylinderSegments, false, false);
+  m.triangles_per_shape = 0;
+  m.shape_area = (z1 - z0) * r * phimax;
   return m;
 }
 
@@ -229,6 +234,8 @@ MeshDesc disk_mesh(const ParamSet& params, const ShapeContext& ctx) {
     }
   }
   add_grid_triangles(m, kDiskRings, kDiskSegments, inner == 0.f, false);
+  m.triangles_per_shape = 0;
+  m.shape_area = phimax * 0.5f * (radius * radius - inner * inner);
   return m;
 }
 

@@ -39,13 +39,23 @@ struct MeshDesc {
   // Motion blur: positions (and normals, when n is given) at the end of the
   // transform interval; empty for a shape that does not move.
   std::vector<Vec3> p_end, n_end;
+  // The shapes pbrt-v4 would make of this mesh, each of which an area light's
+  // "power" is given to whole: runs of this many triangles (1: a triangle
+  // mesh, 2: bilinear patches), or 0: one shape, the whole mesh, of area
+  // shape_area (a quadric: pbrt-v4's object-space Area()).
+  uint32_t triangles_per_shape = 1;
+  Float shape_area = 0.f;
   std::string where;            // "file:line" of the Shape directive, for messages
 };
 
 struct AreaLightDesc {
-  Rgb L{1.f};  // radiance with "scale" folded in
+  Rgb L{1.f};  // radiance with "scale" folded in; with an image, what multiplies its texels
   Float blackbody_kelvin = 0.f;  // "blackbody L": its temperature (spectral mode emits Planck's law)
   bool two_sided = false;
+  int32_t image = -1;  // "filename": index into SceneDesc::images, read at (u, 1 - v), -1 = L alone
+  // "power" (> 0): each shape emits this much, as pbrt-v4 scales each shape's
+  // light (L / (pi area sides), over the image's mean luminance when it has one).
+  Float power = 0.f;
 };
 
 struct ImageDesc {

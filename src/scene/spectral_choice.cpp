@@ -21,6 +21,7 @@ std::string spectral_reason(const SceneDesc& scene) {
     if (m.eta_spectrum >= 0 || m.k_spectrum >= 0) return "a conductor given by measured spectra";
   }
   for (const AreaLightDesc& a : scene.area_lights) {
+    if (a.image >= 0) continue;  // an image's texels: natural colours
     const Rgb c = a.blackbody_kelvin > 0.f ? blackbody_rgb(a.blackbody_kelvin) : a.L;
     if (strongly_coloured(c)) return "a strongly coloured area light";
   }

@@ -45,6 +45,34 @@ GridMediumView grid_medium_view(const GridDesc& g, const std::vector<Float>& bla
   return v;
 }
 
+// For each triangle of m, the area of the pbrt-v4 shape it belongs to
+// (MeshDesc::triangles_per_shape): what an area light's "power" is given to.
+std::vector<double> shape_area_per_triangle(const MeshDesc& m) {
+  const size_t n = m.indices.size() / 3;
+  std::vector<double> area(n, static_cast<double>(m.shape_area));
+  if (m.triangles_per_shape == 0) return area;
+  for (size_t t = 0; t < n; ++t) {
+    Vec3 normal;
+    double a = 0.0;
+    if (!triangle_normal(m.p[m.indices[3 * t]], m.p[m.indices[3 * t + 1]], m.p[m.indices[3 * t + 2]], &normal, &a)) a = 0.0;
+    area[t] = a;
+  }
+  const size_t run = m.triangles_per_shape;
+  for (size_t first = 0; first < n; first += run) {
+    double sum = 0.0;
+    for (size_t t = first; t < std::min(n, first + run); ++t) sum += area[t];
+    for (size_t t = first; t < std::min(n, first + run); ++t) area[t] = sum;
+  }
+  return area;
+}
+
+// pbrt-v4's k_e for an image light: the mean luminance of its texels.
+double mean_luminance(const ImageDesc& img) {
+  double sum = 0.0;
+  for (const Rgb& t : img.texels) sum += luminance(t);
+  return img.texels.empty() ? 0.0 : sum / static_cast<double>(img.texels.size());
+}
+
 }  // namespace
 
 SceneData::SceneData(SceneDesc desc) : desc_(std::move(desc)) {
@@ -108,6 +136,17 @@ void SceneData::flatten_meshes() {
       bounds_.lo = glm::min(bounds_.lo, m.p[i]);
       bounds_.hi = glm::max(bounds_.hi, m.p[i]);
     }
+    // An area light's "power": each shape's radiance scaled to emit it, as
+    // pbrt-v4 does (L / (pi area sides), over an image's mean luminance).
+    std::vector<double> power_area;
+    double power_per_area = 0.0;
+    if (m.area_light >= 0 && desc_.area_lights[m.area_light].power > 0.f) {
+      const AreaLightDesc& al = desc_.area_lights[m.area_light];
+      const double k_e = al.image >= 0 ? mean_luminance(desc_.images[al.image]) : 1.0;
+      power_per_area = al.power / (k_e * kPi * (al.two_sided ? 2.0 : 1.0));
+      if (!std::isfinite(power_per_area)) power_per_area = 0.0;  // a black image: nothing to scale
+      power_area = shape_area_per_triangle(m);
+    }
     TriangleInfo info;
     info.material = m.material;
     info.flags = (m.flip_normals ? kTriFlipNormal : 0u) | (has_n ? kTriHasNormals : 0u) | (has_uv ? kTriHasUv : 0u);
@@ -127,6 +166,8 @@ void SceneData::flatten_meshes() {
           Light l;
           l.type = LightType::Area;
           l.L = al.L;
+          l.image = al.image;
+          if (!power_area.empty()) l.L *= static_cast<Float>(power_per_area / power_area[t / 3]);
           l.blackbody_kelvin = al.blackbody_kelvin;
           l.two_sided = al.two_sided;
           l.triangle = static_cast<uint32_t>(triangles_.size());
@@ -164,6 +205,16 @@ void SceneData::build_lights() {
     }
   Float radius = triangles_.empty() ? 1.f : glm::max(1e-3f, 0.5f * glm::length(bounds_.hi - bounds_.lo));
 
+  // Image lights' texel luminance (light selection, firefly bounds).
+  std::vector<bool> emits(desc_.images.size(), false);
+  for (const Light& l : lights_)
+    if (l.image >= 0) emits[static_cast<size_t>(l.image)] = true;
+  image_luminance_.resize(desc_.images.size());
+  for (size_t i = 0; i < desc_.images.size(); ++i)
+    if (emits[i]) {
+      image_luminance_[i].mean = static_cast<Float>(mean_luminance(desc_.images[i]));
+      for (const Rgb& t : desc_.images[i].texels) image_luminance_[i].max = std::max(image_luminance_[i].max, luminance(t));
+    }
   image_views_.reserve(desc_.images.size());
   for (const ImageDesc& img : desc_.images) image_views_.push_back(ImageView{img.width, img.height, img.texels.data()});
 
@@ -173,7 +224,8 @@ void SceneData::build_lights() {
     const Light& l = lights_[i];
     switch (l.type) {
       case LightType::Area: {
-        power[i] = luminance(l.L) * l.area * kPi * (l.two_sided ? 2.f : 1.f);
+        power[i] = luminance(l.L) * l.area * kPi * (l.two_sided ? 2.f : 1.f) *
+                   (l.image >= 0 ? image_luminance_[l.image].mean : 1.f);
         break;
       }
       case LightType::Point: power[i] = 4.f * kPi * luminance(l.L); break;
@@ -421,14 +473,7 @@ uint64_t SceneData::film_fingerprint() const {
 
 Float SceneData::max_emitted_radiance() const {
   Float m = 0.f;
-  for (const Light& l : lights_) {
-    Float scale = 1.f;
-    if (l.type == LightType::Infinite && l.image >= 0) {
-      scale = 0.f;
-      for (const Rgb& t : desc_.images[l.image].texels) scale = std::max(scale, luminance(t));
-    }
-    m = std::max(m, luminance(l.L) * scale);
-  }
+  for (const Light& l : lights_) m = std::max(m, luminance(l.L) * (l.image >= 0 ? image_luminance_[l.image].max : 1.f));
   return m;
 }
 

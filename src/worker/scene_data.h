@@ -60,6 +60,12 @@ class SceneData {
   std::vector<Light> lights_;
   std::vector<int32_t> infinite_lights_;
   Distribution1D light_select_;
+  // Per image: the mean and largest luminance of its texels (only for
+  // images that lights emit).
+  struct ImageLuminance {
+    Float mean = 0.f, max = 0.f;
+  };
+  std::vector<ImageLuminance> image_luminance_;
   std::vector<Distribution2D> env_storage_;     // one per light (empty for non-image lights)
   std::vector<Distribution2DView> env_views_;
   std::vector<TextureSlot> triangle_alpha_;  // per triangle

@@ -111,6 +111,7 @@ TEST(PbrtErrors, MissingWorldBegin) {
 TEST(PbrtErrors, InfiniteLightArguments) {
   test::TempDir dir;
   Imf::Rgba pixels[4 * 2];
+  for (Imf::Rgba& p : pixels) p = Imf::Rgba(1.f, 1.f, 1.f, 1.f);
   {
     Imf::RgbaOutputFile out(dir.file("wide.exr").c_str(), 4, 2, Imf::WRITE_RGBA);
     out.setFrameBuffer(pixels, 1, 4);
