@@ -416,6 +416,26 @@ TESSERA_HOST_DEVICE inline Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, c
   return 0.f;
 }
 
+// Whether MIS weights at this BSDF use pbrt-v4's stochastic density
+// (bsdf_mis_pdf) instead of bsdf_pdf: the coated BSDFs.
+TESSERA_HOST_DEVICE inline bool bsdf_mis_estimated(const BsdfParams& b) {
+  return b.type == BsdfType::CoatedDiffuse || b.type == BsdfType::CoatedConductor;
+}
+
+// The density MIS weighs this BSDF's strategy by. Any function does, as long
+// as next-event estimation and BSDF sampling use the same one (their weights
+// then sum to 1 for every direction): bsdf_pdf, except for the coated BSDFs,
+// where pbrt-v4 weighs by its stochastic LayeredBxDF::PDF, which, since the
+// two layered values differ (layered.h), shapes its pictures.
+TESSERA_HOST_DEVICE inline Float bsdf_mis_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  if (wo.z == 0.f || !is_finite(wo) || !is_finite(wi)) return 0.f;
+  switch (b.type) {
+    case BsdfType::CoatedDiffuse: return bsdf_detail::coated_diffuse_pdf_estimate(b, wo, wi);
+    case BsdfType::CoatedConductor: return bsdf_detail::coated_conductor_pdf_estimate(b, wo, wi);
+    default: return bsdf_pdf(b, wo, wi);
+  }
+}
+
 TESSERA_HOST_DEVICE inline bool bsdf_sample(const BsdfParams& b, const Vec3& wo, Float uc, Vec2 u, BsdfSample* out) {
   if (wo.z == 0.f || !is_finite(wo)) return false;
   uc = glm::clamp(uc, 0.f, 0x1.fffffep-1f);

@@ -86,6 +86,18 @@ TESSERA_HOST_DEVICE inline Float eval_pdf(const BsdfParams& b, const Vec3& wo, c
   if constexpr ((Spec & kSpecNonDiffuse) != 0) return bsdf_pdf(b, wo, wi);
   else return same_hemisphere(wo, wi) ? abs_cos_theta(wi) * kInvPi : 0.f;
 }
+// The density MIS weighs the BSDF's strategy by (bsdf_mis_pdf), and whether
+// the balance heuristic applies (the coated BSDFs under volpath).
+template <uint32_t Spec>
+TESSERA_HOST_DEVICE inline Float eval_mis_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi, Float pdf) {
+  if constexpr ((Spec & kSpecNonDiffuse) != 0) return bsdf_mis_estimated(b) ? bsdf_mis_pdf(b, wo, wi) : pdf;
+  else return pdf;
+}
+template <uint32_t Spec>
+TESSERA_HOST_DEVICE inline bool mis_balance(const SceneView& s, const BsdfParams& b) {
+  if constexpr ((Spec & kSpecNonDiffuse) != 0) return s.layered_mis_balance && bsdf_mis_estimated(b);
+  else return false;
+}
 template <uint32_t Spec>
 TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, const Vec3& wo, Float uc, Vec2 u, BsdfSample* bs) {
   if constexpr ((Spec & kSpecNonDiffuse) != 0) {
@@ -183,7 +195,11 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   // only delta lobes (its walk starts with such a chain).
   bool first_vertex_connectable = false;
   bool last_vertex_delta_only = false;
-  Float prev_scatter_pdf = 0.f;  // pdf of the last sampled direction (the mixture's when guided)
+  // What MIS weighs the last sampled direction by: its pdf (the mixture's
+  // when guided), with the coated BSDFs' estimate in place of theirs
+  // (eval_mis_pdf), and with which heuristic.
+  Float prev_mis_pdf = 0.f;
+  bool prev_mis_balance = false;
   // How much guiding has scaled the path's weight against BSDF sampling:
   // the product over guided vertices of bsdf_pdf / mixture_pdf. Each factor
   // is 1 on average, but over hundreds of guided vertices their product is
@@ -291,7 +307,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             Float phase_pdf = 0.f;
             const Vec3 wi = sample_henyey_greenstein(wo, m.g, u_phase, &phase_pdf);
             if (!(phase_pdf > 0.f)) break;
-            prev_scatter_pdf = phase_pdf;
+            prev_mis_pdf = phase_pdf;
+            prev_mis_balance = false;
             prev_cell = -1;
             prev_p = p;
             prev_in_medium = true;
@@ -323,7 +340,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             L += beta * Le;
           } else {
             Float light_pdf = light_select_pmf(s, guide, prev_cell, li) * environment_pdf(s, li, ray.d);
-            L += beta * Le * power_heuristic(prev_scatter_pdf, light_pdf);
+            L += beta * Le * mis_weight(prev_mis_pdf, light_pdf, prev_mis_balance);
             if constexpr (kGuide) note_mis_emission(luminance(Le), light_pdf);
           }
         }
@@ -354,7 +371,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           } else {
             Float light_pdf = light_select_pmf(s, guide, prev_cell, static_cast<uint32_t>(info.light)) *
                               area_light_pdf_from(s, l, prev_p, h.p, cos_l, prev_in_medium);
-            L += beta * Le_hit * power_heuristic(prev_scatter_pdf, light_pdf);
+            L += beta * Le_hit * mis_weight(prev_mis_pdf, light_pdf, prev_mis_balance);
             if constexpr (kGuide) note_mis_emission(luminance(Le_hit), light_pdf);
           }
         }
@@ -462,7 +479,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           if (!is_black(tr)) {
             Float w = 1.f;
             if (!ls.delta) {
-              Float scatter_pdf = eval_pdf<Spec>(bsdf, wo_l, wi_l);
+              const Float scatter_pdf = eval_pdf<Spec>(bsdf, wo_l, wi_l);
+              Float mis_pdf = eval_mis_pdf<Spec>(bsdf, wo_l, wi_l, scatter_pdf);
               if (light_dir_entry) {
                 const Float guide_pdf_l = g.entry_pdf(*light_dir_entry);
                 if (learn) {
@@ -471,9 +489,9 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
                   nee_mix.nee_guide_pdf = guide_pdf_l;
                   nee_mix.nee_bsdf_pdf = scatter_pdf;
                 }
-                scatter_pdf = guide_p * guide_pdf_l + (1.f - guide_p) * scatter_pdf;
+                mis_pdf = guide_p * guide_pdf_l + (1.f - guide_p) * mis_pdf;
               }
-              w = power_heuristic(light_pdf, scatter_pdf);
+              w = mis_weight(light_pdf, mis_pdf, mis_balance<Spec>(s, bsdf));
             }
             L += beta * f * tr * ls.L * (w / light_pdf);
             learned = luminance(f * tr * ls.L) / ls.pdf;
@@ -561,7 +579,14 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     beta *= weight;
     rr_beta *= bsdf_pdf > 0.f ? bs.f * (abs_cos_theta(bs.wi) / bsdf_pdf) : weight;
     if (guided_vertex) guide_ratio *= bsdf_pdf / scatter_pdf;
-    prev_scatter_pdf = scatter_pdf;
+    prev_mis_balance = mis_balance<Spec>(s, bsdf);
+    prev_mis_pdf = scatter_pdf;
+    if constexpr ((Spec & kSpecNonDiffuse) != 0) {
+      if (bsdf_mis_estimated(bsdf) && !(bs.lobe & kLobeSpecular)) {  // a specular direction is not weighed
+        const Float mis_bsdf = bsdf_mis_pdf(bsdf, wo_l, bs.wi);
+        prev_mis_pdf = guided_vertex ? guide_p * guide_density + (1.f - guide_p) * mis_bsdf : mis_bsdf;
+      }
+    }
     prev_cell = cell;
     specular_bounce = (bs.lobe & kLobeSpecular) != 0;
     if (depth == 1) first_vertex_connectable = settings.light_traced_caustics && !specular_bounce;

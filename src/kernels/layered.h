@@ -95,6 +95,18 @@ TESSERA_HOST_DEVICE inline Float interface_transmission_pdf(const BsdfParams& b,
   return finite_or_zero(distrib(b).pdf(wo, wm) * fabsf(glm::dot(wi, wm)) / denom);
 }
 
+// pbrt-v4 DielectricBxDF::PDF with BxDFReflTransFlags::Reflection: the
+// whole reflection lobe's density (not scaled by the Fresnel reflectance).
+TESSERA_HOST_DEVICE inline Float interface_reflection_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  if (dielectric_is_specular(b) || !same_hemisphere(wo, wi)) return 0.f;
+  Vec3 wm = wo + wi;
+  if (len2(wm) == 0.f) return 0.f;
+  wm = face_forward_z(glm::normalize(wm));
+  if (glm::dot(wm, wi) * wi.z < 0.f || glm::dot(wm, wo) * wo.z < 0.f) return 0.f;  // back-facing microfacet
+  const Float dom = fabsf(glm::dot(wo, wm));
+  return dom > 0.f ? finite_or_zero(distrib(b).pdf(wo, wm) / (4.f * dom)) : 0.f;
+}
+
 TESSERA_HOST_DEVICE inline Float transmittance(Float dz, const Vec3& w) {
   if (fabsf(dz) <= 1.17549435e-38f) return 1.f;
   return expf(-fabsf(dz / w.z));
@@ -240,6 +252,51 @@ TESSERA_HOST_DEVICE inline Rgb layered_f(const BsdfParams& b, const Base& base, 
   return finite_or_zero(f / static_cast<Float>(n_samples));
 }
 
+// pbrt-v4's LayeredBxDF::PDF for reflection: a stochastic estimate of the
+// walk's density (the entrance reflection lobe plus one TRT term per
+// sample), mixed 9:1 with the uniform sphere's density. pbrt-v4 weighs MIS
+// with it, and so with it decides how its pictures blend the two layered
+// values (see the file's opening comment): the same estimator, not only its
+// mean, reproduces them. Seeded by (wi, wo), as pbrt-v4 seeds it, so it is a
+// pure function of the two directions, independent of layered_f's numbers.
+template <class Base>
+TESSERA_HOST_DEVICE inline Float layered_pdf_estimate(const BsdfParams& b, const Base& base, Vec3 wo, Vec3 wi) {
+  constexpr Float kUniformSphere = 1.f / (4.f * kPi);
+  if (!same_hemisphere(wo, wi)) return 0.1f * kUniformSphere;  // an opaque base: no TT term
+  if (wo.z < 0.f) {  // two-sided
+    wo = -wo;
+    wi = -wi;
+  }
+  const uint32_t n_samples = b.layer_samples > 0 ? b.layer_samples : 1;
+  const bool top_specular = dielectric_is_specular(b);
+  Float pdf_sum = static_cast<Float>(n_samples) * layered::interface_reflection_pdf(b, wo, wi);
+  Rng rng = layered::rng_for(wi, wo);
+  auto r = [&rng]() { return rng.uniform(); };
+  for (uint32_t s = 0; s < n_samples; ++s) {
+    layered::LobeSample wos, wis;
+    { Vec2 u(r(), r()); if (!layered::interface_sample(b, wo, u, true, true, &wos)) continue; }
+    { Vec2 u(r(), r()); if (!layered::interface_sample(b, wi, u, true, false, &wis)) continue; }
+    if (top_specular) {
+      pdf_sum += base.pdf(-wos.wi, -wis.wi);
+      continue;
+    }
+    Vec3 wi_base;
+    Rgb f_base;
+    Float base_pdf = 0.f;
+    if (!base.sample(-wos.wi, Vec2(r(), r()), &wi_base, &f_base, &base_pdf)) continue;
+    if (base.specular()) {
+      pdf_sum += dielectric_pdf(b, -wi_base, wi);
+    } else {
+      // Both ends' samples, combined by the power heuristic (pbrt-v4).
+      const Float r_pdf = base.pdf(-wos.wi, -wis.wi);
+      pdf_sum += power_heuristic(wis.pdf, r_pdf) * r_pdf;
+      const Float t_pdf = dielectric_pdf(b, -wi_base, wi);
+      pdf_sum += power_heuristic(base_pdf, t_pdf) * t_pdf;
+    }
+  }
+  return finite_or_zero(0.1f * kUniformSphere + 0.9f * pdf_sum / static_cast<Float>(n_samples));
+}
+
 // coateddiffuse: b.reflectance is the base's albedo.
 TESSERA_HOST_DEVICE inline Rgb coated_diffuse_layered_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi,
                                                         layered::LayerWeights weights = layered::LayerWeights::Consistent) {
@@ -251,4 +308,12 @@ TESSERA_HOST_DEVICE inline Rgb coated_diffuse_layered_f(const BsdfParams& b, con
 TESSERA_HOST_DEVICE inline Rgb coated_conductor_layered_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi,
                                                           layered::LayerWeights weights = layered::LayerWeights::Consistent) {
   return layered_f(b, layered::ConductorBase::under_coat(b), wo, wi, weights);
+}
+
+TESSERA_HOST_DEVICE inline Float coated_diffuse_pdf_estimate(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  return layered_pdf_estimate(b, layered::DiffuseBase{glm::clamp(b.reflectance, Rgb(0.f), Rgb(1.f))}, wo, wi);
+}
+
+TESSERA_HOST_DEVICE inline Float coated_conductor_pdf_estimate(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  return layered_pdf_estimate(b, layered::ConductorBase::under_coat(b), wo, wi);
 }

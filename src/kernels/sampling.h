@@ -57,4 +57,17 @@ TESSERA_HOST_DEVICE inline Float power_heuristic(Float pdf_a, Float pdf_b) {
   return a / (a + b);
 }
 
+TESSERA_HOST_DEVICE inline Float balance_heuristic(Float pdf_a, Float pdf_b) {
+  const Float sum = pdf_a + pdf_b;
+  if (!(sum > 0.f)) return 0.f;
+  if (sum > 1e30f) return pdf_a >= pdf_b ? 1.f : 0.f;
+  return pdf_a / sum;
+}
+
+// The MIS weight of strategy a against b: the balance heuristic (pbrt-v4's
+// volpath) or the power heuristic (its path integrator).
+TESSERA_HOST_DEVICE inline Float mis_weight(Float pdf_a, Float pdf_b, bool balance) {
+  return balance ? balance_heuristic(pdf_a, pdf_b) : power_heuristic(pdf_a, pdf_b);
+}
+
 }  // namespace tessera

@@ -62,6 +62,10 @@ struct FilterView {
 };
 
 struct SceneView {
+  // MIS at the coated BSDFs weighs by the balance heuristic (pbrt-v4's
+  // volpath, its default integrator) or by the power heuristic (its "path"):
+  // with their stochastic densities the choice shapes the picture (bsdf_mis_pdf).
+  bool layered_mis_balance = true;
   const Vec3* positions = nullptr;
   const Vec3* normals = nullptr;
   // Motion blur: every vertex's position and normal at the end of the

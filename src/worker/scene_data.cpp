@@ -329,6 +329,7 @@ void SceneData::build_filter() {
 
 void SceneData::build_view() {
   SceneView& v = view_;
+  v.layered_mis_balance = desc_.integrator != "path";
   v.positions = positions_.data();
   v.normals = normals_.data();
   if (!positions_end_.empty()) {
