@@ -5,6 +5,7 @@
 #include "app/commands.h"
 #include "app/scene_loading.h"
 #include "kernels/effects.h"
+#include "scene/pbrt_film.h"
 #include "scene/scene_effects.h"
 #include "scene/spectral_choice.h"
 #include "scene/system_memory.h"
@@ -27,7 +28,7 @@ int run_info(const std::string& path) {
   const std::optional<uint64_t> built = resident_bytes();
   const SceneView& v = scene.view();
   std::printf("scene:          %s\n", scene.desc().source.c_str());
-  std::printf("resolution:     %dx%d, %d spp, max depth %d\n", v.camera.width, v.camera.height, scene.desc().spp,
+  std::printf("resolution:     %s, %d spp, max depth %d\n", describe_film_size(v.camera).c_str(), scene.desc().spp,
               scene.desc().max_depth);
   std::printf("shapes:         %zu meshes, %zu triangles\n", meshes, scene.num_triangles());
   std::printf("materials:      %zu\n", materials);

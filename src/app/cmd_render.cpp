@@ -24,6 +24,7 @@
 #include "master/renderer.h"
 #include "master/snapshots.h"
 #include "master/stats_json.h"
+#include "scene/pbrt_film.h"
 #include "scene/sampler_setup.h"
 #include "scene/scene_effects.h"
 #include "app/memory_check.h"
@@ -178,7 +179,8 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   check_writable(a.checkpoint, "--checkpoint");
   check_writable(a.guide.out, "--guide-out");
   // A resume holds the checkpoint's film twice more; --guide auto's trial one more.
-  check_film_memory(desc.film.xres, desc.film.yres, m.opt.light_paths, !a.checkpoint.empty(),
+  const PixelBounds crop = film_pixel_bounds(desc.film);
+  check_film_memory(crop.width(), crop.height(), m.opt.light_paths, !a.checkpoint.empty(),
                     (a.resume.empty() ? 0u : 2u) + (a.guide.mode == "auto" ? 1u : 0u));
   uint64_t triangles = 0, vertices = 0;
   for (const MeshDesc& mesh : desc.meshes) {
@@ -214,9 +216,9 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
 
 void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks, int32_t machines) {
   const SceneData& scene = *m.scene;
-  std::fprintf(stderr, "tessera: %s: %zu triangles, %u lights, %dx%d, %s, max depth %d\n",
-               scene.desc().source.c_str(), scene.num_triangles(), scene.view().num_lights, scene.view().camera.width,
-               scene.view().camera.height,
+  std::fprintf(stderr, "tessera: %s: %zu triangles, %u lights, %s, %s, max depth %d\n",
+               scene.desc().source.c_str(), scene.num_triangles(), scene.view().num_lights,
+               describe_film_size(scene.view().camera).c_str(),
                m.opt.spp > 0 ? (std::to_string(m.opt.spp) + " spp").c_str() : "unlimited spp", m.opt.max_depth);
   std::fprintf(stderr, "tessera: effects: %s; integrator specialisation: %s\n", describe_effects(scene.effects()).c_str(),
                describe_specialisation(spec).c_str());
@@ -278,6 +280,13 @@ ExrMetadata base_metadata(const MasterSetup& m, uint32_t spec) {
   meta.strings["specialisation"] = describe_specialisation(spec);
   meta.strings["software"] = "tessera " TESSERA_VERSION;
   meta.strings["scene"] = m.scene->desc().source;
+  const CameraView& c = m.scene->view().camera;
+  if (c.film_width != c.width || c.film_height != c.height) {
+    // pbrt-v4's crop: the image holds only these pixels of the full resolution.
+    meta.strings["crop_pixel_bounds"] = std::to_string(c.film_x0) + " " + std::to_string(c.film_x0 + c.film_width) + " " +
+                                        std::to_string(c.film_y0) + " " + std::to_string(c.film_y0 + c.film_height);
+    meta.strings["full_resolution"] = std::to_string(c.width) + "x" + std::to_string(c.height);
+  }
   return meta;
 }
 

@@ -32,7 +32,7 @@ template <class Archive>
 void serialize(Archive& ar, SceneDesc& d) {
   ar(raw_value(d.camera.world_from_camera), d.camera.fov_degrees, d.camera.lens_radius, d.camera.focal_distance,
      d.camera.where);
-  ar(d.film.xres, d.film.yres, d.film.filename, raw_value(d.filter), d.spp, d.max_depth, d.seed);
+  ar(d.film.xres, d.film.yres, d.film.crop[0], d.film.crop[1], d.film.crop[2], d.film.crop[3], d.film.filename, raw_value(d.filter), d.spp, d.max_depth, d.seed);
   ar(d.integrator, d.sampler, d.strata_x, d.strata_y, d.sampler_jitter, d.halton_randomize, d.sampler_spp, d.camera.exposure_time, d.film.iso, d.film.whitebalance, d.film.sensor, d.film.max_component_value,
      raw_value(d.film.pixel_from_radiance), raw_value(d.film.sensor_from_radiance), raw_value(d.film.pixel_from_sensor));
   ar(d.meshes, raw(d.materials), raw(d.textures), d.images, raw(d.area_lights), raw(d.lights), d.warnings, d.source);

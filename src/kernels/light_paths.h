@@ -88,8 +88,8 @@ TESSERA_HOST_DEVICE inline Float filter_axis_density(const Float* inverse_cdf, u
 }
 
 // Spreads value (one light path's contribution, before the division by the
-// image's light-path count) over
-// the pixels whose filter reaches `raster`, calling sink(pixel index, rgb).
+// image's light-path count) over the film's pixels whose filter reaches
+// `raster` (image raster coordinates), calling sink(film pixel index, rgb).
 template <class Sink>
 TESSERA_HOST_DEVICE inline uint32_t splat_filtered(const SceneView& s, Vec2 raster, const Rgb& value, Sink&& sink) {
   const FilterView& f = s.filter;
@@ -102,17 +102,19 @@ TESSERA_HOST_DEVICE inline uint32_t splat_filtered(const SceneView& s, Vec2 rast
   const int32_t y0 = static_cast<int32_t>(glm::floor(raster.y - 0.5f - f.radius_y));
   const int32_t y1 = static_cast<int32_t>(glm::floor(raster.y - 0.5f + f.radius_y));
   uint32_t splats = 0;
-  for (int32_t y = glm::max(y0, 0); y <= glm::min(y1, s.camera.height - 1); ++y) {
+  const CameraView& c = s.camera;
+  for (int32_t y = glm::max(y0, c.film_y0); y <= glm::min(y1, c.film_y0 + c.film_height - 1); ++y) {
     const Float dy = raster.y - (y + 0.5f);
     const Float wy = filter_axis_density(f.inverse_cdf_y, f.n, dy);
     if (wy == 0.f) continue;
-    for (int32_t x = glm::max(x0, 0); x <= glm::min(x1, s.camera.width - 1); ++x) {
+    for (int32_t x = glm::max(x0, c.film_x0); x <= glm::min(x1, c.film_x0 + c.film_width - 1); ++x) {
       const Float dx = raster.x - (x + 0.5f);
       Float w = wy * filter_axis_density(f.inverse_cdf_x, f.n, dx);
       if (w == 0.f) continue;
       if (f.weight_x)
         w *= filter_axis_weight(f.weight_x, f.bins, dx, f.radius_x) * filter_axis_weight(f.weight_y, f.bins, dy, f.radius_y);
-      sink(static_cast<uint64_t>(y) * static_cast<uint64_t>(s.camera.width) + static_cast<uint64_t>(x), value * w);
+      sink(static_cast<uint64_t>(y - c.film_y0) * static_cast<uint64_t>(c.film_width) + static_cast<uint64_t>(x - c.film_x0),
+           value * w);
       ++splats;
     }
   }

@@ -28,7 +28,10 @@ struct CameraView {
   Vec3 origin{0.f};                    // camera position in world space
   Vec2 screen_min{-1.f}, screen_max{1.f};  // screen window, pbrt-v4 convention
   Float tan_half_fov = 1.f;
-  int32_t width = 0, height = 0;
+  int32_t width = 0, height = 0;  // the full image
+  // The film: the pixels rendered ("cropwindow"), from (film_x0, film_y0) of
+  // the full image. Film pixel (x, y) is image pixel (film_x0 + x, film_y0 + y).
+  int32_t film_x0 = 0, film_y0 = 0, film_width = 0, film_height = 0;
   Float lens_radius = 0.f;      // thin lens; 0 = pinhole (then no lens sample is drawn)
   Float focal_distance = 1e6f;
   // What the film records of a sample's radiance (pbrt-v4's pixel sensor:

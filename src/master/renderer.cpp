@@ -94,7 +94,7 @@ void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vec
 RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& opt, GuideField* guide,
                     PassExecutor* executor, const RenderResult* resume, const PassEndHook& on_pass_end) {
   const SceneView& view = scene.view();
-  const int32_t w = view.camera.width, h = view.camera.height;
+  const int32_t w = view.camera.film_width, h = view.camera.film_height;
   RenderResult result;
   if (resume) {
     result = *resume;

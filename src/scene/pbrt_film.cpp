@@ -1,5 +1,6 @@
 #include "scene/pbrt_film.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -60,6 +61,68 @@ void set_film_sensor(FilmDesc& film, Float exposure_time) {
   film.pixel_from_radiance = kelvin != 0.f ? white_balance_srgb(kelvin) * Mat3(ratio) : Mat3(ratio);
 }
 
+namespace {
+
+// pbrt-v4's "pixelbounds" (x0 x1 y0 y1, clamped to the image with a
+// warning) or "cropwindow" (fractions, clamped to [0, 1]; not both), kept
+// as fractions of the resolution (FilmDesc::crop).
+template <class Warn>
+void read_crop(const ParamSet& ps, const std::string& where, FilmDesc& film, Warn&& warn) {
+  const Param* bounds = ps.find_any("pixelbounds");
+  const Param* window = ps.find_any("cropwindow");
+  if (bounds && window) fail(where, "film has both \"pixelbounds\" and \"cropwindow\"");
+  // Pixel bounds x0 x1 y0 y1 at this resolution, as pbrt-v4 computes them.
+  int64_t pb[4] = {0, film.xres, 0, film.yres};
+  if (bounds) {
+    const std::vector<int32_t>& b = ps.get_ints("pixelbounds");
+    if (b.size() != 4 || bounds->type != "integer")
+      fail(where, "film \"pixelbounds\" needs four integers: x0 x1 y0 y1");
+    bool clamped = false;
+    for (int i = 0; i < 4; ++i) {
+      pb[i] = std::clamp<int64_t>(b[i], 0, i < 2 ? film.xres : film.yres);
+      clamped |= pb[i] != b[i];
+    }
+    if (clamped) warn("film \"pixelbounds\" extend beyond the image; clamped to it");
+  } else if (window) {
+    const std::vector<Float> c = ps.get_floats("cropwindow");
+    if (c.size() != 4) fail(where, "film \"cropwindow\" needs four numbers: x0 x1 y0 y1");
+    for (Float v : c)
+      if (!std::isfinite(v)) fail(where, "film \"cropwindow\" must be finite");
+    // pbrt-v4: the corners ordered and clamped to [0, 1], then ceil(res * c) in float.
+    const Float lo_x = std::clamp(std::min(c[0], c[1]), 0.f, 1.f), hi_x = std::clamp(std::max(c[0], c[1]), 0.f, 1.f);
+    const Float lo_y = std::clamp(std::min(c[2], c[3]), 0.f, 1.f), hi_y = std::clamp(std::max(c[2], c[3]), 0.f, 1.f);
+    const Float xres = static_cast<Float>(film.xres), yres = static_cast<Float>(film.yres);
+    pb[0] = static_cast<int64_t>(std::ceil(xres * lo_x));
+    pb[1] = static_cast<int64_t>(std::ceil(xres * hi_x));
+    pb[2] = static_cast<int64_t>(std::ceil(yres * lo_y));
+    pb[3] = static_cast<int64_t>(std::ceil(yres * hi_y));
+  }
+  if (pb[1] <= pb[0] || pb[3] <= pb[2]) fail(where, "film \"pixelbounds\"/\"cropwindow\" leave no pixels");
+  for (int i = 0; i < 4; ++i) film.crop[i] = static_cast<double>(pb[i]) / (i < 2 ? film.xres : film.yres);
+}
+
+}  // namespace
+
+PixelBounds film_pixel_bounds(const FilmDesc& film) {
+  // ceil(res * fraction); the small subtraction keeps the bounds the scene
+  // gave (stored as fractions) exact at its own resolution.
+  auto edge = [](int32_t res, double f) { return static_cast<int32_t>(std::ceil(res * f - 1e-9)); };
+  const PixelBounds pb{edge(film.xres, film.crop[0]), edge(film.yres, film.crop[2]), edge(film.xres, film.crop[1]),
+                       edge(film.yres, film.crop[3])};
+  if (pb.width() <= 0 || pb.height() <= 0)
+    throw SceneError("the film's crop window leaves no pixels at " + std::to_string(film.xres) + "x" +
+                     std::to_string(film.yres));
+  return pb;
+}
+
+std::string describe_film_size(const CameraView& c) {
+  std::string s = std::to_string(c.width) + "x" + std::to_string(c.height);
+  if (c.film_width == c.width && c.film_height == c.height) return s;
+  return s + ", pixels " + std::to_string(c.film_x0) + "-" + std::to_string(c.film_x0 + c.film_width) + " x " +
+         std::to_string(c.film_y0) + "-" + std::to_string(c.film_y0 + c.film_height) + " (" +
+         std::to_string(c.film_width) + "x" + std::to_string(c.film_height) + ")";
+}
+
 void read_film(const std::string& type, const ParamSet& ps, const std::string& where, FilmDesc& film,
                std::vector<std::string>& warnings) {
   auto warn = [&](const std::string& m) { warnings.push_back(where + ": " + m); };
@@ -84,8 +147,7 @@ void read_film(const std::string& type, const ParamSet& ps, const std::string& w
   film.max_component_value = ps.get_float("maxcomponentvalue", std::numeric_limits<Float>::infinity());
   if (!(film.max_component_value > 0.f)) fail(where, "film \"maxcomponentvalue\" must be positive");
   for (const char* ignored : {"savefp16", "diagonal"}) ps.find_any(ignored);
-  for (const char* unsupported : {"cropwindow", "pixelbounds"})
-    if (ps.find_any(unsupported)) warn(std::string("film \"") + unsupported + "\" is not supported; the whole image is rendered");
+  read_crop(ps, where, film, warn);
 }
 
 FilterDesc read_filter(const std::string& type, const ParamSet& ps, const std::string& where,

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "scene/pbrt_params.h"
+#include "kernels/scene_view.h"
 #include "scene/scene_desc.h"
 
 namespace tessera {
@@ -14,6 +15,13 @@ namespace tessera {
 // invalid resolution, ISO or white balance.
 void read_film(const std::string& type, const ParamSet& params, const std::string& where, FilmDesc& film,
                std::vector<std::string>& warnings);
+
+// The pixels the film's crop covers at its resolution. Throws SceneError
+// when they are none (a resolution changed after loading can do that).
+PixelBounds film_pixel_bounds(const FilmDesc& film);
+
+// "640x480", or with a crop "640x480, pixels 100-300 x 50-150 (200x100)".
+std::string describe_film_size(const CameraView& camera);
 
 // A PixelFilter directive with pbrt-v4's defaults per type.
 FilterDesc read_filter(const std::string& type, const ParamSet& params, const std::string& where,

@@ -113,6 +113,20 @@ struct FilmDesc {
   // (pbrt_film.h); pixel_from_radiance is the identity for pbrt's defaults.
   Mat3 sensor_from_radiance{1.f}, pixel_from_sensor{1.f};
   Mat3 pixel_from_radiance{1.f};
+  // The part of the image rendered ("cropwindow", or "pixelbounds" over the
+  // resolution), as fractions of it: x0 x1 y0 y1, y down. Pixels are those
+  // from ceil(res * low) to ceil(res * high), as pbrt-v4 computes them, so a
+  // changed resolution (--res) keeps the same part of the picture.
+  double crop[4] = {0.0, 1.0, 0.0, 1.0};
+};
+
+// The pixels of a film that are rendered: [x0, x1) x [y0, y1) of the full
+// resolution (film_pixel_bounds in pbrt_film.h).
+struct PixelBounds {
+  int32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  int32_t width() const { return x1 - x0; }
+  int32_t height() const { return y1 - y0; }
+  bool full(const FilmDesc& f) const { return x0 == 0 && y0 == 0 && x1 == f.xres && y1 == f.yres; }
 };
 
 enum class FilterType : uint32_t { Gaussian = 0, Box, Triangle, Mitchell, LanczosSinc };

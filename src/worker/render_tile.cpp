@@ -54,11 +54,14 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
   };
   for (int32_t y = job.y0; y < job.y1; ++y) {
     for (int32_t x = job.x0; x < job.x1; ++x) {
-      const uint64_t pixel_index = static_cast<uint64_t>(y) * static_cast<uint64_t>(s.camera.width) + x;
+      // Tiles are in film pixels; samples belong to the image's pixel, so a
+      // crop renders what the whole image has there.
+      const int32_t ix = s.camera.film_x0 + x, iy = s.camera.film_y0 + y;
+      const uint64_t pixel_index = static_cast<uint64_t>(iy) * static_cast<uint64_t>(s.camera.width) + ix;
       PixelAccum& acc = pixels.at(job, x, y);
       for (uint32_t si = job.sample_begin; si < job.sample_end; ++si) {
-        PixelSampler rng = PixelSampler::start(settings.sampler, static_cast<uint32_t>(x), static_cast<uint32_t>(y), pixel_index, si);
-        const CameraSample cs = sample_camera_ray(s, x, y, rng);
+        PixelSampler rng = PixelSampler::start(settings.sampler, static_cast<uint32_t>(ix), static_cast<uint32_t>(iy), pixel_index, si);
+        const CameraSample cs = sample_camera_ray(s, ix, iy, rng);
         path.learn = settings.learn.learns(si);
         // Spectral transport: the path's three wavelengths (spectral.h).
         Wavelengths wl;
@@ -83,8 +86,8 @@ TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, co
         ++acc.n;
         ++tc.samples;
         if (light_paths) {
-          PixelSampler light_rng = PixelSampler::start(light_sampler, static_cast<uint32_t>(x),
-                                                       static_cast<uint32_t>(y), pixel_index, si);
+          PixelSampler light_rng = PixelSampler::start(light_sampler, static_cast<uint32_t>(ix),
+                                                       static_cast<uint32_t>(iy), pixel_index, si);
           Wavelengths light_wl;
           if (s.spectral.enabled) light_wl = sample_wavelengths(light_rng.uniform());
           const size_t first = splats->size();

@@ -262,6 +262,11 @@ void SceneData::build_camera() {
   const FilmDesc& film = desc_.film;
   camera_.width = film.xres;
   camera_.height = film.yres;
+  const PixelBounds crop = film_pixel_bounds(film);
+  camera_.film_x0 = crop.x0;
+  camera_.film_y0 = crop.y0;
+  camera_.film_width = crop.width();
+  camera_.film_height = crop.height();
   camera_.world_from_camera_linear = Mat3(desc_.camera.world_from_camera);
   camera_.origin = Vec3(desc_.camera.world_from_camera * Vec4(0.f, 0.f, 0.f, 1.f));
   camera_.moves = desc_.camera.world_from_camera_end != desc_.camera.world_from_camera;
@@ -452,7 +457,8 @@ uint64_t SceneData::film_fingerprint() const {
   const FilterDesc default_filter;
   const bool defaults = camera_.pixel_from_radiance == Mat3(1.f) && !std::isfinite(camera_.max_component_value) &&
                         camera_.lens_radius == 0.f && std::memcmp(&desc_.filter, &default_filter, sizeof default_filter) == 0 &&
-                        positions_end_.empty() && !camera_.moves && !desc_.spectral;
+                        positions_end_.empty() && !camera_.moves && !desc_.spectral && camera_.film_x0 == 0 &&
+                        camera_.film_y0 == 0 && camera_.film_width == camera_.width && camera_.film_height == camera_.height;
   if (defaults) return 0;
   Fnv1a f;
   f.add(&camera_.pixel_from_radiance, sizeof camera_.pixel_from_radiance);
@@ -461,6 +467,8 @@ uint64_t SceneData::film_fingerprint() const {
   f.add(&camera_.lens_radius, sizeof camera_.lens_radius);
   f.add(&camera_.focal_distance, sizeof camera_.focal_distance);
   f.add(&desc_.filter, sizeof desc_.filter);
+  const int32_t crop[4] = {camera_.film_x0, camera_.film_y0, camera_.film_width, camera_.film_height};
+  f.add(crop, sizeof crop);
   if (desc_.spectral) f.add("spectral", 8);  // only then: RGB checkpoints keep their fingerprints
   if (!positions_end_.empty() || camera_.moves) {  // motion blur: the shutter, the transforms' times, the camera's end
     f.add(&camera_.world_from_camera_linear_end, sizeof camera_.world_from_camera_linear_end);
