@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "kernels/equal_area.h"
 #include "scene/pbrt_textures.h"
 
 namespace tessera {
@@ -21,6 +22,21 @@ Rgb emission(const ParamSet& params, const std::string& name) { return params.ge
 Float blackbody_kelvin(const ParamSet& params, const std::string& name) {
   const Param* p = params.find_any(name);
   return p && p->type == "blackbody" && !p->numbers.empty() ? static_cast<Float>(p->numbers[0]) : 0.f;
+}
+
+// What pbrt-v4 takes for an environment image's illuminance from the upper
+// hemisphere (light space +z): the texels' luminance times cos(theta) over
+// the pixels whose centre is above the horizon, times 2 pi / pixels (its
+// formula, kept so that "illuminance" scales as in pbrt-v4).
+double image_upper_illuminance(const ImageDesc& img) {
+  double sum = 0.0;
+  for (int32_t y = 0; y < img.height; ++y)
+    for (int32_t x = 0; x < img.width; ++x) {
+      const Vec3 w = equal_area_square_to_sphere(Vec2((x + 0.5f) / img.width, (y + 0.5f) / img.height));
+      if (w.z <= 0.f) continue;
+      sum += luminance(img.texels[static_cast<size_t>(y) * img.width + x]) * w.z;
+    }
+  return sum * 2.0 * kPi / (static_cast<double>(img.width) * img.height);
 }
 
 // pbrt-v4 refuses lights whose images hold NaN or infinite texels.
@@ -84,7 +100,11 @@ std::optional<Light> make_light(const std::string& type, const ParamSet& params,
       l.L = emission(params, "L") * scale;
       l.blackbody_kelvin = blackbody_kelvin(params, "L");
     }
-    if (params.find_any("illuminance")) ctx.warn("infinite light \"illuminance\" is not supported; ignored");
+    const Float illuminance = params.get_float("illuminance", -1.f);
+    if (illuminance > 0.f) {
+      const double k_e = l.image >= 0 ? image_upper_illuminance(ctx.scene.images[l.image]) : kPi;
+      if (k_e > 0.0) l.L *= static_cast<Float>(illuminance / k_e);
+    }
     if (params.find_any("portal")) ctx.warn("infinite light \"portal\" is not supported; ignored");
     l.light_from_world = glm::inverse(Mat3(world_from_light));
   } else {

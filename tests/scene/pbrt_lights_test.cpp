@@ -1,6 +1,8 @@
 // LightSource and AreaLightSource.
 #include <ImfRgbaFile.h>
 
+#include <vector>
+
 #include "scene_test_helpers.h"
 
 namespace tessera {
@@ -68,6 +70,27 @@ TEST(PbrtLights, InfiniteConstantAndImage) {
   EXPECT_EQ(s.lights[1].image, 0);
   EXPECT_VEC3_NEAR(s.lights[1].L, Vec3(3.f), 1e-6f);
   EXPECT_VEC3_NEAR(s.lights[1].light_from_world * Vec3(0, 1, 0), Vec3(1, 0, 0), 1e-6f);
+}
+
+TEST(PbrtLights, InfiniteIlluminanceScalesAsPbrtV4) {
+  test::TempDir dir;
+  constexpr int kRes = 64;
+  std::vector<Imf::Rgba> pixels(kRes * kRes, Imf::Rgba(0.5f, 0.5f, 0.5f, 1.f));
+  {
+    Imf::RgbaOutputFile out(dir.file("sky.exr").c_str(), kRes, kRes, Imf::WRITE_RGBA);
+    out.setFrameBuffer(pixels.data(), 1, kRes);
+    out.writePixels(kRes);
+  }
+  SceneDesc s = load_world("LightSource \"infinite\" \"rgb L\" [ 2 2 2 ] \"float illuminance\" 6\n"
+                           "LightSource \"infinite\" \"string filename\" \"sky.exr\" \"float illuminance\" 6\n",
+                           dir.path());
+  ASSERT_EQ(s.lights.size(), 2u);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  // A constant L: scaled by E / pi (an RGB L keeps its own magnitude too, as in pbrt-v4).
+  EXPECT_VEC3_NEAR(s.lights[0].L, Vec3(2.f * 6.f / kPi), 1e-5f);
+  // An image: by E over pbrt-v4's upper-hemisphere sum, which for a uniform
+  // image is its value times about pi / 2 (pbrt-v4 weighs each pixel 2 pi / N).
+  EXPECT_NEAR(s.lights[1].L.x * 0.5f, 6.f / (kPi / 2.f), 0.01f * 6.f / (kPi / 2.f));
 }
 
 TEST(PbrtLights, UnsupportedLightsWarn) {
