@@ -39,6 +39,11 @@ struct BsdfParams {
   Float thickness = 0.01f;
   uint32_t layer_max_depth = 10;
   uint32_t layer_samples = 1;
+  // The layer's scattering medium (pbrt-v4 "albedo", "g"): black, the layer
+  // only absorbs (exp(-thickness / |cos|)); otherwise a medium of unit
+  // extinction with this single-scattering albedo and Henyey-Greenstein g.
+  Rgb layer_albedo{0.f};
+  Float layer_g = 0.f;
 };
 
 // pbrt-v4 treats microfacet distributions with alpha below this as specular.

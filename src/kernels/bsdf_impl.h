@@ -4,6 +4,7 @@
 #pragma once
 
 #include "fresnel.h"
+#include "medium.h"
 #include "microfacet.h"
 #include "rng.h"
 #include "sampling.h"

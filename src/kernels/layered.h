@@ -185,6 +185,7 @@ TESSERA_HOST_DEVICE inline Rgb layered_f(const BsdfParams& b, const Base& base, 
   const uint32_t n_samples = b.layer_samples > 0 ? b.layer_samples : 1;
   const bool top_specular = dielectric_is_specular(b);
   const bool base_specular = base.specular();
+  const bool scattering = !is_black(b.layer_albedo);
   // Reflection at the entrance (top) interface: deterministic.
   Rgb f = top_specular ? Rgb(0.f) : Rgb(static_cast<Float>(n_samples) * dielectric_f(b, wo, wi).x);
   Rng rng = layered::rng_for(wo, wi);
@@ -197,7 +198,7 @@ TESSERA_HOST_DEVICE inline Rgb layered_f(const BsdfParams& b, const Base& base, 
     { Vec2 u(r(), r()); if (!layered::interface_sample(b, wi, u, true, false, &wis)) continue; }
     Rgb beta(wos.f * abs_cos_theta(wos.wi) / wos.pdf);
     Vec3 w = wos.wi;
-    bool at_top = true;  // z == thickness
+    Float z = thickness;  // the top is the exit: wo and wi are on its side
     for (uint32_t depth = 0; depth < b.layer_max_depth; ++depth) {
       // Russian roulette, as pbrt-v4.
       const Float max_beta = glm::max(beta.x, glm::max(beta.y, beta.z));
@@ -206,9 +207,45 @@ TESSERA_HOST_DEVICE inline Rgb layered_f(const BsdfParams& b, const Base& base, 
         if (r() < q) break;
         beta /= 1.f - q;
       }
-      // Across the layer to the other interface.
-      at_top = !at_top;
-      beta *= layered::transmittance(thickness, w);
+      if (!scattering) {
+        // Across the clear layer to the other interface.
+        z = z == thickness ? 0.f : thickness;
+        beta *= layered::transmittance(thickness, w);
+      } else {
+        // A free flight in the unit-extinction medium (pbrt-v4): a
+        // scattering event inside the layer, or the next interface.
+        const Float dz = -glm::log(1.f - glm::min(r(), 0x1.fffffep-1f)) * fabsf(w.z);
+        const Float zp = w.z > 0.f ? z + dz : z - dz;
+        if (zp == z) continue;
+        if (0.f < zp && zp < thickness) {
+          // Next-event estimation out through the top along wis...
+          const Vec3 to_light = -wis.wi;
+          Float wt = 1.f;
+          if (!top_specular) wt = power_heuristic(wis.pdf, henyey_greenstein(glm::dot(-w, to_light), b.layer_g));
+          f += beta * b.layer_albedo * henyey_greenstein(glm::dot(-w, to_light), b.layer_g) * wt *
+               layered::transmittance(zp - thickness, wis.wi) * (wis.f / wis.pdf);
+          // ...then a new direction from the phase function.
+          Float phase_pdf = 0.f;
+          const Vec3 wp = sample_henyey_greenstein(-w, b.layer_g, Vec2(r(), r()), &phase_pdf);
+          if (!(phase_pdf > 0.f) || wp.z == 0.f) continue;
+          beta *= b.layer_albedo;  // exact sampling: p / pdf = 1
+          w = wp;
+          z = zp;
+          if (w.z > 0.f && !top_specular) {
+            // ...and out through the rough top along it.
+            const Float f_exit = dielectric_f(b, -w, wi).x;
+            if (f_exit > 0.f) {
+              const Float exit_pdf = weights == layered::LayerWeights::Consistent
+                                         ? layered::interface_transmission_pdf(b, wi, -w)
+                                         : layered::interface_transmission_pdf(b, -w, wi);
+              f += beta * layered::transmittance(zp - thickness, w) * f_exit * power_heuristic(phase_pdf, exit_pdf);
+            }
+          }
+          continue;
+        }
+        z = glm::clamp(zp, 0.f, thickness);
+      }
+      const bool at_top = z == thickness;
       if (at_top) {
         // Internal reflection at the exit (top) interface.
         layered::LobeSample bs;

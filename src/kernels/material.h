@@ -91,6 +91,8 @@ struct Material {
   int32_t normal_map = -1;                   // "normalmap" image (linear RGB), -1 = none; bump wins
   bool remap_roughness = true;
   Float thickness = 0.01f;                   // coated materials' layer (pbrt-v4 defaults)
+  TextureSlot layer_albedo{-1, Rgb(0.f)};    // its scattering medium: albedo (black: clear) and
+  TextureSlot layer_g{-1, Rgb(0.f)};         // Henyey-Greenstein g
   uint32_t layer_max_depth = 10, layer_samples = 1;
   int32_t mix[2] = {-1, -1};                 // Mix: material indices
   TextureSlot amount{ -1, Rgb(0.5f) };      // Mix: probability of choosing mix[1] (value.x)

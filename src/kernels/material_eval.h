@@ -52,6 +52,20 @@ TESSERA_HOST_DEVICE inline void textured_alpha(const SceneView& s, const Materia
   *alpha_y = m.remap_roughness ? glm::sqrt(rv) : rv;
 }
 
+// A coated material's layer medium, clamped as pbrt-v4 clamps it (albedo
+// to [0, 1], g to [-1, 1]: here just inside).
+template <uint32_t Spec>
+TESSERA_HOST_DEVICE inline void layer_medium(const SceneView& s, const Material& m, const SurfaceHit& h,
+                                             const Wavelengths* wl, BsdfParams* b) {
+  const Rgb albedo = (Spec & kSpecTextures) ? eval_slot(s, m.layer_albedo, texture_point(h)) : m.layer_albedo.value;
+  const Float g = (Spec & kSpecTextures) ? eval_slot(s, m.layer_g, texture_point(h)).x : m.layer_g.value.x;
+  b->layer_albedo = glm::clamp(spectral_albedo(s.spectral, wl, albedo), Rgb(0.f), Rgb(1.f));
+  // pbrt-v4 clamps to [-1, 1]; at +-1 its Henyey-Greenstein is 0 / 0, so a
+  // hair inside (NaN: isotropic).
+  constexpr Float kMaxG = 0.999f;
+  b->layer_g = g >= -kMaxG && g <= kMaxG ? g : (g > kMaxG ? kMaxG : (g < -kMaxG ? -kMaxG : 0.f));
+}
+
 template <uint32_t Spec>
 TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t material, const SurfaceHit& h, const Vec3& wo,
                                              BsdfParams* out, Wavelengths* wl = nullptr) {
@@ -98,6 +112,12 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
         b.thickness = m->thickness;
         b.layer_max_depth = m->layer_max_depth;
         b.layer_samples = m->layer_samples;
+        // A scattering layer, except between a smooth coat and a smooth
+        // conductor: the value's walk reaches the exit from inside that
+        // layer only by chains of mirrors (the loader warns).
+        if (!(TrowbridgeReitz(b.alpha_x, b.alpha_y).effectively_smooth() &&
+              TrowbridgeReitz(b.base_alpha_x, b.base_alpha_y).effectively_smooth()))
+          layer_medium<Spec>(s, *m, h, wl, &b);
       }
       break;
     case MaterialType::Dielectric:
@@ -118,6 +138,7 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
     case MaterialType::CoatedDiffuse:
       b.type = BsdfType::CoatedDiffuse;
       b.reflectance = spectral_albedo(s.spectral, wl, refl);
+      layer_medium<Spec>(s, *m, h, wl, &b);
       b.thickness = m->thickness;
       b.layer_max_depth = m->layer_max_depth;
       b.layer_samples = m->layer_samples;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 
+#include "kernels/bsdf.h"
 #include "scene/named_spectra.h"
 #include "scene/pbrt_textures.h"
 
@@ -108,7 +109,7 @@ void read_conductor(Material& m, const ParamSet& params, const DirectiveContext&
 }
 
 // The layer of the coated materials: thickness, the random walk's depth and
-// sample count; its scattering medium ("albedo", "g") is not simulated.
+// sample count, and its scattering medium ("albedo", "g").
 void read_layer(Material& m, const ParamSet& params, const DirectiveContext& ctx, const std::string& type) {
   m.thickness = constant_float(params, "thickness", 0.01f, ctx);
   const int max_depth = params.get_int("maxdepth", 10), samples = params.get_int("nsamples", 1);
@@ -117,11 +118,8 @@ void read_layer(Material& m, const ParamSet& params, const DirectiveContext& ctx
   if (samples < 1 || samples > 1000) ctx.fail(type + " \"nsamples\" must be in 1..1000");
   m.layer_max_depth = static_cast<uint32_t>(max_depth);
   m.layer_samples = static_cast<uint32_t>(samples);
-  params.find_any("g");
-  const Param* albedo = params.find_any("albedo");
-  if (albedo && !(albedo->numbers.size() == 3 && albedo->numbers[0] == 0 && albedo->numbers[1] == 0 &&
-                  albedo->numbers[2] == 0) && !(albedo->numbers.size() == 1 && albedo->numbers[0] == 0))
-    ctx.warn(type + " \"albedo\" (a scattering layer) is not supported; the layer only absorbs by its thickness");
+  m.layer_albedo = spectrum_slot(params, "albedo", Rgb(0.f), ctx);
+  m.layer_g = float_slot(params, "g", 0.f, ctx);
 }
 
 }  // namespace
@@ -167,6 +165,10 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
     m.ior = read_ior(params, "interface.eta", 1.5f, ctx, &m);
     read_roughness(m, params, ctx, "interface.");
     read_layer(m, params, ctx, type);
+    const bool smooth = std::max(m.alpha_x, m.alpha_y) < kSmoothAlpha && std::max(m.base_alpha_x, m.base_alpha_y) < kSmoothAlpha;
+    if (smooth && (m.layer_albedo.texture >= 0 || !is_black(m.layer_albedo.value)))
+      ctx.warn("coatedconductor \"albedo\" between a smooth coat and a smooth conductor is not simulated; the layer "
+               "only absorbs by its thickness");
   } else if (type == "interface" || type == "none" || type == "") {
     m.type = MaterialType::Interface;
   } else if (type == "mix") {

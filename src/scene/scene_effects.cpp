@@ -13,7 +13,9 @@ void add_material_effects(const SceneDesc& scene, int32_t index, uint32_t& e, in
   if (index < 0 || index >= static_cast<int32_t>(scene.materials.size()) || depth > 16) return;
   const Material& m = scene.materials[index];
   const bool smooth = m.alpha_x < 1e-3f && m.alpha_y < 1e-3f;
-  if (m.textured_roughness || m.textured_base_roughness || m.bump >= 0 || m.normal_map >= 0) e |= kEffectTextures;
+  if (m.textured_roughness || m.textured_base_roughness || m.bump >= 0 || m.normal_map >= 0 ||
+      slot_textured(m.layer_albedo) || slot_textured(m.layer_g))
+    e |= kEffectTextures;
   switch (m.type) {
     case MaterialType::DiffuseTransmission:
       e |= kEffectDiffuse | kEffectTransmission;

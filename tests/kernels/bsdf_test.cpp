@@ -77,6 +77,13 @@ BsdfParams coated_conductor(Float coat_alpha, Float base_alpha, Rgb eta = Rgb(0.
   return b;
 }
 
+BsdfParams with_layer_medium(BsdfParams b, Rgb albedo, Float g, Float thickness) {
+  b.layer_albedo = albedo;
+  b.layer_g = g;
+  b.thickness = thickness;
+  return b;
+}
+
 Vec3 spherical(double theta, double phi) {
   return Vec3(Float(std::sin(theta) * std::cos(phi)), Float(std::sin(theta) * std::sin(phi)), Float(std::cos(theta)));
 }
@@ -464,7 +471,7 @@ Rgb layer_walk_weight(const BsdfParams& coat, Vec3 wo, Rng& rng) {
   Rgb f = bs.f * std::abs(bs.wi.z);
   Float pdf = bs.pdf;
   Vec3 w = bs.wi;
-  bool at_top = true;
+  Float z = coat.thickness;
   for (uint32_t depth = 0; depth < coat.layer_max_depth; ++depth) {
     const Float rr = std::max({f.x, f.y, f.z}) / pdf;
     if (depth > 3 && rr < 0.25f) {
@@ -472,8 +479,28 @@ Rgb layer_walk_weight(const BsdfParams& coat, Vec3 wo, Rng& rng) {
       if (rng.uniform() < q) return Rgb(0.f);
       pdf *= 1.f - q;
     }
-    at_top = !at_top;
-    f *= std::exp(-coat.thickness / std::abs(w.z));
+    if (is_black(coat.layer_albedo)) {
+      z = z == coat.thickness ? 0.f : coat.thickness;
+      f *= std::exp(-coat.thickness / std::abs(w.z));
+    } else {
+      // pbrt-v4's Sample_f in a scattering layer: a free flight of unit
+      // extinction, then a phase-function scattering or the next interface.
+      const Float dz = -std::log(1.f - rng.uniform()) * std::abs(w.z);
+      const Float zp = w.z > 0.f ? z + dz : z - dz;
+      if (zp == z) return Rgb(0.f);
+      if (0.f < zp && zp < coat.thickness) {
+        Float phase_pdf = 0.f;
+        const Vec3 wp = sample_henyey_greenstein(-w, coat.layer_g, rng.uniform2(), &phase_pdf);
+        if (!(phase_pdf > 0.f) || wp.z == 0.f) return Rgb(0.f);
+        f *= coat.layer_albedo * henyey_greenstein(glm::dot(-w, wp), coat.layer_g);
+        pdf *= phase_pdf;
+        w = wp;
+        z = zp;
+        continue;
+      }
+      z = std::clamp(zp, 0.f, coat.thickness);
+    }
+    const bool at_top = z == coat.thickness;
     BsdfSample s;
     if (!bsdf_sample(at_top ? top : base, -w, rng.uniform(), rng.uniform2(), &s) || !(s.pdf > 0.f) || s.wi.z == 0.f)
       return Rgb(0.f);
@@ -495,7 +522,13 @@ Rgb layer_walk_weight(const BsdfParams& coat, Vec3 wo, Rng& rng) {
 TEST(BsdfEnergy, RoughCoatsAgreeWithTheLayerWalk) {
   const BsdfParams cfgs[] = {coated(0.3f, Rgb(0.8f)), coated(0.1f, Rgb(0.5f, 0.8f, 0.2f)),
                              coated_conductor(0.3f, 0.3f), coated_conductor(0.141f, 0.0447f, Rgb(0.155f, 0.117f, 0.138f),
-                                                                            Rgb(4.828f, 3.122f, 2.147f))};
+                                                                            Rgb(4.828f, 3.122f, 2.147f)),
+                             // Scattering layers ("albedo", "g"), thick enough to matter.
+                             with_layer_medium(coated(0.3f, Rgb(0.8f)), Rgb(0.7f), 0.3f, 0.5f),
+                             with_layer_medium(coated(0.f, Rgb(0.2f, 0.5f, 0.9f)), Rgb(0.9f, 0.5f, 0.2f), -0.3f, 0.3f),
+                             with_layer_medium(coated_conductor(0.3f, 0.3f), Rgb(0.9f, 0.5f, 0.2f), -0.2f, 0.3f),
+                             with_layer_medium(coated_conductor(0.f, 0.2f), Rgb(0.8f), 0.5f, 0.4f),
+                             with_layer_medium(coated_conductor(0.2f, 0.f), Rgb(0.8f), 0.5f, 0.4f)};
   int cfg = 0;
   for (const BsdfParams& b : cfgs) {
     for (double t : {0.3, 1.0}) {
