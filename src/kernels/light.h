@@ -6,7 +6,7 @@
 
 namespace tessera {
 
-enum class LightType : uint32_t { Area = 0, Point, Spot, Distant, Infinite };
+enum class LightType : uint32_t { Area = 0, Point, Spot, Distant, Infinite, Goniometric };
 
 struct Light {
   LightType type = LightType::Point;
@@ -20,10 +20,11 @@ struct Light {
   uint32_t triangle = 0;       // Area: global triangle index in the scene
   Float area = 0.f;            // Area: triangle area (precomputed: used by every pdf)
   bool two_sided = false;      // Area
-  // Infinite: index into the scene's images (equal-area octahedral); Area:
-  // an image over the shape's uv that L multiplies. -1 = L alone.
+  // Infinite, Goniometric: index into the scene's images (equal-area
+  // octahedral; a goniometric light's is grey); Area: an image over the
+  // shape's uv that L multiplies. -1 = L alone.
   int32_t image = -1;
-  Mat3 light_from_world{1.f};  // Infinite: into the light's frame (directions; normalise after)
+  Mat3 light_from_world{1.f};  // Infinite, Goniometric: into the light's frame (directions; normalise after)
   Mat3 world_from_light{1.f};  // Infinite: its inverse (set when the scene is built)
   // A blackbody emitter (pbrt-v4 "blackbody"): in spectral mode it emits
   // luminance(L) * blackbody_norm * B(lambda) / B(peak) instead of L's spectrum.

@@ -33,6 +33,16 @@ TESSERA_HOST_DEVICE inline Rgb area_light_radiance(const SceneView& s, const Lig
   return l.L * image_lookup(s.images[l.image], uv, ImageWrap::Clamp);
 }
 
+// A goniometric light's intensity towards world direction w (from the
+// light): I times its image at w in the light's frame (pbrt-v4: nearest texel).
+TESSERA_HOST_DEVICE inline Rgb goniometric_intensity(const SceneView& s, const Light& l, const Vec3& w) {
+  if (l.image < 0) return l.L;
+  const Vec3 wl = l.light_from_world * w;
+  const Float len = glm::length(wl);
+  if (!(len > 0.f)) return Rgb(0.f);
+  return l.L * image_lookup_nearest_equal_area(s.images[l.image], equal_area_sphere_to_square(wl / len));
+}
+
 // Solid-angle pdf of sampling a point on an area light (triangle of area
 // `area`) at distance dist, seen under cos_l = dot(n_light, -w).
 TESSERA_HOST_DEVICE inline Float area_light_pdf(Float area, Float dist, Float cos_l) {
@@ -120,14 +130,15 @@ TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_
       break;
     }
     case LightType::Point:
-    case LightType::Spot: {
+    case LightType::Spot:
+    case LightType::Goniometric: {
       Vec3 d = l.position - ref_p;
       Float dist2 = glm::dot(d, d);
       if (dist2 <= 0.f) return false;
       ls.wi = d / glm::sqrt(dist2);
       Float falloff = l.type == LightType::Spot ? spot_falloff(l, glm::dot(-ls.wi, l.direction)) : 1.f;
       if (falloff <= 0.f) return false;
-      ls.L = l.L * (falloff / dist2);
+      ls.L = (l.type == LightType::Goniometric ? goniometric_intensity(s, l, -ls.wi) : l.L) * (falloff / dist2);
       ls.pdf = 1.f;
       ls.delta = true;
       ls.p_light = l.position;

@@ -23,8 +23,9 @@ std::string light_paths_obstacle(const SceneDesc& desc) {
   for (const MeshDesc& m : desc.meshes)
     if (!m.p_end.empty()) return "a shape moves";
   bool light = !desc.area_lights.empty();
-  for (const Light& l : desc.lights) light = light || l.type == LightType::Point || l.type == LightType::Spot;
-  if (!light) return "the scene has no area, point or spot light";
+  for (const Light& l : desc.lights)
+    light = light || l.type == LightType::Point || l.type == LightType::Spot || l.type == LightType::Goniometric;
+  if (!light) return "the scene has no area, point, spot or goniometric light";
   return "";
 }
 

@@ -75,6 +75,33 @@ std::optional<Light> make_light(const std::string& type, const ParamSet& params,
     if (from == to) ctx.fail("spot light \"from\" and \"to\" coincide");
     l.position = transform_point(world_from_light, from);
     l.direction = glm::normalize(Mat3(world_from_light) * (to - from));
+  } else if (type == "goniometric") {
+    // A point light at the light frame's origin whose intensity is I times a
+    // grey equal-area image over directions (pbrt-v4 reads it with y and z
+    // swapped: the image's pole is the frame's +y).
+    l.type = LightType::Goniometric;
+    l.L = emission(params, "I") * scale;
+    l.blackbody_kelvin = blackbody_kelvin(params, "I");
+    const std::string filename = params.get_string("filename", "");
+    double mean = 1.0;
+    if (filename.empty()) {
+      ctx.warn("goniometric light without \"filename\": it emits I in every direction");
+    } else {
+      l.image = image_index(filename, "sRGB", true, ctx);
+      const ImageDesc& img = ctx.scene.images[l.image];
+      if (img.width != img.height)
+        ctx.fail("goniometric light image '" + img.path + "' is " + std::to_string(img.width) + "x" +
+                 std::to_string(img.height) + "; it must be square (equal-area octahedral)");
+      require_finite_texels(img, ctx);
+      mean = 0.0;
+      for (const Rgb& t : img.texels) mean += t.x;
+      mean /= static_cast<double>(img.texels.size());
+    }
+    if (Float power = params.get_float("power", -1.f); power > 0.f && mean > 0.0)
+      l.L *= static_cast<Float>(power / (4.0 * kPi * mean));
+    l.position = transform_point(world_from_light, Vec3(0.f));
+    const Mat3 swap_yz(1.f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f, 1.f, 0.f);
+    l.light_from_world = swap_yz * glm::inverse(Mat3(world_from_light));
   } else if (type == "distant") {
     l.type = LightType::Distant;
     l.L = emission(params, "L") * scale;

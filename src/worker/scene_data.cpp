@@ -229,6 +229,9 @@ void SceneData::build_lights() {
         break;
       }
       case LightType::Point: power[i] = 4.f * kPi * luminance(l.L); break;
+      case LightType::Goniometric:
+        power[i] = 4.f * kPi * luminance(l.L) * (l.image >= 0 ? image_luminance_[l.image].mean : 1.f);
+        break;
       case LightType::Spot:
         power[i] = luminance(l.L) * 2.f * kPi * (1.f - 0.5f * (l.cos_falloff_start + l.cos_falloff_end));
         break;
