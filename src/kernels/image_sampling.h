@@ -81,9 +81,9 @@ TESSERA_HOST_DEVICE inline Rgb image_lookup(const ImageView& img, Vec2 st, Image
          (1.f - dx) * dy * image_texel(img, ix, iy + 1, wrap) + dx * dy * image_texel(img, ix + 1, iy + 1, wrap);
 }
 
-// Nearest-texel lookup in an equal-area octahedral environment map (pbrt-v4
-// ImageInfiniteLight::ImageLe): uv (0,0) is the top-left texel, no flip.
-TESSERA_HOST_DEVICE inline Rgb image_lookup_nearest_equal_area(const ImageView& img, Vec2 uv) {
+// pbrt-v4's Image::LookupNearest, clamped: uv (0,0) is the top-left texel,
+// no flip (equal-area environment maps, goniometric and projection lights).
+TESSERA_HOST_DEVICE inline Rgb image_lookup_nearest(const ImageView& img, Vec2 uv) {
   Float fx = glm::clamp(uv.x, 0.f, 1.f) * img.width, fy = glm::clamp(uv.y, 0.f, 1.f) * img.height;
   if (!(fx >= 0.f)) fx = 0.f;  // NaN
   if (!(fy >= 0.f)) fy = 0.f;

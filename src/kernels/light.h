@@ -6,7 +6,7 @@
 
 namespace tessera {
 
-enum class LightType : uint32_t { Area = 0, Point, Spot, Distant, Infinite, Goniometric };
+enum class LightType : uint32_t { Area = 0, Point, Spot, Distant, Infinite, Goniometric, Projection };
 
 struct Light {
   LightType type = LightType::Point;
@@ -22,9 +22,14 @@ struct Light {
   bool two_sided = false;      // Area
   // Infinite, Goniometric: index into the scene's images (equal-area
   // octahedral; a goniometric light's is grey); Area: an image over the
-  // shape's uv that L multiplies. -1 = L alone.
+  // shape's uv that L multiplies; Projection: the slide. -1 = L alone.
   int32_t image = -1;
-  Mat3 light_from_world{1.f};  // Infinite, Goniometric: into the light's frame (directions; normalise after)
+  Mat3 light_from_world{1.f};  // Infinite, Goniometric, Projection: into the light's frame (directions)
+  // Projection: the screen window's corner (aspect, 1) or (1, 1 / aspect)
+  // and tan(fov / 2); a direction w of the light's frame lands on the
+  // screen at (w.x, w.y) / (w.z tan).
+  Vec2 screen_max{1.f};
+  Float tan_half_fov = 1.f;
   Mat3 world_from_light{1.f};  // Infinite: its inverse (set when the scene is built)
   // A blackbody emitter (pbrt-v4 "blackbody"): in spectral mode it emits
   // luminance(L) * blackbody_norm * B(lambda) / B(peak) instead of L's spectrum.

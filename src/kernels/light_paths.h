@@ -208,10 +208,10 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
     }
     case LightType::Point:
     case LightType::Goniometric:
+    case LightType::Projection:
       ray.o = l.position;
       ray.d = sample_uniform_sphere(u_dir);
-      beta = light_emission(s, wl, l, l.type == LightType::Point ? l.L : goniometric_intensity(s, l, ray.d)) *
-             (4.f * kPi / pmf);
+      beta = light_emission(s, wl, l, point_like_intensity(s, l, ray.d)) * (4.f * kPi / pmf);
       break;
     case LightType::Spot: {
       // Uniform in the cone of cos_falloff_end, weighted by the falloff.

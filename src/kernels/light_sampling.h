@@ -22,7 +22,7 @@ struct LightSample {
 TESSERA_HOST_DEVICE inline Rgb environment_radiance(const SceneView& s, const Light& l, const Vec3& dir_world) {
   if (l.image < 0) return l.L;
   Vec3 wl = glm::normalize(l.light_from_world * dir_world);
-  return l.L * image_lookup_nearest_equal_area(s.images[l.image], equal_area_sphere_to_square(wl));
+  return l.L * image_lookup_nearest(s.images[l.image], equal_area_sphere_to_square(wl));
 }
 
 // What an area light emits at surface coordinates uv: L, times its image
@@ -31,16 +31,6 @@ TESSERA_HOST_DEVICE inline Rgb environment_radiance(const SceneView& s, const Li
 TESSERA_HOST_DEVICE inline Rgb area_light_radiance(const SceneView& s, const Light& l, Vec2 uv) {
   if (l.image < 0) return l.L;
   return l.L * image_lookup(s.images[l.image], uv, ImageWrap::Clamp);
-}
-
-// A goniometric light's intensity towards world direction w (from the
-// light): I times its image at w in the light's frame (pbrt-v4: nearest texel).
-TESSERA_HOST_DEVICE inline Rgb goniometric_intensity(const SceneView& s, const Light& l, const Vec3& w) {
-  if (l.image < 0) return l.L;
-  const Vec3 wl = l.light_from_world * w;
-  const Float len = glm::length(wl);
-  if (!(len > 0.f)) return Rgb(0.f);
-  return l.L * image_lookup_nearest_equal_area(s.images[l.image], equal_area_sphere_to_square(wl / len));
 }
 
 // Solid-angle pdf of sampling a point on an area light (triangle of area
@@ -92,6 +82,40 @@ TESSERA_HOST_DEVICE inline Float spot_falloff(const Light& l, Float cos_theta) {
   return t * t * (3.f - 2.f * t);
 }
 
+// A goniometric light's intensity towards world direction w (from the
+// light): I times its image at w in the light's frame (pbrt-v4: nearest texel).
+TESSERA_HOST_DEVICE inline Rgb goniometric_intensity(const SceneView& s, const Light& l, const Vec3& w) {
+  if (l.image < 0) return l.L;
+  const Vec3 wl = l.light_from_world * w;
+  const Float len = glm::length(wl);
+  if (!(len > 0.f)) return Rgb(0.f);
+  return l.L * image_lookup_nearest(s.images[l.image], equal_area_sphere_to_square(wl / len));
+}
+
+// A projection light's intensity towards world direction w: L times the
+// slide's nearest texel where w passes through the screen window (pbrt-v4's
+// ProjectionLight::I; nothing behind the light or outside the window).
+TESSERA_HOST_DEVICE inline Rgb projection_intensity(const SceneView& s, const Light& l, const Vec3& w) {
+  const Vec3 wl = l.light_from_world * w;
+  const Float len = glm::length(wl);
+  if (!(len > 0.f) || !(wl.z / len >= 1e-3f)) return Rgb(0.f);  // pbrt-v4's hither
+  const Vec2 ps(wl.x / (wl.z * l.tan_half_fov), wl.y / (wl.z * l.tan_half_fov));
+  if (!(ps.x >= -l.screen_max.x && ps.x <= l.screen_max.x && ps.y >= -l.screen_max.y && ps.y <= l.screen_max.y))
+    return Rgb(0.f);
+  const Vec2 uv = (ps + l.screen_max) / (2.f * l.screen_max);
+  return l.L * image_lookup_nearest(s.images[l.image], uv);
+}
+
+// What a point-like light sends towards world direction w (unit, from the light).
+TESSERA_HOST_DEVICE inline Rgb point_like_intensity(const SceneView& s, const Light& l, const Vec3& w) {
+  switch (l.type) {
+    case LightType::Goniometric: return goniometric_intensity(s, l, w);
+    case LightType::Projection: return projection_intensity(s, l, w);
+    case LightType::Spot: return l.L * spot_falloff(l, glm::dot(w, l.direction));
+    default: return l.L;
+  }
+}
+
 // in_medium: ref_p is a scattering point in a medium (area lights are then
 // sampled by solid angle where they look large: area_light_pdf_from).
 TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_t light_index, const Vec3& ref_p, Vec2 u,
@@ -131,14 +155,14 @@ TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_
     }
     case LightType::Point:
     case LightType::Spot:
-    case LightType::Goniometric: {
+    case LightType::Goniometric:
+    case LightType::Projection: {
       Vec3 d = l.position - ref_p;
       Float dist2 = glm::dot(d, d);
       if (dist2 <= 0.f) return false;
       ls.wi = d / glm::sqrt(dist2);
-      Float falloff = l.type == LightType::Spot ? spot_falloff(l, glm::dot(-ls.wi, l.direction)) : 1.f;
-      if (falloff <= 0.f) return false;
-      ls.L = (l.type == LightType::Goniometric ? goniometric_intensity(s, l, -ls.wi) : l.L) * (falloff / dist2);
+      ls.L = point_like_intensity(s, l, -ls.wi) / dist2;
+      if (is_black(ls.L)) return false;
       ls.pdf = 1.f;
       ls.delta = true;
       ls.p_light = l.position;
@@ -165,7 +189,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_
         ls.pdf = pdf_uv * kInv4Pi;
         // Radiance of the sampled texel itself (pbrt-v4 ImageLe(uv)): going
         // back through the direction could land in a neighbour at a border.
-        ls.L = l.L * image_lookup_nearest_equal_area(s.images[l.image], uv);
+        ls.L = l.L * image_lookup_nearest(s.images[l.image], uv);
       }
       if (l.image < 0) ls.L = l.L;
       ls.infinite = true;

@@ -24,8 +24,9 @@ std::string light_paths_obstacle(const SceneDesc& desc) {
     if (!m.p_end.empty()) return "a shape moves";
   bool light = !desc.area_lights.empty();
   for (const Light& l : desc.lights)
-    light = light || l.type == LightType::Point || l.type == LightType::Spot || l.type == LightType::Goniometric;
-  if (!light) return "the scene has no area, point, spot or goniometric light";
+    light = light || l.type == LightType::Point || l.type == LightType::Spot || l.type == LightType::Goniometric ||
+            l.type == LightType::Projection;
+  if (!light) return "the scene has no area, point, spot, goniometric or projection light";
   return "";
 }
 

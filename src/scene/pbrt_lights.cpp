@@ -102,6 +102,38 @@ std::optional<Light> make_light(const std::string& type, const ParamSet& params,
     l.position = transform_point(world_from_light, Vec3(0.f));
     const Mat3 swap_yz(1.f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f, 1.f, 0.f);
     l.light_from_world = swap_yz * glm::inverse(Mat3(world_from_light));
+  } else if (type == "projection") {
+    // A slide projector at the light frame's origin looking down +z: the
+    // image through a perspective window of "fov" (pbrt-v4 flips the frame's y).
+    l.type = LightType::Projection;
+    const std::string filename = params.get_string("filename", "");
+    if (filename.empty()) ctx.fail("projection light needs \"string filename\"");
+    l.image = image_index(filename, "sRGB", false, ctx);
+    const ImageDesc& img = ctx.scene.images[l.image];
+    require_finite_texels(img, ctx);
+    const Float fov = params.get_float("fov", 90.f);
+    if (!(fov > 0.f && fov < 180.f)) ctx.fail("projection light \"fov\" must be in (0, 180) degrees");
+    const Float aspect = static_cast<Float>(img.width) / static_cast<Float>(img.height);
+    l.screen_max = aspect > 1.f ? Vec2(aspect, 1.f) : Vec2(1.f, 1.f / aspect);
+    l.tan_half_fov = std::tan(radians(fov) * 0.5f);
+    l.L = Rgb(scale);
+    if (Float power = params.get_float("power", -1.f); power > 0.f) {
+      // pbrt-v4: the window's area times the texels' mean luminance x cos^3.
+      const double area = 4.0 * double(l.tan_half_fov) * l.tan_half_fov * (aspect > 1.f ? aspect : 1.f / aspect);
+      double sum = 0.0;
+      for (int32_t y = 0; y < img.height; ++y)
+        for (int32_t x = 0; x < img.width; ++x) {
+          const Vec2 ps(-l.screen_max.x + 2.f * l.screen_max.x * (x + 0.5f) / img.width,
+                        -l.screen_max.y + 2.f * l.screen_max.y * (y + 0.5f) / img.height);
+          const double cos_t = glm::normalize(Vec3(ps * l.tan_half_fov, 1.f)).z;
+          sum += luminance(img.texels[static_cast<size_t>(y) * img.width + x]) * cos_t * cos_t * cos_t;
+        }
+      const double k_e = area * sum / (static_cast<double>(img.width) * img.height);
+      if (k_e > 0.0) l.L *= static_cast<Float>(power / k_e);
+    }
+    l.position = transform_point(world_from_light, Vec3(0.f));
+    const Mat3 flip_y(1.f, 0.f, 0.f, 0.f, -1.f, 0.f, 0.f, 0.f, 1.f);
+    l.light_from_world = flip_y * glm::inverse(Mat3(world_from_light));
   } else if (type == "distant") {
     l.type = LightType::Distant;
     l.L = emission(params, "L") * scale;

@@ -8,8 +8,8 @@
 
 namespace tessera {
 
-// point, spot, goniometric, distant, infinite (constant "L" or equal-area
-// "filename"). projection / unknown: a warning and nullopt. `world_from_light`
+// point, spot, goniometric, projection, distant, infinite (constant "L" or
+// equal-area "filename"). Unknown types: a warning and nullopt. `world_from_light`
 // is the CTM. Light "scale" (and "power"/"illuminance", as pbrt-v4 applies
 // them) are folded into L.
 std::optional<Light> make_light(const std::string& type, const ParamSet& params, const Mat4& world_from_light,

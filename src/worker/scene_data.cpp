@@ -232,6 +232,10 @@ void SceneData::build_lights() {
       case LightType::Goniometric:
         power[i] = 4.f * kPi * luminance(l.L) * (l.image >= 0 ? image_luminance_[l.image].mean : 1.f);
         break;
+      case LightType::Projection:  // the window's solid angle, about
+        power[i] = luminance(l.L) * image_luminance_[l.image].mean * 4.f * l.screen_max.x * l.screen_max.y *
+                   l.tan_half_fov * l.tan_half_fov;
+        break;
       case LightType::Spot:
         power[i] = luminance(l.L) * 2.f * kPi * (1.f - 0.5f * (l.cos_falloff_start + l.cos_falloff_end));
         break;

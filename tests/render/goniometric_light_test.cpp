@@ -1,5 +1,6 @@
-// pbrt-v4's goniometric light: a point light whose intensity is I times a
-// grey equal-area image over directions, read with y and z swapped.
+// pbrt-v4's goniometric light (a point light whose intensity is I times a
+// grey equal-area image over directions, read with y and z swapped) and its
+// projection light (a slide projected through a perspective window).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -79,6 +80,23 @@ TEST_F(GoniometricLight, PowerIsPbrtV4s) {
                                         path_ + "\" \"float power\" " + std::to_string(8 * M_PI) + "\nAttributeEnd\n");
   const double point = plane_radiance(R"(LightSource "point" "rgb I" [ 2 2 2 ] "point3 from" [ 0 2 0 ])");
   EXPECT_NEAR(powered, point, 1e-5 * point);
+}
+
+TEST_F(GoniometricLight, AProjectionLightShinesItsSlideDownItsZAxis) {
+  write(0.5f, 0.5f);  // any texel the window shows is 0.5
+  auto projector = [&](const std::string& rotate, const std::string& fov) {
+    return "AttributeBegin\nTranslate 0 2 0\n" + rotate + "LightSource \"projection\" \"float scale\" 4 \"float fov\" " +
+           fov + " \"string filename\" \"" + path_ + "\"\nAttributeEnd\n";
+  };
+  const double point = plane_radiance(R"(LightSource "point" "rgb I" [ 2 2 2 ] "point3 from" [ 0 2 0 ])");
+  // Rotate 90 about x turns the light's +z to -y: the plane sees the slide
+  // (the view's 10 degrees lie inside a 90-degree window).
+  EXPECT_NEAR(plane_radiance(projector("Rotate 90 1 0 0\n", "90")), point, 1e-5 * point);
+  // Pointing up, or a window narrower than the view: dark, or partly dark.
+  EXPECT_EQ(plane_radiance(projector("Rotate -90 1 0 0\n", "90")), 0.0);
+  const double narrow = plane_radiance(projector("Rotate 90 1 0 0\n", "2"));
+  EXPECT_GT(narrow, 0.0);
+  EXPECT_LT(narrow, 0.5 * point);
 }
 
 }  // namespace

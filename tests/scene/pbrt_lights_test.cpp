@@ -94,7 +94,7 @@ TEST(PbrtLights, InfiniteIlluminanceScalesAsPbrtV4) {
 }
 
 TEST(PbrtLights, UnsupportedLightsWarn) {
-  SceneDesc s = load_world(std::string("LightSource \"projection\" \"string filename\" \"x.exr\"\n") + kTriangle);
+  SceneDesc s = load_world(std::string("LightSource \"sunsky\" \"float turbidity\" 3\n") + kTriangle);
   EXPECT_TRUE(s.lights.empty());
   ASSERT_EQ(s.warnings.size(), 1u);
   EXPECT_NE(s.warnings[0].find("test.pbrt:2"), std::string::npos);
