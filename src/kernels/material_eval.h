@@ -113,8 +113,9 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
         b.layer_max_depth = m->layer_max_depth;
         b.layer_samples = m->layer_samples;
         // A scattering layer, except between a smooth coat and a smooth
-        // conductor: the value's walk reaches the exit from inside that
-        // layer only by chains of mirrors (the loader warns).
+        // conductor (the loader warns): there the value would count only
+        // light leaving straight from a scattering event, while light that
+        // scatters and leaves by the mirrors belongs to no lobe we sample.
         if (!(TrowbridgeReitz(b.alpha_x, b.alpha_y).effectively_smooth() &&
               TrowbridgeReitz(b.base_alpha_x, b.base_alpha_y).effectively_smooth()))
           layer_medium<Spec>(s, *m, h, wl, &b);

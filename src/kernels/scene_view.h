@@ -15,6 +15,9 @@ enum TriangleFlags : uint32_t {
   kTriFlipNormal = 1u << 0,   // negate cross(p0 - p2, p1 - p2)
   kTriHasNormals = 1u << 1,   // per-vertex shading normals present
   kTriHasUv = 1u << 2,        // per-vertex uv present (else pbrt's (0,0),(1,0),(1,1))
+  // The second triangle (p00, p11, p01) of a quad (bilinear patch, PLY
+  // quad) without uv: pbrt-v4's patch uv there is (0,0),(1,1),(0,1).
+  kTriQuadSecondHalf = 1u << 3,
 };
 
 struct TriangleInfo {

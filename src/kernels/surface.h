@@ -23,9 +23,11 @@ struct SurfaceHit {
 };
 
 // The uv at barycentrics (b1, b2): interpolated, or pbrt's default
-// (0,0), (1,0), (1,1) for triangles without uv.
+// (0,0), (1,0), (1,1) for triangles without uv ((0,0), (1,1), (0,1) for a
+// quad's second half, so that the quad reads its patch's uv).
 TESSERA_HOST_DEVICE inline Vec2 triangle_uv(const SceneView& s, uint32_t tri, Float b1, Float b2) {
-  if (!(s.triangles[tri].flags & kTriHasUv)) return Vec2(b1 + b2, b2);
+  const uint32_t flags = s.triangles[tri].flags;
+  if (!(flags & kTriHasUv)) return (flags & kTriQuadSecondHalf) ? Vec2(b1, b1 + b2) : Vec2(b1 + b2, b2);
   const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
   return (1.f - b1 - b2) * s.uvs[idx[0]] + b1 * s.uvs[idx[1]] + b2 * s.uvs[idx[2]];
 }
@@ -147,6 +149,10 @@ TESSERA_HOST_DEVICE inline Vec3 keep_on_lobe_side(const Vec3& wi, const Vec3& wo
 TESSERA_HOST_DEVICE inline Vec3 surface_dp_duv(const SceneView& s, uint32_t tri, int axis) {
   const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
   Vec2 uv0(0.f, 0.f), uv1(1.f, 0.f), uv2(1.f, 1.f);
+  if (s.triangles[tri].flags & kTriQuadSecondHalf) {
+    uv1 = Vec2(1.f, 1.f);
+    uv2 = Vec2(0.f, 1.f);
+  }
   if (s.triangles[tri].flags & kTriHasUv) {
     uv0 = s.uvs[idx[0]];
     uv1 = s.uvs[idx[1]];

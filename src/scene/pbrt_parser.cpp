@@ -568,6 +568,9 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
     scene_.warnings.push_back(at.where() + ": an area light on a shape with the \"interface\" material is ignored");
     mesh->area_light = -1;
   }
+  if (mesh->area_light >= 0 && mesh->mixed_faces && scene_.area_lights[mesh->area_light].power > 0.f)
+    scene_.warnings.push_back(at.where() + ": area light \"power\" on a PLY of triangles and quads goes to each "
+                              "triangle; pbrt-v4 gives it to each quad whole (each quad here emits twice that)");
   mesh->media = state_.media;
   if (state_.ctm_end != state_.ctm) {
     if (mesh->area_light >= 0) {

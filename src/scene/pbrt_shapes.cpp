@@ -103,6 +103,9 @@ MeshDesc ply_mesh(const ParamSet& params, const ShapeContext& ctx) {
     warn(ctx, "plymesh '" + name + "': " + std::to_string(ply.skipped_faces) +
                   " faces that are neither triangles nor quads ignored (as pbrt-v4 does)");
   MeshDesc m;
+  // A PLY of quads alone is pbrt-v4's bilinear patches: two triangles each.
+  if (ply.quads > 0 && ply.quads * 6 == ply.indices.size()) m.triangles_per_shape = 2;
+  m.mixed_faces = ply.quads > 0 && ply.quads * 6 != ply.indices.size();
   m.p = std::move(ply.p);
   m.n = std::move(ply.n);
   m.uv = std::move(ply.uv);

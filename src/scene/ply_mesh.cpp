@@ -412,6 +412,7 @@ void read_faces(const PlyElement& e, BodyReader& in, PlyMesh& out, uint64_t vert
         out.indices.insert(out.indices.end(), {face[0], face[1], face[2]});
       } else if (len == 4) {
         out.indices.insert(out.indices.end(), {face[0], face[1], face[2], face[0], face[2], face[3]});
+        ++out.quads;
       } else {
         ++out.skipped_faces;
       }

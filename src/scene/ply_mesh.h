@@ -19,6 +19,7 @@ struct PlyMesh {
   std::vector<Vec2> uv;
   std::vector<uint32_t> indices;
   size_t skipped_faces = 0;  // faces with fewer than 3 or more than 4 vertices
+  size_t quads = 0;          // quads, each made two triangles
 };
 
 // Parses a whole PLY file held in memory. `name` is used in messages only.

@@ -45,6 +45,9 @@ struct MeshDesc {
   // shape_area (a quadric: pbrt-v4's object-space Area()).
   uint32_t triangles_per_shape = 1;
   Float shape_area = 0.f;
+  // A PLY of triangles and quads (pbrt-v4: a triangle mesh and bilinear
+  // patches); loading only.
+  bool mixed_faces = false;
   std::string where;            // "file:line" of the Shape directive, for messages
 };
 

@@ -66,10 +66,11 @@ std::vector<double> shape_area_per_triangle(const MeshDesc& m) {
   return area;
 }
 
-// pbrt-v4's k_e for an image light: the mean luminance of its texels.
+// pbrt-v4's k_e for an image light: the mean luminance of its texels
+// (negative ones read as 0, as every lookup reads them).
 double mean_luminance(const ImageDesc& img) {
   double sum = 0.0;
-  for (const Rgb& t : img.texels) sum += luminance(t);
+  for (const Rgb& t : img.texels) sum += luminance(glm::max(t, Rgb(0.f)));
   return img.texels.empty() ? 0.0 : sum / static_cast<double>(img.texels.size());
 }
 
@@ -143,8 +144,8 @@ void SceneData::flatten_meshes() {
     if (m.area_light >= 0 && desc_.area_lights[m.area_light].power > 0.f) {
       const AreaLightDesc& al = desc_.area_lights[m.area_light];
       const double k_e = al.image >= 0 ? mean_luminance(desc_.images[al.image]) : 1.0;
-      power_per_area = al.power / (k_e * kPi * (al.two_sided ? 2.0 : 1.0));
-      if (!std::isfinite(power_per_area)) power_per_area = 0.0;  // a black image: nothing to scale
+      // A black image emits nothing however it is scaled.
+      power_per_area = k_e > 0.0 ? al.power / (k_e * kPi * (al.two_sided ? 2.0 : 1.0)) : 0.0;
       power_area = shape_area_per_triangle(m);
     }
     TriangleInfo info;
@@ -160,6 +161,7 @@ void SceneData::flatten_meshes() {
       face_normals_.push_back(m.flip_normals ? -n : n);
       for (int k = 0; k < 3; ++k) indices_.push_back(base + m.indices[t + k]);
       TriangleInfo ti = info;
+      if (!has_uv && m.triangles_per_shape == 2 && (t / 3) % 2 == 1) ti.flags |= kTriQuadSecondHalf;
       if (m.area_light >= 0) {
         const AreaLightDesc& al = desc_.area_lights[m.area_light];
         if (!is_black(al.L)) {
@@ -167,7 +169,7 @@ void SceneData::flatten_meshes() {
           l.type = LightType::Area;
           l.L = al.L;
           l.image = al.image;
-          if (!power_area.empty()) l.L *= static_cast<Float>(power_per_area / power_area[t / 3]);
+          if (!power_area.empty()) l.L *= static_cast<Float>(power_per_area / power_area[t / 3]);  // area > 0 here
           l.blackbody_kelvin = al.blackbody_kelvin;
           l.two_sided = al.two_sided;
           l.triangle = static_cast<uint32_t>(triangles_.size());
@@ -465,7 +467,8 @@ uint64_t SceneData::film_fingerprint() const {
   const bool defaults = camera_.pixel_from_radiance == Mat3(1.f) && !std::isfinite(camera_.max_component_value) &&
                         camera_.lens_radius == 0.f && std::memcmp(&desc_.filter, &default_filter, sizeof default_filter) == 0 &&
                         positions_end_.empty() && !camera_.moves && !desc_.spectral && camera_.film_x0 == 0 &&
-                        camera_.film_y0 == 0 && camera_.film_width == camera_.width && camera_.film_height == camera_.height;
+                        camera_.film_y0 == 0 && camera_.film_width == camera_.width && camera_.film_height == camera_.height &&
+                        view_.layered_mis_balance;
   if (defaults) return 0;
   Fnv1a f;
   f.add(&camera_.pixel_from_radiance, sizeof camera_.pixel_from_radiance);
@@ -476,6 +479,7 @@ uint64_t SceneData::film_fingerprint() const {
   f.add(&desc_.filter, sizeof desc_.filter);
   const int32_t crop[4] = {camera_.film_x0, camera_.film_y0, camera_.film_width, camera_.film_height};
   f.add(crop, sizeof crop);
+  if (!view_.layered_mis_balance) f.add("power-mis", 9);  // "path": the coated BSDFs' picture differs
   if (desc_.spectral) f.add("spectral", 8);  // only then: RGB checkpoints keep their fingerprints
   if (!positions_end_.empty() || camera_.moves) {  // motion blur: the shutter, the transforms' times, the camera's end
     f.add(&camera_.world_from_camera_linear_end, sizeof camera_.world_from_camera_linear_end);

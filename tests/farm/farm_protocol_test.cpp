@@ -165,6 +165,24 @@ TEST(FarmProtocol, SceneSurvivesTheWire) {
   EXPECT_EQ(a.desc().warnings, b.desc().warnings);
   Bytes garbage{1, 2, 3};
   EXPECT_THROW(decode_scene(garbage), std::runtime_error);
+  // A crop, shapes that receive a light's power whole, the integrator.
+  SceneDesc e = load_pbrt_string(
+      "Film \"rgb\" \"integer xresolution\" 40 \"integer yresolution\" 30 \"float cropwindow\" [ 0.3 0.75 0.1 0.55 ]\n"
+      "Integrator \"path\"\nWorldBegin\nAreaLightSource \"diffuse\" \"float power\" 10\nShape \"sphere\"\n"
+      "Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 0 ]\n",
+      "wire.pbrt", ".");
+  SceneDesc e_back = decode_scene(encode_scene(e));
+  for (size_t i = 0; i < e.meshes.size(); ++i) {
+    EXPECT_EQ(e.meshes[i].triangles_per_shape, e_back.meshes[i].triangles_per_shape);
+    EXPECT_EQ(e.meshes[i].shape_area, e_back.meshes[i].shape_area);
+  }
+  SceneData c(std::move(e)), d_back(std::move(e_back));
+  EXPECT_NE(c.film_fingerprint(), 0u);
+  EXPECT_EQ(c.film_fingerprint(), d_back.film_fingerprint());
+  EXPECT_EQ(c.fingerprint(), d_back.fingerprint());
+  EXPECT_EQ(d_back.view().camera.film_width, 18);
+  EXPECT_FALSE(d_back.view().layered_mis_balance);
+  EXPECT_EQ(c.view().lights[0].L, d_back.view().lights[0].L);
 }
 
 TEST(FarmProtocol, WorkerFailureReachesTheMaster) {
