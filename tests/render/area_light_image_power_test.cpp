@@ -54,15 +54,12 @@ TEST(AreaLightPower, EachShapeEmitsThePowerAsInPbrtV4) {
 
 class ImageAreaLight : public ::testing::Test {
  protected:
-  void SetUp() override {
-    path_ = (std::filesystem::temp_directory_path() / ("tessera_area_" + std::to_string(::getpid()) + ".exr")).string();
-  }
-  void TearDown() override { std::filesystem::remove(path_); }
   void write(int w, int h, const std::vector<float>& rgb) { write_exr(path_, ImageRgb{w, h, rgb}, nullptr, {}); }
   std::string light(const std::string& extra = "") const {
     return R"(AreaLightSource "diffuse" "string filename" [ ")" + path_ + "\" ] \"bool twosided\" true " + extra + "\n";
   }
-  std::string path_;
+  testing::TempFile file_{"area.exr"};
+  const std::string& path_ = file_.path();
 };
 
 TEST_F(ImageAreaLight, ShowsItsTexelsOverTheShapesUv) {
@@ -118,8 +115,8 @@ Shape "trianglemesh" "point3 P" [ -4 0 -4  4 0 -4  4 0 4  -4 0 4 ] "integer indi
 }
 
 TEST(AreaLightErrors, ImageAndLTogetherAndNonFiniteTexelsAreRefused) {
-  const std::string dir = std::filesystem::temp_directory_path().string();
-  const std::string nan_path = dir + "/tessera_area_nan_" + std::to_string(::getpid()) + ".exr";
+  const testing::TempFile nan_file("area_nan.exr");
+  const std::string& nan_path = nan_file.path();
   write_exr(nan_path, ImageRgb{1, 1, {NAN, 1.f, 1.f}}, nullptr, {});
   auto error = [](const std::string& world) {
     try {
@@ -138,7 +135,6 @@ TEST(AreaLightErrors, ImageAndLTogetherAndNonFiniteTexelsAreRefused) {
   // Environment maps too, as in pbrt-v4.
   EXPECT_NE(error("LightSource \"infinite\" \"string filename\" \"" + nan_path + "\"\n").find("NaN or infinite texels"),
             std::string::npos);
-  std::filesystem::remove(nan_path);
 }
 
 }  // namespace

@@ -32,10 +32,6 @@ Shape "trianglemesh" "point3 P" [ -10 0 -10  10 0 -10  10 0 10  -10 0 10 ] "inte
 
 class GoniometricLight : public ::testing::Test {
  protected:
-  void SetUp() override {
-    path_ = (std::filesystem::temp_directory_path() / ("tessera_gonio_" + std::to_string(::getpid()) + ".exr")).string();
-  }
-  void TearDown() override { std::filesystem::remove(path_); }
   // 32x32 texels: `inside` where the equal-area square maps to the upper
   // hemisphere (|u - 1/2| + |v - 1/2| < 1/2), `outside` elsewhere.
   void write(float inside, float outside) {
@@ -52,7 +48,8 @@ class GoniometricLight : public ::testing::Test {
     return "AttributeBegin\nTranslate 0 2 0\n" + extra + "LightSource \"goniometric\" \"rgb I\" [ 4 4 4 ] \"string filename\" \"" +
            path_ + "\"\nAttributeEnd\n";
   }
-  std::string path_;
+  testing::TempFile file_{"gonio.exr"};
+  const std::string& path_ = file_.path();
 };
 
 TEST_F(GoniometricLight, AUniformImageIsAPointLightOfItsValue) {

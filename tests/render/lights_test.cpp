@@ -91,10 +91,6 @@ AttributeEnd)";
 
 class EnvironmentLight : public ::testing::Test {
  protected:
-  void SetUp() override {
-    path_ = (std::filesystem::temp_directory_path() / ("tessera_env_" + std::to_string(::getpid()) + ".exr")).string();
-  }
-  void TearDown() override { std::filesystem::remove(path_); }
   // Writes a square equal-area environment map: top half `top`, bottom half `bottom`.
   void write_env(float top, float bottom) {
     ImageRgb img{32, 32, std::vector<float>(32 * 32 * 3)};
@@ -120,7 +116,8 @@ Material "diffuse" "rgb reflectance" [ 0.3 0.3 0.3 ]
 Shape "trianglemesh" "point3 P" [ -4 -1 -4  4 -1 -4  4 -1 4  -4 -1 4 ] "integer indices" [ 0 1 2 0 2 3 ]
 )";
   }
-  std::string path_;
+  testing::TempFile file_{"env.exr"};
+  const std::string& path_ = file_.path();
 };
 
 TEST_F(EnvironmentLight, ConstantImageMatchesConstantLight) {

@@ -1,7 +1,10 @@
 // Helpers for tests that render through the library (no subprocess).
 #pragma once
 
+#include <unistd.h>
+
 #include <cstring>
+#include <filesystem>
 #include <string>
 
 #include "master/film.h"
@@ -46,5 +49,20 @@ inline bool films_identical(const Film& a, const Film& b) {
 }
 
 inline std::string source_dir() { return TESSERA_SOURCE_DIR; }
+
+// A file name in the temporary folder, unique to this process and `tag`,
+// removed when the test ends (images the scenes of a test read).
+class TempFile {
+ public:
+  explicit TempFile(const std::string& tag)
+      : path_((std::filesystem::temp_directory_path() / ("tessera_" + tag + "_" + std::to_string(::getpid()))).string()) {}
+  ~TempFile() { std::filesystem::remove(path_); }
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
 
 }  // namespace tessera::testing
