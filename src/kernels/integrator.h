@@ -200,6 +200,25 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   // (eval_mis_pdf), and with which heuristic.
   Float prev_mis_pdf = 0.f;
   bool prev_mis_balance = false;
+  // A coated BSDF's estimate costs a short layered walk: it is taken only
+  // when the direction finds a light (mis_pdf_of_last_direction), from the
+  // vertex's BSDF, directions and guide mixture kept here.
+  struct PendingMisPdf {
+    BsdfParams bsdf;
+    Vec3 wo, wi;
+    Float guide_p = 0.f, guide_density = 0.f;
+    bool pending = false;
+  } prev_mis;
+  auto mis_pdf_of_last_direction = [&]() {
+    if constexpr ((Spec & kSpecNonDiffuse) != 0) {
+      if (prev_mis.pending) {
+        const Float mis_bsdf = bsdf_mis_pdf(prev_mis.bsdf, prev_mis.wo, prev_mis.wi);
+        prev_mis_pdf = prev_mis.guide_p * prev_mis.guide_density + (1.f - prev_mis.guide_p) * mis_bsdf;
+        prev_mis.pending = false;
+      }
+    }
+    return prev_mis_pdf;
+  };
   // How much guiding has scaled the path's weight against BSDF sampling:
   // the product over guided vertices of bsdf_pdf / mixture_pdf. Each factor
   // is 1 on average, but over hundreds of guided vertices their product is
@@ -309,6 +328,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             if (!(phase_pdf > 0.f)) break;
             prev_mis_pdf = phase_pdf;
             prev_mis_balance = false;
+            prev_mis.pending = false;
             prev_cell = -1;
             prev_p = p;
             prev_in_medium = true;
@@ -340,7 +360,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             L += beta * Le;
           } else {
             Float light_pdf = light_select_pmf(s, guide, prev_cell, li) * environment_pdf(s, li, ray.d);
-            L += beta * Le * mis_weight(prev_mis_pdf, light_pdf, prev_mis_balance);
+            L += beta * Le * mis_weight(mis_pdf_of_last_direction(), light_pdf, prev_mis_balance);
             if constexpr (kGuide) note_mis_emission(luminance(Le), light_pdf);
           }
         }
@@ -371,7 +391,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           } else {
             Float light_pdf = light_select_pmf(s, guide, prev_cell, static_cast<uint32_t>(info.light)) *
                               area_light_pdf_from(s, l, prev_p, h.p, cos_l, prev_in_medium);
-            L += beta * Le_hit * mis_weight(prev_mis_pdf, light_pdf, prev_mis_balance);
+            L += beta * Le_hit * mis_weight(mis_pdf_of_last_direction(), light_pdf, prev_mis_balance);
             if constexpr (kGuide) note_mis_emission(luminance(Le_hit), light_pdf);
           }
         }
@@ -581,10 +601,15 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     if (guided_vertex) guide_ratio *= bsdf_pdf / scatter_pdf;
     prev_mis_balance = mis_balance<Spec>(s, bsdf);
     prev_mis_pdf = scatter_pdf;
+    prev_mis.pending = false;
     if constexpr ((Spec & kSpecNonDiffuse) != 0) {
       if (bsdf_mis_estimated(bsdf) && !(bs.lobe & kLobeSpecular)) {  // a specular direction is not weighed
-        const Float mis_bsdf = bsdf_mis_pdf(bsdf, wo_l, bs.wi);
-        prev_mis_pdf = guided_vertex ? guide_p * guide_density + (1.f - guide_p) * mis_bsdf : mis_bsdf;
+        prev_mis.bsdf = bsdf;
+        prev_mis.wo = wo_l;
+        prev_mis.wi = bs.wi;
+        prev_mis.guide_p = guided_vertex ? guide_p : 0.f;
+        prev_mis.guide_density = guide_density;
+        prev_mis.pending = true;
       }
     }
     prev_cell = cell;
