@@ -129,7 +129,6 @@ struct PixelBounds {
   int32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   int32_t width() const { return x1 - x0; }
   int32_t height() const { return y1 - y0; }
-  bool full(const FilmDesc& f) const { return x0 == 0 && y0 == 0 && x1 == f.xres && y1 == f.yres; }
 };
 
 enum class FilterType : uint32_t { Gaussian = 0, Box, Triangle, Mitchell, LanczosSinc };
