@@ -18,6 +18,9 @@ enum TriangleFlags : uint32_t {
   // The second triangle (p00, p11, p01) of a quad (bilinear patch, PLY
   // quad) without uv: pbrt-v4's patch uv there is (0,0),(1,1),(0,1).
   kTriQuadSecondHalf = 1u << 3,
+  // A face of a curve's tube: rays meeting it from inside (along the outward
+  // face normal) pass through (MeshDesc::invisible_from_inside).
+  kTriInvisibleFromInside = 1u << 4,
 };
 
 struct TriangleInfo {
@@ -87,6 +90,9 @@ struct SceneView {
   uint32_t num_triangles = 0;
   // Per triangle, its alpha (pbrt-v4 cutouts); null when no shape has one.
   const TextureSlot* triangle_alpha = nullptr;
+  // Some triangle is kTriInvisibleFromInside: ray queries must filter hits
+  // (hit_ignored in alpha.h), as for triangle_alpha.
+  bool has_one_way_faces = false;
 
   const Material* materials = nullptr;
   uint32_t num_materials = 0;

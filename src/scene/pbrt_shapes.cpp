@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "scene/curve_tessellation.h"
 #include "scene/pbrt_paths.h"
 #include "scene/loop_subdivision.h"
 #include "scene/ply_mesh.h"
@@ -242,6 +243,43 @@ MeshDesc disk_mesh(const ParamSet& params, const ShapeContext& ctx) {
   return m;
 }
 
+// pbrt-v4's "curve": P, basis, degree, type, N, width/width0/width1,
+// splitdepth; tessellated (curve_tessellation.h).
+MeshDesc curve_mesh(const ParamSet& params, const ShapeContext& ctx) {
+  const std::vector<Vec3> p = params.get_point3s("P");
+  if (p.empty()) fail(ctx, "curve needs \"point3 P\"");
+  params.release("P");
+  const std::string type_name = params.get_string("type", "flat");
+  CurveType type = CurveType::Flat;
+  if (type_name == "cylinder")
+    type = CurveType::Cylinder;
+  else if (type_name == "ribbon")
+    type = CurveType::Ribbon;
+  else if (type_name != "flat")
+    fail(ctx, "curve \"type\" \"" + type_name + "\" is unknown (flat, cylinder, ribbon)");
+  std::vector<Vec3> normals = params.get_normals("N");
+  if (!normals.empty() && type != CurveType::Ribbon) {
+    warn(ctx, "curve normals \"N\" are only used by \"ribbon\" curves; ignored");
+    normals.clear();
+  }
+  const Float width = params.get_float("width", 1.f);
+  CurveSegments c;
+  try {
+    c = curve_segments(p, params.get_string("basis", "bezier"), params.get_int("degree", 3), type, normals);
+  } catch (const SceneError& e) {
+    fail(ctx, e.what());
+  }
+  c.width0 = params.get_float("width0", width);
+  c.width1 = params.get_float("width1", width);
+  if (!(c.width0 >= 0.f) || !(c.width1 >= 0.f) || !std::isfinite(c.width0) || !std::isfinite(c.width1))
+    fail(ctx, "curve widths must be finite and not negative");
+  c.split_depth = params.get_int("splitdepth", 3);
+  if (type == CurveType::Flat)
+    warn(ctx, "\"flat\" curves are rendered as round tubes: the same silhouette, and for hair the same "
+              "offsets across the fibre; other materials shade as on a cylinder");
+  return tessellate_curve(c);
+}
+
 Mat3 normal_matrix(const Mat4& m) { return glm::transpose(glm::inverse(Mat3(m))); }
 
 void check_finite(const MeshDesc& m, const ShapeContext& ctx) {
@@ -309,6 +347,8 @@ std::optional<MeshDesc> make_shape_mesh(const std::string& type, const ParamSet&
   } else if (type == "cylinder") {
     m = cylinder_mesh(params, ctx);
     quadric = true;
+  } else if (type == "curve") {
+    m = curve_mesh(params, ctx);
   } else {
     warn(ctx, "unsupported shape \"" + type + "\"; skipped");
     return std::nullopt;
@@ -316,7 +356,10 @@ std::optional<MeshDesc> make_shape_mesh(const std::string& type, const ParamSet&
   m.where = ctx.where;
   transform_mesh(m, ctx.world_from_object);  // flip_normals = swaps handedness
   const bool swaps = m.flip_normals;
-  if (!quadric) {
+  if (m.invisible_from_inside) {
+    // A tube's faces stay outward whatever the orientation: its inside is never seen.
+    m.flip_normals = swaps;
+  } else if (!quadric) {
     // Triangles: pbrt-v4 flips the world-space cross product.
     m.flip_normals = ctx.reverse_orientation != swaps;
   } else {

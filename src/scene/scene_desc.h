@@ -48,6 +48,9 @@ struct MeshDesc {
   // A PLY of triangles and quads (pbrt-v4: a triangle mesh and bilinear
   // patches); loading only.
   bool mixed_faces = false;
+  // A closed surface seen only from outside (curve tubes): hits from inside,
+  // against the outward geometric normal, are ignored.
+  bool invisible_from_inside = false;
   std::string where;            // "file:line" of the Shape directive, for messages
 };
 

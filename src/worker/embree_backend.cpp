@@ -16,9 +16,10 @@ void embree_error(void* user, RTCError code, const char* message) {
   if (code != RTC_ERROR_NONE && first->empty()) *first = message ? message : "unknown error";
 }
 
-// Closest-hit and shadow rays alike: candidate hits on cut-out surfaces are
-// rejected here, so Embree continues to the next candidate.
-void alpha_filter(const RTCFilterFunctionNArguments* args) {
+// Closest-hit and shadow rays alike: candidate hits on cut-out surfaces and
+// on one-way faces from behind are rejected here, so Embree continues to the
+// next candidate.
+void hit_filter(const RTCFilterFunctionNArguments* args) {
   const auto* view = static_cast<const SceneView*>(args->geometryUserPtr);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
@@ -26,7 +27,7 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
                  RTCRayN_org_z(args->ray, args->N, i));
     const Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
                  RTCRayN_dir_z(args->ray, args->N, i));
-    if (alpha_ignores_hit(*view, RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i),
+    if (hit_ignored(*view, RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i),
                           RTCHitN_v(args->hit, args->N, i), o, d, RTCRayN_time(args->ray, args->N, i)))
       args->valid[i] = 0;
   }
@@ -83,10 +84,11 @@ void EmbreeScene::build(const SceneData& data) {
       }
       std::memcpy(v1, end, nv * 3 * sizeof(float));
     }
-    if (data.view().triangle_alpha) {  // only scenes with cutouts pay for the filter
+    // Only scenes with cutouts or curve tubes pay for the filter.
+    if (data.view().triangle_alpha || data.view().has_one_way_faces) {
       rtcSetGeometryUserData(geom, const_cast<SceneView*>(&data.view()));
-      rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
-      rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
+      rtcSetGeometryIntersectFilterFunction(geom, hit_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, hit_filter);
     }
     rtcCommitGeometry(geom);
     rtcAttachGeometry(scene_, geom);

@@ -90,7 +90,10 @@ SceneData::SceneData(SceneDesc desc) : desc_(std::move(desc)) {
 
 void SceneData::flatten_meshes() {
   // Per-triangle alpha only for scenes with cutouts.
-  for (const MeshDesc& m : desc_.meshes) has_alpha_ |= m.alpha.texture >= 0 || m.alpha.value.x < 1.f;
+  for (const MeshDesc& m : desc_.meshes) {
+    has_alpha_ |= m.alpha.texture >= 0 || m.alpha.value.x < 1.f;
+    has_one_way_faces_ |= m.invisible_from_inside;
+  }
   // Per-triangle media only for scenes that have any (the camera's included).
   has_media_ = (effects_ & kEffectMedia) != 0;
   bool moves = false, any_normals = false, any_uv = false;
@@ -150,7 +153,8 @@ void SceneData::flatten_meshes() {
     }
     TriangleInfo info;
     info.material = m.material;
-    info.flags = (m.flip_normals ? kTriFlipNormal : 0u) | (has_n ? kTriHasNormals : 0u) | (has_uv ? kTriHasUv : 0u);
+    info.flags = (m.flip_normals ? kTriFlipNormal : 0u) | (has_n ? kTriHasNormals : 0u) | (has_uv ? kTriHasUv : 0u) |
+                 (m.invisible_from_inside ? kTriInvisibleFromInside : 0u);
     for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
       const Vec3 &a = m.p[m.indices[t]], &b = m.p[m.indices[t + 1]], &c = m.p[m.indices[t + 2]];
       // Degenerate triangles can never be hit or sampled; dropping them keeps
@@ -356,6 +360,7 @@ void SceneData::build_view() {
   v.face_normals = face_normals_.data();
   v.num_triangles = static_cast<uint32_t>(triangles_.size());
   v.triangle_alpha = has_alpha_ ? triangle_alpha_.data() : nullptr;
+  v.has_one_way_faces = has_one_way_faces_;
   v.materials = desc_.materials.data();
   v.num_materials = static_cast<uint32_t>(desc_.materials.size());
   v.textures = desc_.textures.data();

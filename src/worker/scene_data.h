@@ -70,6 +70,7 @@ class SceneData {
   std::vector<Distribution2DView> env_views_;
   std::vector<TextureSlot> triangle_alpha_;  // per triangle
   bool has_alpha_ = false;                   // any triangle not opaque
+  bool has_one_way_faces_ = false;           // any triangle kTriInvisibleFromInside
   std::vector<MediumInterface> triangle_media_;  // per triangle, only for scenes with media
   std::vector<GridMediumView> grid_views_;
   std::vector<Float> blackbody_rgb_table_;     // for grids that glow by temperature (RGB transport)
