@@ -9,7 +9,7 @@
 namespace tessera {
 
 enum class BsdfType : uint32_t {
-  Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, DiffuseTransmission, CoatedConductor, ThinDielectric
+  Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, DiffuseTransmission, CoatedConductor, ThinDielectric, Hair
 };
 
 // Lobe flags, combinable.
@@ -44,6 +44,11 @@ struct BsdfParams {
   // extinction with this single-scattering albedo and Henyey-Greenstein g.
   Rgb layer_albedo{0.f};
   Float layer_g = 0.f;
+  // Hair (hair.h; its index is ior): absorption per unit fibre radius,
+  // longitudinal and azimuthal roughness, the scales' tilt in degrees. Its
+  // frame has x along the fibre and z the tube's round normal.
+  Rgb hair_sigma_a{0.f};
+  Float hair_beta_m = 0.3f, hair_beta_n = 0.3f, hair_alpha = 2.f;
 };
 
 // pbrt-v4 treats microfacet distributions with alpha below this as specular.

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "fresnel.h"
+#include "hair.h"
 #include "medium.h"
 #include "microfacet.h"
 #include "rng.h"
@@ -375,6 +376,25 @@ TESSERA_HOST_DEVICE inline bool coated_sample(const BsdfParams& b, const Vec3& w
 
 #include "coated_conductor.h"
 
+TESSERA_HOST_DEVICE inline HairFiber hair_fiber(const BsdfParams& b) {
+  HairFiber h;
+  h.sigma_a = b.hair_sigma_a;
+  h.eta = b.ior;
+  h.beta_m = b.hair_beta_m;
+  h.beta_n = b.hair_beta_n;
+  h.alpha = b.hair_alpha;
+  return h;
+}
+
+// A hair BSDF's sample: glossy, reflection or transmission by the side of
+// the round normal wi leaves on; nothing refracts into a medium (eta 1).
+TESSERA_HOST_DEVICE inline bool hair_sample(const BsdfParams& b, const Vec3& wo, Float uc, Vec2 u, BsdfSample* s) {
+  if (!tessera::hair_sample(hair_fiber(b), wo, uc, u, &s->wi, &s->f, &s->pdf)) return false;
+  s->lobe = kLobeGlossy | (s->wi.z * wo.z > 0.f ? kLobeReflection : kLobeTransmission);
+  s->eta = 1.f;
+  return true;
+}
+
 }  // namespace bsdf_detail
 
 TESSERA_HOST_DEVICE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
@@ -387,6 +407,7 @@ TESSERA_HOST_DEVICE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, co
     case BsdfType::CoatedConductor: return bsdf_detail::coated_conductor_f(b, wo, wi);
     case BsdfType::ThinDielectric: return Rgb(0.f);  // deltas only
     case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_f(b, wo, wi);
+    case BsdfType::Hair: return hair_f(bsdf_detail::hair_fiber(b), wo, wi);
   }
   return Rgb(0.f);
 }
@@ -413,6 +434,7 @@ TESSERA_HOST_DEVICE inline Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, c
     case BsdfType::CoatedConductor: return bsdf_detail::coated_conductor_pdf(b, wo, wi);
     case BsdfType::ThinDielectric: return 0.f;
     case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_pdf(b, wo, wi);
+    case BsdfType::Hair: return hair_pdf(bsdf_detail::hair_fiber(b), wo, wi);
   }
   return 0.f;
 }
@@ -451,12 +473,21 @@ TESSERA_HOST_DEVICE inline bool bsdf_sample(const BsdfParams& b, const Vec3& wo,
     case BsdfType::CoatedConductor: ok = bsdf_detail::coated_conductor_sample(b, wo, uc, u, &s); break;
     case BsdfType::ThinDielectric: ok = bsdf_detail::thin_dielectric_sample(b, wo, uc, &s); break;
     case BsdfType::DiffuseTransmission: ok = bsdf_detail::diffuse_transmission_sample(b, wo, uc, u, &s); break;
+    case BsdfType::Hair: ok = bsdf_detail::hair_sample(b, wo, uc, u, &s); break;
   }
   // pbrt-v4 BSDF::Sample_f: reject black f, zero pdf and wi in the tangent plane.
   if (!ok || s.wi.z == 0.f || !is_finite(s.wi) || !is_finite(s.f) || is_black(s.f)) return false;
   if (!(s.pdf > 0.f) || !bsdf_detail::finite_f(s.pdf) || !bsdf_detail::finite_f(s.eta) || !(s.eta > 0.f)) return false;
   *out = s;
   return true;
+}
+
+// Whether a sampled direction on the wrong side of the flat face for its
+// lobe is mirrored back (surface.h, keep_on_lobe_side): every lobe but the
+// deltas and hair's, whose sides are those of the round fibre, not of the
+// tube's faces (its transmission leaves through the one-way far wall).
+TESSERA_HOST_DEVICE inline bool keeps_lobe_side(const BsdfParams& b, uint32_t lobe) {
+  return !(lobe & kLobeSpecular) && b.type != BsdfType::Hair;
 }
 
 TESSERA_HOST_DEVICE inline uint32_t bsdf_lobes(const BsdfParams& b) {
@@ -479,6 +510,7 @@ TESSERA_HOST_DEVICE inline uint32_t bsdf_lobes(const BsdfParams& b) {
       return kLobeReflection | kLobeDiffuse |
              (bsdf_detail::distrib(b).effectively_smooth() ? kLobeSpecular : kLobeGlossy);
     case BsdfType::ThinDielectric: return kLobeReflection | kLobeTransmission | kLobeSpecular;
+    case BsdfType::Hair: return kLobeReflection | kLobeTransmission | kLobeGlossy;
     case BsdfType::CoatedConductor: {
       const bool coat_smooth = bsdf_detail::distrib(b).effectively_smooth();
       if (coat_smooth && bsdf_detail::coated_conductor::base_smooth(b)) return kLobeReflection | kLobeSpecular;

@@ -125,8 +125,10 @@ TESSERA_HOST_DEVICE inline Frame shading_frame(const SceneView& s, const BsdfPar
     if (bsdf.bump >= 0) h.ns = bumped_shading_normal(s, bsdf.bump, h);
     else if (bsdf.normal_map >= 0) h.ns = normal_mapped_shading_normal(s, bsdf.normal_map, h);
   }
-  return (Spec & kSpecNonDiffuse) && bsdf.alpha_x != bsdf.alpha_y ? Frame::from_tangent(h.ns, surface_dpdu(s, h.triangle))
-                                                                  : Frame::from_z(h.ns);
+  // Hair: x along the fibre (a curve's u).
+  return (Spec & kSpecNonDiffuse) && (bsdf.alpha_x != bsdf.alpha_y || bsdf.type == BsdfType::Hair)
+             ? Frame::from_tangent(h.ns, surface_dpdu(s, h.triangle))
+             : Frame::from_z(h.ns);
 }
 
 template <uint32_t Spec>
@@ -617,7 +619,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     if (depth == 1) first_vertex_connectable = settings.light_traced_caustics && !specular_bounce;
     last_vertex_delta_only = !lobes_have_non_specular(lobes);
     if (bs.lobe & kLobeTransmission) eta_scale *= sqr(bs.eta);
-    if (!(bs.lobe & kLobeSpecular)) wi = keep_on_lobe_side(wi, wo, h.ng, (bs.lobe & kLobeTransmission) != 0);
+    if (keeps_lobe_side(bsdf, bs.lobe)) wi = keep_on_lobe_side(wi, wo, h.ng, (bs.lobe & kLobeTransmission) != 0);
     ray.o = offset_ray_origin(h, wi);
     ray.d = wi;
     prev_p = h.p;

@@ -336,7 +336,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
     beta *= bs.f * w;
     if (is_black(beta) || !is_finite(beta)) return;
     // The weight above is the sampled direction's; only the ray is kept on its lobe's side (as trace_path).
-    if (!(bs.lobe & kLobeSpecular)) wi = keep_on_lobe_side(wi, wo, h.ng, (bs.lobe & kLobeTransmission) != 0);
+    if (keeps_lobe_side(bsdf, bs.lobe)) wi = keep_on_lobe_side(wi, wo, h.ng, (bs.lobe & kLobeTransmission) != 0);
     if constexpr (kMedia) medium = medium_after(s, hit.triangle, h.ng, wi, medium);
     ray.o = offset_ray_origin(h, wi);
     ray.d = wi;

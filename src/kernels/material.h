@@ -59,8 +59,13 @@ struct ImageView {
 };
 
 enum class MaterialType : uint32_t {
-  Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, Interface, Mix, DiffuseTransmission, CoatedConductor, ThinDielectric
+  Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, Interface, Mix, DiffuseTransmission, CoatedConductor, ThinDielectric,
+  Hair
 };
+
+// Where a hair material's absorption comes from (pbrt-v4 HairMaterial, in
+// this order of precedence): "sigma_a", "reflectance", the melanins.
+enum class HairAbsorption : uint32_t { SigmaA = 0, Reflectance, Melanin };
 
 struct Material {
   MaterialType type = MaterialType::Diffuse;
@@ -94,6 +99,13 @@ struct Material {
   TextureSlot layer_albedo{-1, Rgb(0.f)};    // its scattering medium: albedo (black: clear) and
   TextureSlot layer_g{-1, Rgb(0.f)};         // Henyey-Greenstein g
   uint32_t layer_max_depth = 10, layer_samples = 1;
+  // hair: the fibre's absorption (sigma_a, or reflectance above, or
+  // eumelanin/pheomelanin concentrations), its longitudinal and azimuthal
+  // roughness and its scales' tilt in degrees; its index is ior (1.55).
+  HairAbsorption hair_absorption = HairAbsorption::Melanin;
+  TextureSlot hair_sigma_a{-1, Rgb(0.f)};
+  TextureSlot eumelanin{-1, Rgb(1.3f)}, pheomelanin{-1, Rgb(0.f)};
+  TextureSlot beta_m{-1, Rgb(0.3f)}, beta_n{-1, Rgb(0.3f)}, hair_alpha{-1, Rgb(2.f)};
   int32_t mix[2] = {-1, -1};                 // Mix: material indices
   TextureSlot amount{ -1, Rgb(0.5f) };      // Mix: probability of choosing mix[1] (value.x)
 };

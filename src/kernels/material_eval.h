@@ -66,6 +66,39 @@ TESSERA_HOST_DEVICE inline void layer_medium(const SceneView& s, const Material&
   b->layer_g = g >= -kMaxG && g <= kMaxG ? g : (g > kMaxG ? kMaxG : (g < -kMaxG ? -kMaxG : 0.f));
 }
 
+// pbrt-v4's HairMaterial at a hit: roughness clamped to [0, 1] (hair.h
+// keeps it above 0.01), absorption from sigma_a, the colour (refl) or the
+// melanins, each read per wavelength in spectral transport.
+template <uint32_t Spec>
+TESSERA_HOST_DEVICE inline void hair_params(const SceneView& s, const Material& m, const SurfaceHit& h, const Rgb& refl,
+                                            const Wavelengths* wl, BsdfParams* b) {
+  auto value = [&](const TextureSlot& slot) {
+    return (Spec & kSpecTextures) ? eval_slot(s, slot, texture_point(h)).x : slot.value.x;
+  };
+  b->type = BsdfType::Hair;
+  b->hair_beta_m = glm::clamp(value(m.beta_m), 0.f, 1.f);
+  b->hair_beta_n = glm::clamp(value(m.beta_n), 0.f, 1.f);
+  b->hair_alpha = value(m.hair_alpha);
+  switch (m.hair_absorption) {
+    case HairAbsorption::SigmaA: {
+      const Rgb sigma = (Spec & kSpecTextures) ? eval_slot(s, m.hair_sigma_a, texture_point(h)) : m.hair_sigma_a.value;
+      b->hair_sigma_a = glm::max(spectral_unbounded(s.spectral, wl, sigma), Rgb(0.f));
+      break;
+    }
+    case HairAbsorption::Reflectance:
+      b->hair_sigma_a = hair_sigma_a_from_reflectance(
+          glm::clamp(spectral_albedo(s.spectral, wl, refl), Rgb(0.f), Rgb(1.f)), b->hair_beta_n);
+      break;
+    case HairAbsorption::Melanin:
+      b->hair_sigma_a = glm::max(
+          spectral_unbounded(s.spectral, wl,
+                             hair_sigma_a_from_concentration(glm::max(value(m.eumelanin), 0.f),
+                                                             glm::max(value(m.pheomelanin), 0.f))),
+          Rgb(0.f));
+      break;
+  }
+}
+
 template <uint32_t Spec>
 TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t material, const SurfaceHit& h, const Vec3& wo,
                                              BsdfParams* out, Wavelengths* wl = nullptr) {
@@ -143,6 +176,9 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
       b.thickness = m->thickness;
       b.layer_max_depth = m->layer_max_depth;
       b.layer_samples = m->layer_samples;
+      break;
+    case MaterialType::Hair:
+      hair_params<Spec>(s, *m, h, refl, wl, &b);
       break;
     default:
       b.type = BsdfType::Diffuse;

@@ -122,6 +122,34 @@ void read_layer(Material& m, const ParamSet& params, const DirectiveContext& ctx
   m.layer_g = float_slot(params, "g", 0.f, ctx);
 }
 
+// pbrt-v4's HairMaterial: absorption from "sigma_a", else "reflectance"
+// (pbrt-v3's "color" too), else the melanins (eumelanin 1.3 when none is given).
+void read_hair(Material& m, const ParamSet& params, const DirectiveContext& ctx) {
+  m.type = MaterialType::Hair;
+  const char* colour = params.find_any("reflectance") ? "reflectance" : "color";
+  const bool sigma_a = params.find_any("sigma_a") != nullptr, reflectance = params.find_any(colour) != nullptr;
+  const bool melanin = params.find_any("eumelanin") || params.find_any("pheomelanin");
+  if (sigma_a) {
+    m.hair_absorption = HairAbsorption::SigmaA;
+    m.hair_sigma_a = spectrum_slot(params, "sigma_a", Rgb(0.f), ctx);
+    if (reflectance) ctx.warn(std::string("hair \"") + colour + "\" is ignored: \"sigma_a\" is given");
+    if (melanin) ctx.warn("hair melanin concentrations are ignored: \"sigma_a\" is given");
+  } else if (reflectance) {
+    m.hair_absorption = HairAbsorption::Reflectance;
+    m.reflectance = spectrum_slot(params, colour, Rgb(0.5f), ctx);
+    if (melanin) ctx.warn(std::string("hair melanin concentrations are ignored: \"") + colour + "\" is given");
+  } else {
+    m.hair_absorption = HairAbsorption::Melanin;
+    // pbrt-v4: eumelanin 1.3 only when no absorption is given at all.
+    m.eumelanin = float_slot(params, "eumelanin", melanin ? 0.f : 1.3f, ctx);
+    m.pheomelanin = float_slot(params, "pheomelanin", 0.f, ctx);
+  }
+  m.ior = read_ior(params, "eta", 1.55f, ctx);
+  m.beta_m = float_slot(params, "beta_m", 0.3f, ctx);
+  m.beta_n = float_slot(params, "beta_n", 0.3f, ctx);
+  m.hair_alpha = float_slot(params, "alpha", 2.f, ctx);
+}
+
 }  // namespace
 
 Float roughness_to_alpha(Float roughness) { return std::sqrt(std::max(roughness, 0.f)); }
@@ -199,6 +227,8 @@ Material make_material(const std::string& type, const ParamSet& params, const Di
     m.ior = read_ior(params, "eta", 1.33f, ctx);
     read_roughness(m, params, ctx);
     params.mark_all_used();
+  } else if (type == "hair") {
+    read_hair(m, params, ctx);
   } else if (type == "diffusetransmission") {
     m.type = MaterialType::DiffuseTransmission;
     m.reflectance = spectrum_slot(params, "reflectance", Rgb(0.25f), ctx);

@@ -44,6 +44,12 @@ void add_material_effects(const SceneDesc& scene, int32_t index, uint32_t& e, in
       e |= kEffectDiffuse | (smooth ? kEffectSpecular : kEffectGlossy);
       if (slot_textured(m.reflectance)) e |= kEffectTextures;
       break;
+    case MaterialType::Hair:
+      e |= kEffectGlossy | kEffectTransmission;
+      for (const TextureSlot* t : {&m.hair_sigma_a, &m.reflectance, &m.eumelanin, &m.pheomelanin, &m.beta_m, &m.beta_n,
+                                   &m.hair_alpha})
+        if (slot_textured(*t)) e |= kEffectTextures;
+      break;
     case MaterialType::Interface:
       e |= kEffectInterface;
       break;

@@ -218,6 +218,13 @@ int main() {
   b.type = BsdfType::CoatedConductor;
   b.base_alpha_x = b.base_alpha_y = 0.3f;
   pass &= check_bsdf("coatedcond", b);
+  b = BsdfParams();
+  b.type = BsdfType::Hair;
+  b.ior = 1.55f;
+  b.hair_sigma_a = Rgb(0.54f, 0.9f, 1.8f);  // eumelanin 1.3
+  b.hair_beta_m = 0.25f;
+  b.hair_beta_n = 0.4f;
+  pass &= check_bsdf("hair", b);
   std::printf("%s\n", pass ? "all kernels agree with the host" : "FAILED");
   return pass ? 0 : 1;
 }

@@ -8,6 +8,7 @@
 #include "scene/displacement.h"
 #include "scene/image_io.h"
 #include "scene/pbrt_materials.h"
+#include "scene/scene_effects.h"
 #include "scene_test_helpers.h"
 
 namespace tessera {
@@ -267,6 +268,44 @@ TEST(PbrtTextures, ExrImageLoadsLinear) {
   EXPECT_FLOAT_EQ(img.texels[3].x, 0.75f);
   EXPECT_FLOAT_EQ(img.texels[1].y, 2.f);  // no clamping, no decoding
   EXPECT_THROW(load_image(dir.file("missing.exr")), SceneError);
+}
+
+// pbrt-v4's HairMaterial: absorption from sigma_a, else reflectance (or
+// pbrt-v3's color), else melanin (eumelanin 1.3 when nothing is given);
+// the ignored ones are named in warnings.
+TEST(PbrtMaterials, HairAbsorptionPrecedenceAndDefaults) {
+  SceneDesc s = load_world(std::string("Material \"hair\"\n") + kTriangle);
+  const Material& plain = material_of_last_mesh(s);
+  EXPECT_EQ(plain.type, MaterialType::Hair);
+  EXPECT_EQ(plain.hair_absorption, HairAbsorption::Melanin);
+  EXPECT_FLOAT_EQ(plain.eumelanin.value.x, 1.3f);
+  EXPECT_FLOAT_EQ(plain.ior, 1.55f);
+  EXPECT_FLOAT_EQ(plain.beta_m.value.x, 0.3f);
+  EXPECT_FLOAT_EQ(plain.hair_alpha.value.x, 2.f);
+  EXPECT_NE(compute_effects(s) & kEffectGlossy, 0u);
+
+  s = load_world(std::string("Material \"hair\" \"float pheomelanin\" 0.5\n") + kTriangle);
+  EXPECT_FLOAT_EQ(material_of_last_mesh(s).eumelanin.value.x, 0.f);  // a melanin given: no default eumelanin
+  EXPECT_FLOAT_EQ(material_of_last_mesh(s).pheomelanin.value.x, 0.5f);
+
+  s = load_world(std::string("Material \"hair\" \"rgb color\" [ 0.3 0.2 0.1 ] \"float eumelanin\" 2\n") + kTriangle);
+  EXPECT_EQ(material_of_last_mesh(s).hair_absorption, HairAbsorption::Reflectance);
+  EXPECT_VEC3_NEAR(material_of_last_mesh(s).reflectance.value, Vec3(0.3f, 0.2f, 0.1f), 1e-6f);
+  ASSERT_FALSE(s.warnings.empty());
+  EXPECT_NE(s.warnings[0].find("melanin concentrations are ignored"), std::string::npos);
+
+  s = load_world(std::string("Material \"hair\" \"rgb sigma_a\" [ 0.1 0.2 0.3 ] \"rgb reflectance\" [ 0.5 0.5 0.5 ] "
+                             "\"float eta\" 1.4 \"float beta_m\" 0.2 \"float beta_n\" 0.6 \"float alpha\" 3\n") +
+                 kTriangle);
+  const Material& m = material_of_last_mesh(s);
+  EXPECT_EQ(m.hair_absorption, HairAbsorption::SigmaA);
+  EXPECT_VEC3_NEAR(m.hair_sigma_a.value, Vec3(0.1f, 0.2f, 0.3f), 1e-6f);
+  EXPECT_FLOAT_EQ(m.ior, 1.4f);
+  EXPECT_FLOAT_EQ(m.beta_m.value.x, 0.2f);
+  EXPECT_FLOAT_EQ(m.beta_n.value.x, 0.6f);
+  EXPECT_FLOAT_EQ(m.hair_alpha.value.x, 3.f);
+  ASSERT_FALSE(s.warnings.empty());
+  EXPECT_NE(s.warnings[0].find("\"reflectance\" is ignored"), std::string::npos);
 }
 
 }  // namespace
