@@ -1,7 +1,11 @@
-// pbrt-v4 perspective camera: raster (0,0) is the top-left corner, the fov
-// spans the shorter image axis, camera space is x right, y up, z forward.
+// pbrt-v4's perspective, orthographic and spherical cameras: raster (0,0)
+// is the top-left corner, camera space is x right, y up, z forward. The
+// perspective fov spans the screen window's shorter axis; the orthographic
+// screen window is in camera-space units; the spherical camera maps the
+// whole image to the sphere (equal-area square or equirectangular).
 #pragma once
 
+#include "equal_area.h"
 #include "sampler.h"
 #include "sampling.h"
 #include "scene_view.h"
@@ -18,11 +22,33 @@ struct Ray {
 // pinhole ray meets).
 // time: Ray::time; a moving camera (motion blur) is interpolated linearly
 // between its start and end placements.
+// pbrt-v4's SphericalCamera: the image's uv to a camera-space direction,
+// equal-area (Clarberg's octahedral square) or equirectangular (theta =
+// pi v, phi = 2 pi u), with y and z swapped so that the image's centre row
+// is the horizon around camera-space y (up).
+TESSERA_HOST_DEVICE inline Vec3 spherical_camera_direction(CameraProjection p, Vec2 uv) {
+  Vec3 d;
+  if (p == CameraProjection::SphericalEqualArea) {
+    d = equal_area_square_to_sphere(glm::clamp(uv, Vec2(0.f), Vec2(1.f)));
+  } else {
+    const Float theta = kPi * uv.y, phi = 2.f * kPi * uv.x;
+    d = Vec3(glm::sin(theta) * glm::cos(phi), glm::sin(theta) * glm::sin(phi), glm::cos(theta));
+  }
+  return Vec3(d.x, d.z, d.y);
+}
+
 TESSERA_HOST_DEVICE inline Ray generate_camera_ray(const CameraView& c, Vec2 p_film, Vec2 u_lens = Vec2(0.f),
                                                    Float time = 0.f) {
   Float sx = c.screen_min.x + (p_film.x / c.width) * (c.screen_max.x - c.screen_min.x);
   Float sy = c.screen_max.y - (p_film.y / c.height) * (c.screen_max.y - c.screen_min.y);
   Vec3 d_cam(sx * c.tan_half_fov, sy * c.tan_half_fov, 1.f);
+  Vec3 o_cam(0.f);
+  if (c.projection == CameraProjection::Orthographic) {
+    o_cam = Vec3(sx, sy, 0.f);
+    d_cam = Vec3(0.f, 0.f, 1.f);
+  } else if (c.projection != CameraProjection::Perspective) {
+    d_cam = spherical_camera_direction(c.projection, Vec2(p_film.x / c.width, p_film.y / c.height));
+  }
   Mat3 world_from_camera_linear = c.world_from_camera_linear;
   Vec3 origin = c.origin;
   if (c.moves && time > 0.f) {
@@ -31,8 +57,15 @@ TESSERA_HOST_DEVICE inline Ray generate_camera_ray(const CameraView& c, Vec2 p_f
   }
   Ray r;
   r.time = time;
-  r.o = origin;
-  if (c.lens_radius > 0.f) {
+  r.o = origin + world_from_camera_linear * o_cam;
+  if (c.lens_radius > 0.f && c.projection == CameraProjection::Orthographic) {
+    // pbrt-v4's orthographic thin lens: from the lens point beside the
+    // pinhole ray's origin through its point on the focal plane.
+    const Vec2 lens = c.lens_radius * sample_uniform_disk_concentric(u_lens);
+    const Vec3 o_lens(o_cam.x + lens.x, o_cam.y + lens.y, 0.f);
+    d_cam = o_cam + Vec3(0.f, 0.f, c.focal_distance) - o_lens;
+    r.o = origin + world_from_camera_linear * o_lens;
+  } else if (c.lens_radius > 0.f && c.projection == CameraProjection::Perspective) {
     d_cam = glm::normalize(d_cam);
     const Vec2 lens = c.lens_radius * sample_uniform_disk_concentric(u_lens);
     const Vec3 focus = d_cam * (c.focal_distance / d_cam.z);

@@ -2,6 +2,7 @@
 // (CPU or GPU) whose memory they point into. Built by src/worker/scene_data.h.
 #pragma once
 
+#include "camera_projection.h"
 #include "distribution.h"
 #include "light.h"
 #include "material.h"
@@ -30,6 +31,7 @@ struct TriangleInfo {
 };
 
 struct CameraView {
+  CameraProjection projection = CameraProjection::Perspective;
   Mat3 world_from_camera_linear{1.f};  // upper 3x3 of world_from_camera (may include scale/flip)
   Vec3 origin{0.f};                    // camera position in world space
   Vec2 screen_min{-1.f}, screen_max{1.f};  // screen window, pbrt-v4 convention

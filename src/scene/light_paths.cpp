@@ -18,6 +18,7 @@ bool bidirectional_integrator(const std::string& type) {
 bool wants_bidirectional(const SceneDesc& desc) { return bidirectional_integrator(desc.integrator); }
 
 std::string light_paths_obstacle(const SceneDesc& desc) {
+  if (desc.camera.projection != CameraProjection::Perspective) return "the camera is not a perspective camera";
   if (desc.camera.lens_radius > 0.f) return "the camera has a lens (depth of field)";
   if (desc.camera.world_from_camera_end != desc.camera.world_from_camera) return "the camera moves";
   for (const MeshDesc& m : desc.meshes)

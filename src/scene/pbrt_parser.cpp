@@ -503,7 +503,34 @@ void PbrtParser::check_coordinates(const MeshDesc& mesh, const Token& at) const 
 
 void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet& params) {
   std::vector<std::string>& warnings = scene_.warnings;
-  if (type != "perspective") warnings.push_back(at.where() + ": camera \"" + type + "\" treated as \"perspective\"");
+  CameraProjection projection = CameraProjection::Perspective;
+  if (type == "orthographic") {
+    projection = CameraProjection::Orthographic;
+  } else if (type == "spherical") {
+    const std::string mapping = params.get_string("mapping", "equalarea");
+    if (mapping == "equalarea")
+      projection = CameraProjection::SphericalEqualArea;
+    else if (mapping == "equirectangular")
+      projection = CameraProjection::SphericalEquirectangular;
+    else
+      fail(at, "spherical camera \"mapping\" \"" + mapping + "\" is unknown (equalarea, equirectangular)");
+  } else if (type != "perspective") {
+    warnings.push_back(at.where() + ": camera \"" + type + "\" treated as \"perspective\"");
+  }
+  scene_.camera.projection = projection;
+  // pbrt-v4's CameraBase parameters.
+  if (const std::vector<Float> w = params.get_floats("screenwindow"); !w.empty()) {
+    if (w.size() != 4 || !(w[1] > w[0]) || !(w[3] > w[2]) || !std::isfinite(w[0]) || !std::isfinite(w[1]) ||
+        !std::isfinite(w[2]) || !std::isfinite(w[3]))
+      fail(at, "camera \"screenwindow\" needs four finite values x0 < x1, y0 < y1");
+    scene_.camera.has_screen_window = true;
+    scene_.camera.screen_window = Vec4(w[0], w[1], w[2], w[3]);
+  }
+  if (params.find_any("frameaspectratio")) {
+    scene_.camera.frame_aspect_ratio = params.get_float("frameaspectratio", 0.f);
+    if (!(scene_.camera.frame_aspect_ratio > 0.f) || !std::isfinite(scene_.camera.frame_aspect_ratio))
+      fail(at, "camera \"frameaspectratio\" must be positive");
+  }
   if (glm::determinant(state_.ctm) == 0.0) fail(at, "camera transform is singular");
   const DMat4 world_from_camera = glm::inverse(state_.ctm);
   const glm::dvec3 eye(world_from_camera[3]);
@@ -520,7 +547,7 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   scene_.render_origin = eye;
   scene_.camera.world_from_camera = Mat4(render_from_world_ * world_from_camera);
   scene_.camera.world_from_camera_end = Mat4(render_from_world_ * world_from_camera_end);
-  scene_.camera.fov_degrees = params.get_float("fov", 90.f);
+  if (projection == CameraProjection::Perspective) scene_.camera.fov_degrees = params.get_float("fov", 90.f);
   // pbrt-v4 swaps reversed shutter times and refuses a shutter that never opens.
   Float open = params.get_float("shutteropen", 0.f), close = params.get_float("shutterclose", 1.f);
   if (close < open) {
@@ -535,13 +562,15 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   scene_.camera.where = at.where();
   scene_.camera_medium = state_.media.outside;  // pbrt-v4: the camera sits in the current outside medium
   coordinate_systems_["camera"] = {render_from_world_ * world_from_camera, render_from_world_ * world_from_camera_end, true};
-  scene_.camera.lens_radius = params.get_float("lensradius", 0.f);
-  scene_.camera.focal_distance = params.get_float("focaldistance", 1e6f);
+  // The spherical camera has no lens (pbrt-v4 does not read one).
+  const bool lens = projection == CameraProjection::Perspective || projection == CameraProjection::Orthographic;
+  scene_.camera.lens_radius = lens ? params.get_float("lensradius", 0.f) : 0.f;
+  scene_.camera.focal_distance = lens ? params.get_float("focaldistance", 1e6f) : 1e6f;
   if (!(scene_.camera.lens_radius >= 0.f) || !std::isfinite(scene_.camera.lens_radius))
     fail(at, "camera \"lensradius\" must not be negative");
   if (!(scene_.camera.focal_distance > 0.f) || !std::isfinite(scene_.camera.focal_distance))
     fail(at, "camera \"focaldistance\" must be positive and finite");
-  if (type != "perspective") params.mark_all_used();
+  if (type != "perspective" && type != "orthographic" && type != "spherical") params.mark_all_used();
   params.report_unused(warnings);
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "kernels/camera_projection.h"
 #include "kernels/light.h"
 #include "kernels/material.h"
 #include "kernels/medium.h"
@@ -91,6 +92,12 @@ struct GridDesc {
 // "World" in a SceneDesc is pbrt-v4's render space: the scene's world
 // translated so that the camera is at the origin (render_origin).
 struct CameraDesc {
+  CameraProjection projection = CameraProjection::Perspective;  // the Camera directive's type (and spherical "mapping")
+  // "screenwindow" (x0 x1 y0 y1, camera-plane units) when given, else
+  // pbrt-v4's default from "frameaspectratio" (default: the film's).
+  bool has_screen_window = false;
+  Vec4 screen_window{-1.f, 1.f, -1.f, 1.f};
+  Float frame_aspect_ratio = 0.f;  // 0: the film's xres / yres
   Mat4 world_from_camera{1.f};  // pbrt camera space: x right, y up, z forward (left-handed)
   Float fov_degrees = 90.f;     // pbrt-v4: angle spanned by the shorter image axis
   Float exposure_time = 1.f;    // shutterclose - shutteropen (scales the image, as in pbrt-v4)

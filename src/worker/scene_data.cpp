@@ -285,8 +285,17 @@ void SceneData::build_camera() {
   camera_.moves = desc_.camera.world_from_camera_end != desc_.camera.world_from_camera;
   camera_.world_from_camera_linear_end = Mat3(desc_.camera.world_from_camera_end);
   camera_.origin_end = Vec3(desc_.camera.world_from_camera_end * Vec4(0.f, 0.f, 0.f, 1.f));
-  Float aspect = static_cast<Float>(film.xres) / static_cast<Float>(film.yres);
-  if (aspect > 1.f) {
+  camera_.projection = desc_.camera.projection;
+  // pbrt-v4's CameraBase: the screen window given, or [-a, a] x [-1, 1] for
+  // a frame aspect a > 1, else [-1, 1] x [-1/a, 1/a].
+  const Float aspect = desc_.camera.frame_aspect_ratio > 0.f
+                           ? desc_.camera.frame_aspect_ratio
+                           : static_cast<Float>(film.xres) / static_cast<Float>(film.yres);
+  if (desc_.camera.has_screen_window) {
+    const Vec4& w = desc_.camera.screen_window;
+    camera_.screen_min = Vec2(w.x, w.z);
+    camera_.screen_max = Vec2(w.y, w.w);
+  } else if (aspect > 1.f) {
     camera_.screen_min = Vec2(-aspect, -1.f);
     camera_.screen_max = Vec2(aspect, 1.f);
   } else {
@@ -473,7 +482,8 @@ uint64_t SceneData::film_fingerprint() const {
                         camera_.lens_radius == 0.f && std::memcmp(&desc_.filter, &default_filter, sizeof default_filter) == 0 &&
                         positions_end_.empty() && !camera_.moves && !desc_.spectral && camera_.film_x0 == 0 &&
                         camera_.film_y0 == 0 && camera_.film_width == camera_.width && camera_.film_height == camera_.height &&
-                        view_.layered_mis_balance;
+                        view_.layered_mis_balance && camera_.projection == CameraProjection::Perspective &&
+                        !desc_.camera.has_screen_window && desc_.camera.frame_aspect_ratio == 0.f;
   if (defaults) return 0;
   Fnv1a f;
   f.add(&camera_.pixel_from_radiance, sizeof camera_.pixel_from_radiance);
@@ -484,6 +494,9 @@ uint64_t SceneData::film_fingerprint() const {
   f.add(&desc_.filter, sizeof desc_.filter);
   const int32_t crop[4] = {camera_.film_x0, camera_.film_y0, camera_.film_width, camera_.film_height};
   f.add(crop, sizeof crop);
+  f.add(&camera_.projection, sizeof camera_.projection);
+  f.add(&camera_.screen_min, sizeof camera_.screen_min);
+  f.add(&camera_.screen_max, sizeof camera_.screen_max);
   if (!view_.layered_mis_balance) f.add("power-mis", 9);  // "path": the coated BSDFs' picture differs
   if (desc_.spectral) f.add("spectral", 8);  // only then: RGB checkpoints keep their fingerprints
   if (!positions_end_.empty() || camera_.moves) {  // motion blur: the shutter, the transforms' times, the camera's end
