@@ -361,7 +361,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           if (depth == 0 || specular_bounce || !settings.nee) {
             L += beta * Le;
           } else {
-            Float light_pdf = light_select_pmf(s, guide, prev_cell, li) * environment_pdf(s, li, ray.d);
+            Float light_pdf = light_select_pmf(s, guide, prev_cell, li) * environment_pdf(s, li, ray.o, ray.d);
             L += beta * Le * mis_weight(mis_pdf_of_last_direction(), light_pdf, prev_mis_balance);
             if constexpr (kGuide) note_mis_emission(luminance(Le), light_pdf);
           }

@@ -36,6 +36,12 @@ struct Light {
   Float blackbody_kelvin = 0.f;  // 0: L is an RGB (illuminant spectrum)
   Float blackbody_norm = 0.f;    // 1 / luminance of B / B(peak) (set when the scene is built)
   int32_t medium = -1;  // Point / Spot: the medium it sits in (pbrt-v4: the outside medium where defined)
+  // Infinite with a "portal" (portal_area > 0): a rectangle p0 + a s + b t
+  // (a, b in [0, 1]) in render space; the light emits only along directions
+  // d with dot(d, portal_n) > 0 (pbrt-v4's PortalImageInfiniteLight), and
+  // next-event estimation samples points of the rectangle.
+  Vec3 portal_p0{0.f}, portal_s{0.f}, portal_t{0.f}, portal_n{0.f, 0.f, 1.f};
+  Float portal_area = 0.f;
 };
 
 }  // namespace tessera

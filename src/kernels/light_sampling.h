@@ -20,6 +20,7 @@ struct LightSample {
 };
 
 TESSERA_HOST_DEVICE inline Rgb environment_radiance(const SceneView& s, const Light& l, const Vec3& dir_world) {
+  if (l.portal_area > 0.f && !(glm::dot(dir_world, l.portal_n) > 0.f)) return Rgb(0.f);  // behind the portal's plane
   if (l.image < 0) return l.L;
   Vec3 wl = glm::normalize(l.light_from_world * dir_world);
   return l.L * image_lookup_nearest(s.images[l.image], equal_area_sphere_to_square(wl));
@@ -67,8 +68,27 @@ TESSERA_HOST_DEVICE inline Float area_light_pdf_from(const SceneView& s, const L
   return area_light_pdf(l.area, glm::length(p_light - ref_p), cos_l);
 }
 
-TESSERA_HOST_DEVICE inline Float environment_pdf(const SceneView& s, uint32_t light_index, const Vec3& dir_world) {
+// Solid-angle density, seen from o, of the portal's point sampling for the
+// unit direction d: where the ray (o, d) crosses the rectangle from its
+// back (dot(d, n) > 0), dist^2 / (area cos); 0 where it misses it.
+TESSERA_HOST_DEVICE inline Float portal_pdf(const Light& l, const Vec3& o, const Vec3& d) {
+  const Float cos_n = glm::dot(d, l.portal_n);
+  if (!(cos_n > 0.f)) return 0.f;
+  const Float t = glm::dot(l.portal_p0 - o, l.portal_n) / cos_n;
+  if (!(t > 0.f) || !(t < kInfinity)) return 0.f;
+  const Vec3 q = o + t * d - l.portal_p0;
+  const Float a = glm::dot(q, l.portal_s) / glm::dot(l.portal_s, l.portal_s);
+  const Float b = glm::dot(q, l.portal_t) / glm::dot(l.portal_t, l.portal_t);
+  if (!(a >= 0.f && a <= 1.f && b >= 0.f && b <= 1.f)) return 0.f;
+  const Float pdf = t * t / (l.portal_area * cos_n);
+  return pdf < kInfinity ? pdf : 0.f;
+}
+
+// o: where the ray that escaped started (a portal's density depends on it).
+TESSERA_HOST_DEVICE inline Float environment_pdf(const SceneView& s, uint32_t light_index, const Vec3& o,
+                                                 const Vec3& dir_world) {
   const Light& l = s.lights[light_index];
+  if (l.portal_area > 0.f) return portal_pdf(l, o, dir_world);
   if (l.image < 0) return kUniformSpherePdf;
   Vec3 wl = glm::normalize(l.light_from_world * dir_world);
   return s.env_distributions[light_index].pdf(equal_area_sphere_to_square(wl)) * kInv4Pi;
@@ -177,6 +197,22 @@ TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_
       break;
     }
     case LightType::Infinite: {
+      if (l.portal_area > 0.f) {
+        // A point of the portal, uniformly by area, and the sky's radiance
+        // along the direction through it (the same function escaped rays
+        // read, so the two strategies' MIS weights sum to 1).
+        const Vec3 q = l.portal_p0 + u.x * l.portal_s + u.y * l.portal_t;
+        const Vec3 d = q - ref_p;
+        const Float dist = glm::length(d);
+        if (!(dist > 0.f)) return false;
+        ls.wi = d / dist;
+        const Float cos_n = glm::dot(ls.wi, l.portal_n);
+        if (!(cos_n > 0.f)) return false;  // the point is beyond the portal
+        ls.pdf = dist * dist / (l.portal_area * cos_n);
+        ls.L = environment_radiance(s, l, ls.wi);
+        ls.infinite = true;
+        break;
+      }
       if (l.image < 0) {
         ls.wi = sample_uniform_sphere(u);
         ls.pdf = kUniformSpherePdf;

@@ -438,6 +438,10 @@ uint64_t SceneData::fingerprint() const {
     f.add(&l.type, sizeof l.type);
     f.add(&l.L, sizeof l.L);
     f.add(&l.position, sizeof l.position);
+    if (l.portal_area > 0.f) {  // only portals add bytes: other scenes keep their fingerprints
+      const Vec3 portal[4] = {l.portal_p0, l.portal_s, l.portal_t, l.portal_n};
+      f.add(portal, sizeof portal);
+    }
   }
   uint64_t materials = desc_.materials.size();
   f.add(&materials, sizeof materials);
