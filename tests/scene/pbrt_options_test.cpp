@@ -150,8 +150,14 @@ TEST(PbrtOptions, FilterFunctionsArePbrtsDefinitions) {
 }
 
 TEST(PbrtOptions, CameraTypesAndLensWarn) {
-  SceneDesc s = load_with_options("Camera \"orthographic\"\n");
-  EXPECT_TRUE(has_warning(s, "opt.pbrt:1: camera \"orthographic\""));
+  SceneDesc s = load_with_options("Camera \"realistic\" \"string lensfile\" \"wide.dat\"\n");
+  EXPECT_TRUE(has_warning(s, "opt.pbrt:1: camera \"realistic\" treated as \"perspective\""));
+  s = load_with_options("Camera \"orthographic\" \"float lensradius\" 0.2\n");
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_EQ(s.camera.projection, CameraProjection::Orthographic);
+  s = load_with_options("Camera \"spherical\" \"string mapping\" \"equirectangular\"\n");
+  EXPECT_TRUE(s.warnings.empty());
+  EXPECT_EQ(s.camera.projection, CameraProjection::SphericalEquirectangular);
   s = load_with_options("Camera \"perspective\" \"float lensradius\" 0.1 \"float focaldistance\" 3\n");
   EXPECT_TRUE(s.warnings.empty());
   EXPECT_FLOAT_EQ(s.camera.lens_radius, 0.1f);
