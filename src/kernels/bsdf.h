@@ -9,7 +9,8 @@
 namespace tessera {
 
 enum class BsdfType : uint32_t {
-  Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, DiffuseTransmission, CoatedConductor, ThinDielectric, Hair
+  Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, DiffuseTransmission, CoatedConductor, ThinDielectric, Hair,
+  SubsurfaceExit
 };
 
 // Lobe flags, combinable.
@@ -49,6 +50,11 @@ struct BsdfParams {
   // frame has x along the fibre and z the tube's round normal.
   Rgb hair_sigma_a{0.f};
   Float hair_beta_m = 0.3f, hair_beta_n = 0.3f, hair_alpha = 2.f;
+  // SubsurfaceExit: where a random walk inside a subsurface material meets
+  // its boundary and leaves (wo inside, z < 0; wi outside): pbrt-v4's
+  // NormalizedFresnelBxDF, (1 - F(cos wi, ior)) / (exit_norm pi) times
+  // ior^2 (radiance leaving a denser medium), cosine-sampled.
+  Float exit_norm = 1.f;
 };
 
 // pbrt-v4 treats microfacet distributions with alpha below this as specular.

@@ -395,6 +395,25 @@ TESSERA_HOST_DEVICE inline bool hair_sample(const BsdfParams& b, const Vec3& wo,
   return true;
 }
 
+TESSERA_HOST_DEVICE inline Rgb subsurface_exit_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+  if (!(wo.z < 0.f) || !(wi.z > 0.f) || !(b.exit_norm > 0.f)) return Rgb(0.f);
+  return Rgb((1.f - fr_dielectric(wi.z, b.ior)) * sqr(b.ior) / (b.exit_norm * kPi));
+}
+
+TESSERA_HOST_DEVICE inline Float subsurface_exit_pdf(const Vec3& wo, const Vec3& wi) {
+  return wo.z < 0.f && wi.z > 0.f ? wi.z * kInvPi : 0.f;
+}
+
+TESSERA_HOST_DEVICE inline bool subsurface_exit_sample(const BsdfParams& b, const Vec3& wo, Vec2 u, BsdfSample* s) {
+  if (!(wo.z < 0.f)) return false;
+  s->wi = sample_cosine_hemisphere(u);
+  s->pdf = subsurface_exit_pdf(wo, s->wi);
+  s->f = subsurface_exit_f(b, wo, s->wi);
+  s->lobe = kLobeTransmission | kLobeDiffuse;
+  s->eta = 1.f / b.ior;  // leaving the medium: undoes the entry's eta^2 for Russian roulette
+  return true;
+}
+
 }  // namespace bsdf_detail
 
 TESSERA_HOST_DEVICE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
@@ -408,6 +427,7 @@ TESSERA_HOST_DEVICE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, co
     case BsdfType::ThinDielectric: return Rgb(0.f);  // deltas only
     case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_f(b, wo, wi);
     case BsdfType::Hair: return hair_f(bsdf_detail::hair_fiber(b), wo, wi);
+    case BsdfType::SubsurfaceExit: return bsdf_detail::subsurface_exit_f(b, wo, wi);
   }
   return Rgb(0.f);
 }
@@ -435,6 +455,7 @@ TESSERA_HOST_DEVICE inline Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, c
     case BsdfType::ThinDielectric: return 0.f;
     case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_pdf(b, wo, wi);
     case BsdfType::Hair: return hair_pdf(bsdf_detail::hair_fiber(b), wo, wi);
+    case BsdfType::SubsurfaceExit: return bsdf_detail::subsurface_exit_pdf(wo, wi);
   }
   return 0.f;
 }
@@ -474,6 +495,7 @@ TESSERA_HOST_DEVICE inline bool bsdf_sample(const BsdfParams& b, const Vec3& wo,
     case BsdfType::ThinDielectric: ok = bsdf_detail::thin_dielectric_sample(b, wo, uc, &s); break;
     case BsdfType::DiffuseTransmission: ok = bsdf_detail::diffuse_transmission_sample(b, wo, uc, u, &s); break;
     case BsdfType::Hair: ok = bsdf_detail::hair_sample(b, wo, uc, u, &s); break;
+    case BsdfType::SubsurfaceExit: ok = bsdf_detail::subsurface_exit_sample(b, wo, u, &s); break;
   }
   // pbrt-v4 BSDF::Sample_f: reject black f, zero pdf and wi in the tangent plane.
   if (!ok || s.wi.z == 0.f || !is_finite(s.wi) || !is_finite(s.f) || is_black(s.f)) return false;
@@ -511,6 +533,7 @@ TESSERA_HOST_DEVICE inline uint32_t bsdf_lobes(const BsdfParams& b) {
              (bsdf_detail::distrib(b).effectively_smooth() ? kLobeSpecular : kLobeGlossy);
     case BsdfType::ThinDielectric: return kLobeReflection | kLobeTransmission | kLobeSpecular;
     case BsdfType::Hair: return kLobeReflection | kLobeTransmission | kLobeGlossy;
+    case BsdfType::SubsurfaceExit: return kLobeTransmission | kLobeDiffuse;
     case BsdfType::CoatedConductor: {
       const bool coat_smooth = bsdf_detail::distrib(b).effectively_smooth();
       if (coat_smooth && bsdf_detail::coated_conductor::base_smooth(b)) return kLobeReflection | kLobeSpecular;

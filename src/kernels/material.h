@@ -60,7 +60,7 @@ struct ImageView {
 
 enum class MaterialType : uint32_t {
   Diffuse = 0, Conductor, Dielectric, CoatedDiffuse, Interface, Mix, DiffuseTransmission, CoatedConductor, ThinDielectric,
-  Hair
+  Hair, Subsurface
 };
 
 // Where a hair material's absorption comes from (pbrt-v4 HairMaterial, in
@@ -106,6 +106,11 @@ struct Material {
   TextureSlot hair_sigma_a{-1, Rgb(0.f)};
   TextureSlot eumelanin{-1, Rgb(1.3f)}, pheomelanin{-1, Rgb(0.f)};
   TextureSlot beta_m{-1, Rgb(0.3f)}, beta_n{-1, Rgb(0.3f)}, hair_alpha{-1, Rgb(2.f)};
+  // subsurface: the medium inside (SceneView::media; the loader puts it
+  // inside the material's shapes) and the exit lobe's normalisation c
+  // (scene/subsurface_params.h); the boundary is a dielectric of ior and alpha.
+  int32_t subsurface_medium = -1;
+  Float exit_norm = 1.f;
   int32_t mix[2] = {-1, -1};                 // Mix: material indices
   TextureSlot amount{ -1, Rgb(0.5f) };      // Mix: probability of choosing mix[1] (value.x)
 };

@@ -180,6 +180,16 @@ TESSERA_HOST_DEVICE inline bool resolve_bsdf(const SceneView& s, int32_t materia
     case MaterialType::Hair:
       hair_params<Spec>(s, *m, h, refl, wl, &b);
       break;
+    case MaterialType::Subsurface:
+      // Outside: the boundary's dielectric; from inside (a random walk
+      // reaching it): the lobe the walk leaves by.
+      if (glm::dot(wo, h.ng) >= 0.f) {
+        b.type = BsdfType::Dielectric;
+      } else {
+        b.type = BsdfType::SubsurfaceExit;
+        b.exit_norm = m->exit_norm;
+      }
+      break;
     default:
       b.type = BsdfType::Diffuse;
       b.reflectance = spectral_albedo(s.spectral, wl, refl);

@@ -601,6 +601,10 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
     scene_.warnings.push_back(at.where() + ": area light \"power\" on a PLY of triangles and quads goes to each "
                               "triangle; pbrt-v4 gives it to each quad whole (each quad here emits twice that)");
   mesh->media = state_.media;
+  // A subsurface material's medium fills its shapes (inside: the side the
+  // geometric normal points away from).
+  if (scene_.materials[state_.material].type == MaterialType::Subsurface)
+    mesh->media.inside = static_cast<int16_t>(scene_.materials[state_.material].subsurface_medium);
   if (state_.ctm_end != state_.ctm) {
     if (mesh->area_light >= 0) {
       scene_.warnings.push_back(at.where() + ": a moving area light is not supported; it stays where it starts");

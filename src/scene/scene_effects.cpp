@@ -50,6 +50,9 @@ void add_material_effects(const SceneDesc& scene, int32_t index, uint32_t& e, in
                                    &m.hair_alpha})
         if (slot_textured(*t)) e |= kEffectTextures;
       break;
+    case MaterialType::Subsurface:
+      e |= kEffectDiffuse | kEffectTransmission | (smooth ? kEffectSpecular : kEffectGlossy);
+      break;
     case MaterialType::Interface:
       e |= kEffectInterface;
       break;

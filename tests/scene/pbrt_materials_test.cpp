@@ -308,5 +308,41 @@ TEST(PbrtMaterials, HairAbsorptionPrecedenceAndDefaults) {
   EXPECT_NE(s.warnings[0].find("\"reflectance\" is ignored"), std::string::npos);
 }
 
+// pbrt-v4's subsurface as a random walk: the medium's coefficients by
+// pbrt-v4's precedence (name, sigma_a/sigma_s, reflectance with mfp, the
+// whole-milk default), times scale, inside every shape of the material.
+TEST(PbrtMaterials, SubsurfaceMakesAMediumInsideItsShapes) {
+  SceneDesc s = load_world(std::string("Material \"subsurface\"\n") + kTriangle);
+  const Material& m = material_of_last_mesh(s);
+  EXPECT_EQ(m.type, MaterialType::Subsurface);
+  EXPECT_FLOAT_EQ(m.ior, 1.33f);
+  ASSERT_GE(m.subsurface_medium, 0);
+  EXPECT_EQ(s.meshes.back().media.inside, m.subsurface_medium);
+  EXPECT_EQ(s.meshes.back().media.outside, -1);
+  EXPECT_VEC3_NEAR(s.media[m.subsurface_medium].sigma_s, Vec3(2.55f, 3.21f, 3.77f), 1e-6f);
+  EXPECT_GT(m.exit_norm, 0.5f);  // 1 - 2 (Fresnel moment): about 0.8 for eta 1.33
+  EXPECT_LT(m.exit_norm, 1.f);
+  EXPECT_TRUE(s.warnings.empty());
+
+  s = load_world(std::string("Material \"subsurface\" \"string name\" \"Ketchup\" \"float scale\" 2 \"float g\" 0.5\n") + kTriangle);
+  const Medium& ketchup = s.media[material_of_last_mesh(s).subsurface_medium];
+  EXPECT_VEC3_NEAR(ketchup.sigma_s, 2.f * Vec3(0.18f, 0.07f, 0.03f), 1e-6f);
+  EXPECT_VEC3_NEAR(ketchup.sigma_a, 2.f * Vec3(0.061f, 0.97f, 1.45f), 1e-6f);
+  EXPECT_FLOAT_EQ(ketchup.g, 0.5f);
+
+  s = load_world(std::string("Material \"subsurface\" \"rgb reflectance\" [ 0 0.5 1 ] \"float mfp\" 0.5\n") + kTriangle);
+  const Medium& r = s.media[material_of_last_mesh(s).subsurface_medium];
+  EXPECT_VEC3_NEAR(r.sigma_a + r.sigma_s, Vec3(2.f), 1e-5f);   // 1 / mfp
+  EXPECT_NEAR(r.sigma_s.x, 0.f, 1e-4f);                         // black: albedo 0 (the fit, to 6e-6)
+  EXPECT_NEAR(r.sigma_a.z, 0.f, 1e-5f);                         // white: albedo 1
+  EXPECT_GT(r.sigma_s.y / 2.f, 0.5f);                           // a walk needs albedo > reflectance
+
+  EXPECT_NE(test::load_error("WorldBegin\nMaterial \"subsurface\" \"string name\" \"Jam\"\n").find("\"Jam\" is not a known medium"),
+            std::string::npos);
+  EXPECT_NE(test::load_error("WorldBegin\nMaterial \"subsurface\" \"rgb reflectance\" [ 1 1 1 ] \"float mfp\" 0\n")
+                .find("\"mfp\" must be positive"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace tessera
