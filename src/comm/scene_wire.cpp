@@ -7,7 +7,7 @@ namespace tessera {
 template <class Archive>
 void serialize(Archive& ar, MeshDesc& m) {
   ar(raw(m.p), raw(m.n), raw(m.uv), raw(m.indices), m.material, m.flip_normals, m.area_light, raw_value(m.alpha), raw_value(m.media),
-     raw(m.p_end), raw(m.n_end), m.triangles_per_shape, m.shape_area, m.where);
+     raw(m.p_end), raw(m.n_end), m.triangles_per_shape, m.shape_area, m.invisible_from_inside, m.where);
 }
 template <class Archive>
 void serialize(Archive& ar, ImageDesc& i) {
@@ -31,7 +31,8 @@ void serialize(Archive& ar, GridDesc& g) {
 template <class Archive>
 void serialize(Archive& ar, SceneDesc& d) {
   ar(raw_value(d.camera.world_from_camera), d.camera.fov_degrees, d.camera.lens_radius, d.camera.focal_distance,
-     d.camera.where);
+     d.camera.where, d.camera.projection, d.camera.has_screen_window, raw_value(d.camera.screen_window),
+     d.camera.frame_aspect_ratio);
   ar(d.film.xres, d.film.yres, d.film.crop[0], d.film.crop[1], d.film.crop[2], d.film.crop[3], d.film.filename, raw_value(d.filter), d.spp, d.max_depth, d.seed);
   ar(d.integrator, d.sampler, d.strata_x, d.strata_y, d.sampler_jitter, d.halton_randomize, d.sampler_spp, d.camera.exposure_time, d.film.iso, d.film.whitebalance, d.film.sensor, d.film.max_component_value,
      raw_value(d.film.pixel_from_radiance), raw_value(d.film.sensor_from_radiance), raw_value(d.film.pixel_from_sensor));

@@ -1,4 +1,4 @@
-// Hits a ray query skips. pbrt-v4's alpha cutouts: a hit on a surface whose alpha is a < 1 is ignored
+// pbrt-v4's alpha cutouts: a hit on a surface whose alpha is a < 1 is ignored
 // with probability 1 - a. The decision is a hash of the ray and the triangle,
 // as pbrt-v4 hashes the ray: deterministic per ray, independent between the
 // layers of overlapping cutouts. Every ray-query backend calls this for each
@@ -23,16 +23,6 @@ TESSERA_HOST_DEVICE inline bool alpha_ignores_hit(const SceneView& s, uint32_t t
                               (static_cast<uint64_t>(tri) * 0x9e3779b97f4a7c15ull));
   const Float u = static_cast<Float>(h >> 40) * 0x1p-24f;
   return u >= a;
-}
-
-// Whether a ray query skips this candidate hit: a one-way face (a curve's
-// tube) met from inside, or an alpha cutout. Every backend calls this for
-// every candidate when the scene has either (SceneView::triangle_alpha,
-// has_one_way_faces).
-TESSERA_HOST_DEVICE inline bool hit_ignored(const SceneView& s, uint32_t tri, Float b1, Float b2, const Vec3& o,
-                                            const Vec3& d, Float time) {
-  if ((s.triangles[tri].flags & kTriInvisibleFromInside) && glm::dot(d, s.face_normals[tri]) > 0.f) return true;
-  return s.triangle_alpha && alpha_ignores_hit(s, tri, b1, b2, o, d, time);
 }
 
 }  // namespace tessera

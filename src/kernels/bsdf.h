@@ -51,7 +51,7 @@ struct BsdfParams {
   Rgb hair_sigma_a{0.f};
   Float hair_beta_m = 0.3f, hair_beta_n = 0.3f, hair_alpha = 2.f;
   // SubsurfaceExit: where a random walk inside a subsurface material meets
-  // its boundary and leaves (wo inside, z < 0; wi outside): pbrt-v4's
+  // its boundary and leaves (wi on the outer side, z > 0): pbrt-v4's
   // NormalizedFresnelBxDF, (1 - F(cos wi, ior)) / (exit_norm pi) times
   // ior^2 (radiance leaving a denser medium), cosine-sampled.
   Float exit_norm = 1.f;

@@ -395,19 +395,19 @@ TESSERA_HOST_DEVICE inline bool hair_sample(const BsdfParams& b, const Vec3& wo,
   return true;
 }
 
+// The side a walk leaves from is decided by the geometric normal
+// (resolve_bsdf); the lobe is the shading normal's outer hemisphere,
+// whatever side wo is on there.
 TESSERA_HOST_DEVICE inline Rgb subsurface_exit_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
-  if (!(wo.z < 0.f) || !(wi.z > 0.f) || !(b.exit_norm > 0.f)) return Rgb(0.f);
+  if (!(wi.z > 0.f) || !(b.exit_norm > 0.f)) return Rgb(0.f);
   return Rgb((1.f - fr_dielectric(wi.z, b.ior)) * sqr(b.ior) / (b.exit_norm * kPi));
 }
 
-TESSERA_HOST_DEVICE inline Float subsurface_exit_pdf(const Vec3& wo, const Vec3& wi) {
-  return wo.z < 0.f && wi.z > 0.f ? wi.z * kInvPi : 0.f;
-}
+TESSERA_HOST_DEVICE inline Float subsurface_exit_pdf(const Vec3& wi) { return wi.z > 0.f ? wi.z * kInvPi : 0.f; }
 
 TESSERA_HOST_DEVICE inline bool subsurface_exit_sample(const BsdfParams& b, const Vec3& wo, Vec2 u, BsdfSample* s) {
-  if (!(wo.z < 0.f)) return false;
   s->wi = sample_cosine_hemisphere(u);
-  s->pdf = subsurface_exit_pdf(wo, s->wi);
+  s->pdf = subsurface_exit_pdf(s->wi);
   s->f = subsurface_exit_f(b, wo, s->wi);
   s->lobe = kLobeTransmission | kLobeDiffuse;
   s->eta = 1.f / b.ior;  // leaving the medium: undoes the entry's eta^2 for Russian roulette
@@ -455,7 +455,7 @@ TESSERA_HOST_DEVICE inline Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, c
     case BsdfType::ThinDielectric: return 0.f;
     case BsdfType::DiffuseTransmission: return bsdf_detail::diffuse_transmission_pdf(b, wo, wi);
     case BsdfType::Hair: return hair_pdf(bsdf_detail::hair_fiber(b), wo, wi);
-    case BsdfType::SubsurfaceExit: return bsdf_detail::subsurface_exit_pdf(wo, wi);
+    case BsdfType::SubsurfaceExit: return bsdf_detail::subsurface_exit_pdf(wi);
   }
   return 0.f;
 }

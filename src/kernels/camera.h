@@ -1,8 +1,9 @@
 // pbrt-v4's perspective, orthographic and spherical cameras: raster (0,0)
 // is the top-left corner, camera space is x right, y up, z forward. The
-// perspective fov spans the screen window's shorter axis; the orthographic
-// screen window is in camera-space units; the spherical camera maps the
-// whole image to the sphere (equal-area square or equirectangular).
+// perspective fov spans screen-window units [-1, 1] (the shorter axis of
+// the default window); the orthographic screen window is in camera-space
+// units; the spherical camera maps the whole image to the sphere
+// (equal-area square or equirectangular).
 #pragma once
 
 #include "equal_area.h"
@@ -17,15 +18,10 @@ struct Ray {
   Float time = 0.f;  // where in the transform interval (0 = its start, 1 = its end): moving shapes
 };
 
-// u_lens: a point on the lens (used only when c.lens_radius > 0; pbrt-v4's
-// thin lens: the ray passes through the point of the focal plane that the
-// pinhole ray meets).
-// time: Ray::time; a moving camera (motion blur) is interpolated linearly
-// between its start and end placements.
 // pbrt-v4's SphericalCamera: the image's uv to a camera-space direction,
 // equal-area (Clarberg's octahedral square) or equirectangular (theta =
-// pi v, phi = 2 pi u), with y and z swapped so that the image's centre row
-// is the horizon around camera-space y (up).
+// pi v, phi = 2 pi u), with y and z swapped so that camera-space y (up) is
+// the pole: the equirectangular image's top row, the equal-area square's centre.
 TESSERA_HOST_DEVICE inline Vec3 spherical_camera_direction(CameraProjection p, Vec2 uv) {
   Vec3 d;
   if (p == CameraProjection::SphericalEqualArea) {
@@ -37,6 +33,11 @@ TESSERA_HOST_DEVICE inline Vec3 spherical_camera_direction(CameraProjection p, V
   return Vec3(d.x, d.z, d.y);
 }
 
+// u_lens: a point on the lens (used only when c.lens_radius > 0; pbrt-v4's
+// thin lens: the ray passes through the point of the focal plane that the
+// pinhole ray meets).
+// time: Ray::time; a moving camera (motion blur) is interpolated linearly
+// between its start and end placements.
 TESSERA_HOST_DEVICE inline Ray generate_camera_ray(const CameraView& c, Vec2 p_film, Vec2 u_lens = Vec2(0.f),
                                                    Float time = 0.f) {
   Float sx = c.screen_min.x + (p_film.x / c.width) * (c.screen_max.x - c.screen_min.x);
@@ -59,10 +60,11 @@ TESSERA_HOST_DEVICE inline Ray generate_camera_ray(const CameraView& c, Vec2 p_f
   r.time = time;
   r.o = origin + world_from_camera_linear * o_cam;
   if (c.lens_radius > 0.f && c.projection == CameraProjection::Orthographic) {
-    // pbrt-v4's orthographic thin lens: from the lens point beside the
-    // pinhole ray's origin through its point on the focal plane.
+    // pbrt-v4's orthographic thin lens, as it is written: the ray leaves the
+    // lens point around the camera's origin (not around the pixel's) for
+    // the pixel's point on the focal plane.
     const Vec2 lens = c.lens_radius * sample_uniform_disk_concentric(u_lens);
-    const Vec3 o_lens(o_cam.x + lens.x, o_cam.y + lens.y, 0.f);
+    const Vec3 o_lens(lens.x, lens.y, 0.f);
     d_cam = o_cam + Vec3(0.f, 0.f, c.focal_distance) - o_lens;
     r.o = origin + world_from_camera_linear * o_lens;
   } else if (c.lens_radius > 0.f && c.projection == CameraProjection::Perspective) {

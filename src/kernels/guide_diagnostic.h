@@ -22,7 +22,7 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g
     if (!tracer.intersect(ray.o, ray.d, kInfinity, &hit)) {
       Rgb Le(0.f);
       for (uint32_t k = 0; k < s.num_infinite_lights; ++k)
-        Le += environment_radiance(s, s.lights[s.infinite_lights[k]], ray.d);
+        Le += environment_radiance(s, s.lights[s.infinite_lights[k]], ray.o, ray.d);
       return beta * Le;
     }
     const RayPoint from_ray{ray.o, ray.d, hit.t};

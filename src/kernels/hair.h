@@ -22,10 +22,9 @@
 // the mirror image of the geometry: its R lobe is centred on phi_o - 2 gamma_o
 // (gamma_o = asin h), while the mirror reflection of wo about the true normal
 // is (-wo.x, -wo.y, wo.z), at phi_o + 2 gamma_o. So for |h| > 1/2 the R lobe
-// points into the tube (wi.z < 0), as TT and TRT do by design: about 65 % of
-// R samples and 71 % of all samples for wo over the front hemisphere (5 % and
-// 54 % with h = -wo.y / |(wo.y, wo.z)|). The integrator must let such rays
-// leave through the fiber rather than stop at its inside.
+// points into the tube (wi.z < 0), as TT and TRT do by design; most samples
+// do. The integrator must let such rays leave through the fiber rather than
+// stop at its inside (one-way tube faces).
 //
 // Why ours: pbrt-v4's HairBxDF is a class over SampledSpectrum with h fixed
 // at construction; here it is free functions over RGB that nvcc compiles, h
@@ -46,7 +45,7 @@ namespace tessera {
 struct HairFiber {
   Rgb sigma_a{0.f};     // absorption coefficient inside the fiber, per unit radius (pbrt-v4's "sigma_a")
   Float eta = 1.55f;    // fiber index of refraction
-  Float beta_m = 0.3f;  // longitudinal roughness in [0,1] (clamped to [0.01, 1] as pbrt-v4's material does)
+  Float beta_m = 0.3f;  // longitudinal roughness in [0,1] (kept in [0.01, 1]: below 0.01 the lobes' variances underflow)
   Float beta_n = 0.3f;  // azimuthal roughness in [0,1] (likewise)
   Float alpha = 2.f;    // cuticle scale tilt, degrees
 };

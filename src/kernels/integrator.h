@@ -235,6 +235,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   int32_t prev_cell = -1;  // guide cell of the last scattering point (its light selection)
   Float eta_scale = 1.f;
   int32_t interface_skips = 0;
+  int32_t walk_events = 0;  // scattering events inside subsurface media (they do not count as bounces)
   // Learning update waiting for the end of the current segment x -> y: into
   // entry pend_bin of cell pend_cell. pend_le is the part of the target known
   // at y's hit (emission NEE does not cover); the rest comes from y's NEE and
@@ -291,7 +292,12 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           rr_beta *= seg.weight;
           segment_tr = luminance(seg.weight);
           if (seg.scattered) {
-            if (is_black(beta) || depth++ == settings.max_depth) break;
+            if (is_black(beta)) break;
+            if (m.subsurface) {
+              if (++walk_events > kMaxSubsurfaceEvents) break;
+            } else if (depth++ == settings.max_depth) {
+              break;
+            }
             ++c.medium_vertices;
             if (depth == 1) first_vertex_connectable = settings.light_traced_caustics;
             last_vertex_delta_only = false;
@@ -301,7 +307,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             const Vec2 u_light = rng.uniform2();
             const Vec2 u_phase = rng.uniform2();
             Float direct_estimate = 0.f;  // unweighted NEE estimate of light scattered here (guide targets)
-            if (settings.nee && s.num_lights > 0) {
+            if (settings.nee && s.num_lights > 0 && !m.subsurface) {
               Float pmf = 0.f;
               const uint32_t li = select_light(s, guide, -1, u_select, &pmf);
               LightSample ls;
@@ -356,12 +362,15 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       if constexpr ((Spec & kSpecEnvironment) != 0) {
         for (uint32_t k = 0; k < s.num_infinite_lights; ++k) {
           uint32_t li = static_cast<uint32_t>(s.infinite_lights[k]);
-          const Rgb Le = light_emission(s, wl, s.lights[li], environment_radiance(s, s.lights[li], ray.d));
+          // A portal's sky is seen through its rectangle from the last scattering point (prev_p, where NEE
+          // sampled it; the camera's position for camera rays): not from an interface the ray crossed since.
+          const Vec3 from = depth == 0 ? ray.o : prev_p;
+          const Rgb Le = light_emission(s, wl, s.lights[li], environment_radiance(s, s.lights[li], from, ray.d));
           Le_total += Le;
           if (depth == 0 || specular_bounce || !settings.nee) {
             L += beta * Le;
           } else {
-            Float light_pdf = light_select_pmf(s, guide, prev_cell, li) * environment_pdf(s, li, ray.o, ray.d);
+            Float light_pdf = light_select_pmf(s, guide, prev_cell, li) * environment_pdf(s, li, from, ray.d);
             L += beta * Le * mis_weight(mis_pdf_of_last_direction(), light_pdf, prev_mis_balance);
             if constexpr (kGuide) note_mis_emission(luminance(Le), light_pdf);
           }

@@ -19,11 +19,35 @@ struct LightSample {
   bool infinite = false;  // shadow ray runs to infinity
 };
 
+// Solid-angle density, seen from o, of sampling the portal's rectangle
+// uniformly by area, for the unit direction d: where the ray (o, d) crosses
+// the rectangle towards its front (dot(d, n) > 0), dist^2 / (area cos); 0
+// where it misses it.
+TESSERA_HOST_DEVICE inline Float portal_pdf(const Light& l, const Vec3& o, const Vec3& d) {
+  const Float cos_n = glm::dot(d, l.portal_n);
+  if (!(cos_n > 0.f)) return 0.f;
+  const Float t = glm::dot(l.portal_p0 - o, l.portal_n) / cos_n;
+  if (!(t > 0.f) || !(t < kInfinity)) return 0.f;
+  const Vec3 q = o + t * d - l.portal_p0;
+  const Float a = glm::dot(q, l.portal_s) / glm::dot(l.portal_s, l.portal_s);
+  const Float b = glm::dot(q, l.portal_t) / glm::dot(l.portal_t, l.portal_t);
+  if (!(a >= 0.f && a <= 1.f && b >= 0.f && b <= 1.f)) return 0.f;
+  const Float pdf = t * t / (l.portal_area * cos_n);
+  return pdf < kInfinity ? pdf : 0.f;
+}
+
+// The sky's radiance along dir (its image, or L), wherever it is seen from.
 TESSERA_HOST_DEVICE inline Rgb environment_radiance(const SceneView& s, const Light& l, const Vec3& dir_world) {
-  if (l.portal_area > 0.f && !(glm::dot(dir_world, l.portal_n) > 0.f)) return Rgb(0.f);  // behind the portal's plane
   if (l.image < 0) return l.L;
   Vec3 wl = glm::normalize(l.light_from_world * dir_world);
   return l.L * image_lookup_nearest(s.images[l.image], equal_area_sphere_to_square(wl));
+}
+
+// What a ray from o along dir receives from an infinite light: with a
+// portal, only through its rectangle (pbrt-v4's PortalImageInfiniteLight::Le).
+TESSERA_HOST_DEVICE inline Rgb environment_radiance(const SceneView& s, const Light& l, const Vec3& o, const Vec3& dir) {
+  if (l.portal_area > 0.f && !(portal_pdf(l, o, dir) > 0.f)) return Rgb(0.f);
+  return environment_radiance(s, l, dir);
 }
 
 // What an area light emits at surface coordinates uv: L, times its image
@@ -68,30 +92,21 @@ TESSERA_HOST_DEVICE inline Float area_light_pdf_from(const SceneView& s, const L
   return area_light_pdf(l.area, glm::length(p_light - ref_p), cos_l);
 }
 
-// Solid-angle density, seen from o, of the portal's point sampling for the
-// unit direction d: where the ray (o, d) crosses the rectangle from its
-// back (dot(d, n) > 0), dist^2 / (area cos); 0 where it misses it.
-TESSERA_HOST_DEVICE inline Float portal_pdf(const Light& l, const Vec3& o, const Vec3& d) {
-  const Float cos_n = glm::dot(d, l.portal_n);
-  if (!(cos_n > 0.f)) return 0.f;
-  const Float t = glm::dot(l.portal_p0 - o, l.portal_n) / cos_n;
-  if (!(t > 0.f) || !(t < kInfinity)) return 0.f;
-  const Vec3 q = o + t * d - l.portal_p0;
-  const Float a = glm::dot(q, l.portal_s) / glm::dot(l.portal_s, l.portal_s);
-  const Float b = glm::dot(q, l.portal_t) / glm::dot(l.portal_t, l.portal_t);
-  if (!(a >= 0.f && a <= 1.f && b >= 0.f && b <= 1.f)) return 0.f;
-  const Float pdf = t * t / (l.portal_area * cos_n);
-  return pdf < kInfinity ? pdf : 0.f;
-}
-
 // o: where the ray that escaped started (a portal's density depends on it).
 TESSERA_HOST_DEVICE inline Float environment_pdf(const SceneView& s, uint32_t light_index, const Vec3& o,
                                                  const Vec3& dir_world) {
   const Light& l = s.lights[light_index];
-  if (l.portal_area > 0.f) return portal_pdf(l, o, dir_world);
-  if (l.image < 0) return kUniformSpherePdf;
-  Vec3 wl = glm::normalize(l.light_from_world * dir_world);
-  return s.env_distributions[light_index].pdf(equal_area_sphere_to_square(wl)) * kInv4Pi;
+  Float sky = kUniformSpherePdf;
+  if (l.image >= 0) {
+    const Vec3 wl = glm::normalize(l.light_from_world * dir_world);
+    sky = s.env_distributions[light_index].pdf(equal_area_sphere_to_square(wl)) * kInv4Pi;
+  }
+  if (!(l.portal_area > 0.f)) return sky;
+  // A portal: its rectangle by area, mixed half and half for an image with
+  // the image's own distribution where that passes through the rectangle.
+  const Float area = portal_pdf(l, o, dir_world);
+  if (l.image < 0) return area;
+  return area > 0.f ? 0.5f * (area + sky) : 0.f;
 }
 
 // Spot falloff, pbrt-v4: smoothstep between the cone's outer and inner cosines.
@@ -198,17 +213,24 @@ TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_
     }
     case LightType::Infinite: {
       if (l.portal_area > 0.f) {
-        // A point of the portal, uniformly by area, and the sky's radiance
-        // along the direction through it (the same function escaped rays
-        // read, so the two strategies' MIS weights sum to 1).
-        const Vec3 q = l.portal_p0 + u.x * l.portal_s + u.y * l.portal_t;
-        const Vec3 d = q - ref_p;
-        const Float dist = glm::length(d);
-        if (!(dist > 0.f)) return false;
-        ls.wi = d / dist;
-        const Float cos_n = glm::dot(ls.wi, l.portal_n);
-        if (!(cos_n > 0.f)) return false;  // the point is beyond the portal
-        ls.pdf = dist * dist / (l.portal_area * cos_n);
+        // A direction through the portal: a point of its rectangle uniformly
+        // by area, or for an image (half the time) the image's own
+        // distribution (a sun seen through a window), kept where it passes
+        // through the rectangle. The pdf is the mixture environment_pdf
+        // gives escaped rays, so the MIS weights sum to 1.
+        if (l.image >= 0 && u.x < 0.5f) {
+          Float pdf_uv;
+          const Vec2 uv = s.env_distributions[light_index].sample(Vec2(2.f * u.x, u.y), &pdf_uv);
+          if (!(pdf_uv > 0.f)) return false;
+          ls.wi = glm::normalize(l.world_from_light * equal_area_square_to_sphere(uv));
+        } else {
+          const Float ua = l.image >= 0 ? glm::min(2.f * u.x - 1.f, 0x1.fffffep-1f) : u.x;
+          const Vec3 d = l.portal_p0 + ua * l.portal_s + u.y * l.portal_t - ref_p;
+          const Float dist = glm::length(d);
+          if (!(dist > 0.f)) return false;
+          ls.wi = d / dist;
+        }
+        ls.pdf = environment_pdf(s, light_index, ref_p, ls.wi);  // 0 beyond the portal or off its rectangle
         ls.L = environment_radiance(s, l, ls.wi);
         ls.infinite = true;
         break;

@@ -23,7 +23,14 @@ struct Medium {
   Float g = 0.f;                   // Henyey-Greenstein asymmetry, in [-0.99, 0.99]
   int32_t grid = -1;               // >= 0: a density grid (SceneView::grids) scales sigma_a, sigma_s and Le
   int32_t grid_emits = 0;          // 1: the grid's emission (a temperature or Lescale grid) glows, whatever Le is
+  // 1: the inside of a "subsurface" material. Its scattering events are one
+  // random walk, which costs one bounce of maxdepth as pbrt-v4's BSSRDF does
+  // (at most kMaxSubsurfaceEvents of them), and take no light samples: the
+  // boundary around them blocks every one (the walk's exit takes them).
+  int32_t subsurface = 0;
 };
+
+constexpr int32_t kMaxSubsurfaceEvents = 4096;
 
 // The media on either side of a surface (-1: vacuum); inside is the side the
 // geometric normal points away from. A surface with inside == outside is not a

@@ -46,7 +46,8 @@ int pieces_for(const Vec3* b, Float twist, int split_depth) {
   const Float turning =
       angle_between(b[1] - b[0], b[2] - b[1]) + angle_between(b[2] - b[1], b[3] - b[2]) + twist;
   const int most = 1 << std::clamp(split_depth, 0, 8);
-  return std::clamp(static_cast<int>(std::ceil(turning / 0.15f)), 1, most);
+  if (!(turning >= 0.f)) return most;  // NaN from overflowing points: never cast it
+  return static_cast<int>(std::clamp(std::ceil(turning / 0.15f), 1.f, static_cast<Float>(most)));
 }
 
 // Unit n(u) on the great circle from n0 to n1 (pbrt-v4's ribbon normal).
@@ -61,6 +62,8 @@ Vec3 ribbon_normal(const Vec3& n0, const Vec3& n1, Float u) {
 
 CurveSegments curve_segments(const std::vector<Vec3>& p, const std::string& basis, int degree, CurveType type,
                              const std::vector<Vec3>& normals) {
+  for (const Vec3& q : p)
+    if (!is_finite(q)) throw SceneError("curve control points must be finite (NaN or Inf in \"P\")");
   if (degree != 2 && degree != 3)
     throw SceneError("curve \"degree\" " + std::to_string(degree) + " is not supported (2 or 3)");
   const size_t d = static_cast<size_t>(degree);
@@ -84,7 +87,16 @@ CurveSegments curve_segments(const std::vector<Vec3>& p, const std::string& basi
     if (normals.size() != segments + 1)
       throw SceneError("ribbon curve needs " + std::to_string(segments + 1) + " normals \"N\" (one per segment end), has " +
                        std::to_string(normals.size()));
-    c.normals = normals;
+    for (const Vec3& n : normals)
+      if (!(glm::length(n) > 0.f) || !(glm::length(n) < kInfinity))
+        throw SceneError("ribbon curve normals \"N\" must be finite and not zero");
+    c.normals.reserve(normals.size());
+    for (size_t i = 0; i < normals.size(); ++i) {
+      c.normals.push_back(glm::normalize(normals[i]));
+      if (i > 0 && glm::dot(c.normals[i], c.normals[i - 1]) < -0.9999f)
+        throw SceneError("ribbon curve normals \"N\" " + std::to_string(i - 1) + " and " + std::to_string(i) +
+                         " are opposite: the ribbon's twist between them is undefined");
+    }
   }
   c.cps.reserve(4 * segments);
   for (size_t s = 0; s < segments; ++s) {
@@ -112,6 +124,12 @@ MeshDesc tessellate_curve(const CurveSegments& curve) {
   MeshDesc m;
   const size_t segments = curve.cps.size() / 4;
   const bool ribbon = curve.type == CurveType::Ribbon;
+  // Refused before anything is allocated: at most 2^splitdepth pieces per segment.
+  const uint64_t most_pieces = uint64_t(1) << std::clamp(curve.split_depth, 0, 8);
+  const uint64_t most_triangles = segments * most_pieces * (ribbon ? 2 : 2 * kCurveTubeSides);
+  if (most_triangles > kMaxCurveTriangles)
+    throw SceneError("curve would make up to " + std::to_string(most_triangles) + " triangles (at most " +
+                     std::to_string(kMaxCurveTriangles) + " per shape; lower \"splitdepth\")");
   // A regular n-gon of circumradius r has mean projected width 2 n r sin(pi/n) / pi.
   const Float tube_scale = static_cast<Float>(kPiD / (kCurveTubeSides * std::sin(kPiD / kCurveTubeSides)));
   Vec3 reference(0.f);  // the tube's first side, carried along the curve so that rings do not twist
@@ -123,13 +141,15 @@ MeshDesc tessellate_curve(const CurveSegments& curve) {
     const Float w1 = glm::mix(curve.width0, curve.width1, static_cast<Float>(s + 1) / segments);
     const uint32_t first = static_cast<uint32_t>(m.p.size());
     const int ring_size = ribbon ? 2 : kCurveTubeSides + 1;
-    bool ok = true;
+    // A segment without width (both ends 0) or direction makes nothing; a
+    // tapered one closes to a point (those triangles are dropped as degenerate).
+    bool ok = w0 > 0.f || w1 > 0.f;
     for (int i = 0; i <= pieces && ok; ++i) {
       const Float u = static_cast<Float>(i) / pieces;
       const Vec3 c = bezier_point(b, u);
-      const Float width = glm::mix(w0, w1, u);
+      const Float width = glm::max(glm::mix(w0, w1, u), 0.f);
       Vec3 t;
-      if (!unit_tangent(b, u, &t) || !(width > 0.f)) {
+      if (!unit_tangent(b, u, &t) || !is_finite(c)) {
         ok = false;
         break;
       }

@@ -27,6 +27,9 @@ namespace tessera {
 enum class CurveType { Flat, Cylinder, Ribbon };
 
 constexpr int kCurveTubeSides = 6;
+// The most triangles one Shape "curve" may make (its worst case is checked
+// before any is made): 2^25, as a displaced plymesh.
+constexpr uint64_t kMaxCurveTriangles = uint64_t(1) << 25;
 
 // A curve as pbrt-v4 reads it: cubic Bezier segments in object space.
 struct CurveSegments {
@@ -40,13 +43,15 @@ struct CurveSegments {
 // pbrt-v4's "P", "basis" (bezier, bspline), "degree" (2, 3) and "N" as cubic
 // Bezier segments. Throws SceneError (without a location) for counts pbrt-v4
 // refuses: a Bezier of degree d needs 1 + n d points (n >= 1), a B-spline
-// at least d + 1, ribbons one normal per segment end.
+// at least d + 1, ribbons one normal per segment end (finite, not zero, no
+// two in a row opposite); control points must be finite.
 CurveSegments curve_segments(const std::vector<Vec3>& p, const std::string& basis, int degree, CurveType type,
                              const std::vector<Vec3>& normals);
 
 // The triangles of a curve, in object space: uv = (u within its segment,
-// around the tube or across the ribbon). Degenerate pieces (zero width, a
-// segment that is a point) make no triangles.
+// around the tube or across the ribbon). A segment that is a point or has no
+// width at either end makes no triangles; a tapered one closes to a point.
+// Throws SceneError when the worst case exceeds kMaxCurveTriangles.
 MeshDesc tessellate_curve(const CurveSegments& curve);
 
 }  // namespace tessera

@@ -23,6 +23,12 @@ std::string light_paths_obstacle(const SceneDesc& desc) {
   if (desc.camera.world_from_camera_end != desc.camera.world_from_camera) return "the camera moves";
   for (const MeshDesc& m : desc.meshes)
     if (!m.p_end.empty()) return "a shape moves";
+  // Light paths connect to the camera through BSDFs evaluated the other way
+  // round: the subsurface exit lobe and hair's offset from wo are not
+  // reciprocal.
+  for (const Material& m : desc.materials)
+    if (m.type == MaterialType::Subsurface || m.type == MaterialType::Hair)
+      return "the scene has a subsurface or hair material";
   bool light = !desc.area_lights.empty();
   for (const Light& l : desc.lights)
     light = light || l.type == LightType::Point || l.type == LightType::Spot || l.type == LightType::Goniometric ||

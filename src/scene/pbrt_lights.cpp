@@ -46,15 +46,15 @@ void require_finite_texels(const ImageDesc& img, const DirectiveContext& ctx) {
       ctx.fail("image '" + img.path + "' has NaN or infinite texels; a light needs finite ones");
 }
 
-// pbrt-v4's infinite-light "portal": four points of a rectangle (light
-// space), emission only through its front (z = normalize(p3 - p0) x
+// pbrt-v4's infinite-light "portal": four points of a rectangle (world
+// space, placed by render_from_world), emission only through its front (z = normalize(p3 - p0) x
 // normalize(p1 - p0), pbrt-v4's Frame::FromXY). A portal that is not a
 // rectangle (pbrt-v4's tolerance, 0.001) is refused.
-void read_portal(Light& l, const std::vector<Vec3>& p, const Mat4& world_from_light, const DirectiveContext& ctx) {
+void read_portal(Light& l, const std::vector<Vec3>& p, const Mat4& render_from_world, const DirectiveContext& ctx) {
   if (p.size() != 4) ctx.fail("infinite light \"portal\" needs 4 points, has " + std::to_string(p.size()));
   Vec3 w[4];
   for (int i = 0; i < 4; ++i) {
-    w[i] = transform_point(world_from_light, p[i]);
+    w[i] = transform_point(render_from_world, p[i]);
     if (!std::isfinite(w[i].x) || !std::isfinite(w[i].y) || !std::isfinite(w[i].z))
       ctx.fail("infinite light \"portal\" has a non-finite point");
   }
@@ -62,8 +62,10 @@ void read_portal(Light& l, const std::vector<Vec3>& p, const Mat4& world_from_li
   for (const Vec3& e : {e01, e03, e12, e32})
     if (!(glm::length(e) > 0.f)) ctx.fail("infinite light \"portal\" has coincident points");
   const Vec3 p01 = glm::normalize(e01), p03 = glm::normalize(e03), p12 = glm::normalize(e12), p32 = glm::normalize(e32);
-  if (std::fabs(glm::dot(p01, p32) - 1.f) > 0.001f || std::fabs(glm::dot(p12, p03) - 1.f) > 0.001f ||
-      std::fabs(glm::dot(p01, p12)) > 0.001f || std::fabs(glm::dot(p03, p32)) > 0.001f)
+  // Written as "not within": NaN from overflowing edges fails too.
+  if (!(std::fabs(glm::dot(p01, p32) - 1.f) <= 0.001f) || !(std::fabs(glm::dot(p12, p03) - 1.f) <= 0.001f) ||
+      !(std::fabs(glm::dot(p01, p12)) <= 0.001f) || !(std::fabs(glm::dot(p03, p32)) <= 0.001f) ||
+      !(glm::length(glm::cross(e01, e03)) < kInfinity))
     ctx.fail("infinite light \"portal\" is not a rectangle (points in order around it)");
   l.portal_p0 = w[0];
   l.portal_s = e01;
@@ -75,6 +77,7 @@ void read_portal(Light& l, const std::vector<Vec3>& p, const Mat4& world_from_li
 }  // namespace
 
 std::optional<Light> make_light(const std::string& type, const ParamSet& params, const Mat4& world_from_light,
+                                const Mat4& render_from_world,
                                 const DirectiveContext& ctx) {
   Light l;
   const Float scale = params.get_float("scale", 1.f);
@@ -190,7 +193,7 @@ std::optional<Light> make_light(const std::string& type, const ParamSet& params,
       const double k_e = l.image >= 0 ? image_upper_illuminance(ctx.scene.images[l.image]) : kPi;
       if (k_e > 0.0) l.L *= static_cast<Float>(illuminance / k_e);
     }
-    if (params.find_any("portal")) read_portal(l, params.get_point3s("portal"), world_from_light, ctx);
+    if (params.find_any("portal")) read_portal(l, params.get_point3s("portal"), render_from_world, ctx);
     l.light_from_world = glm::inverse(Mat3(world_from_light));
   } else {
     ctx.warn("light \"" + type + "\" is not supported; skipped");

@@ -147,6 +147,7 @@ void read_hair(Material& m, const ParamSet& params, const DirectiveContext& ctx)
     m.pheomelanin = float_slot(params, "pheomelanin", 0.f, ctx);
   }
   m.ior = read_ior(params, "eta", 1.55f, ctx);
+  if (!(m.ior > 0.f) || !std::isfinite(m.ior)) ctx.fail("hair \"eta\" must be positive");
   m.beta_m = float_slot(params, "beta_m", 0.3f, ctx);
   m.beta_n = float_slot(params, "beta_n", 0.3f, ctx);
   m.hair_alpha = float_slot(params, "alpha", 2.f, ctx);
@@ -164,32 +165,45 @@ void read_subsurface(Material& m, const ParamSet& params, const DirectiveContext
   m.type = MaterialType::Subsurface;
   m.ior = read_ior(params, "eta", 1.33f, ctx);
   read_roughness(m, params, ctx);
+  if (!(m.ior > 0.f) || !std::isfinite(m.ior)) ctx.fail("subsurface \"eta\" must be positive");
   const Float scale = params.get_float("scale", 1.f);
   if (!(scale >= 0.f) || !std::isfinite(scale)) ctx.fail("subsurface \"scale\" must be finite and not negative");
   Rgb sigma_a(0.0011f, 0.0024f, 0.014f), sigma_s(2.55f, 3.21f, 3.77f);
+  // A float or rgb constant, or a constant texture.
   auto constant = [&](const char* name, Rgb fallback) {
-    if (params.get_texture(name)) ctx.warn(std::string("a texture for subsurface \"") + name + "\" is not supported; using its default");
-    return params.get_rgb(name, /*allow_float=*/true).value_or(fallback);
+    if (const std::optional<Rgb> v = params.get_rgb(name, /*allow_float=*/true)) return *v;
+    return read_constant_rgb(params, name, fallback, ctx);
   };
   const std::string name = params.get_string("name", "");
+  const bool has_a = params.find_any("sigma_a") != nullptr, has_s = params.find_any("sigma_s") != nullptr;
   if (!name.empty()) {
     if (!medium_preset(name, &sigma_a, &sigma_s)) ctx.fail("subsurface \"name\" \"" + name + "\" is not a known medium");
-  } else if (params.find_any("sigma_a") || params.find_any("sigma_s")) {
-    sigma_a = constant("sigma_a", sigma_a);
-    sigma_s = constant("sigma_s", sigma_s);
+    sigma_a *= scale;
+    sigma_s *= scale;
+  } else if (has_a || has_s) {
+    if (!(has_a && has_s)) ctx.fail("subsurface needs both \"sigma_a\" and \"sigma_s\"");
+    sigma_a = scale * constant("sigma_a", sigma_a);
+    sigma_s = scale * constant("sigma_s", sigma_s);
   } else if (params.find_any("reflectance")) {
+    // pbrt-v4: the mean free path is scale x mfp.
     const Rgb r = glm::clamp(constant("reflectance", Rgb(0.5f)), Rgb(0.f), Rgb(1.f));
-    const Rgb mfp = constant("mfp", Rgb(1.f));
-    if (!(glm::min(mfp.x, glm::min(mfp.y, mfp.z)) > 0.f)) ctx.fail("subsurface \"mfp\" must be positive");
+    const Rgb mfp = scale * constant("mfp", Rgb(1.f));
     for (int c = 0; c < 3; ++c) {
+      if (!(mfp[c] > 0.f) || !std::isfinite(1.f / mfp[c])) ctx.fail("subsurface \"mfp\" times \"scale\" must be positive");
       const Float albedo = random_walk_albedo(r[c]);
       sigma_s[c] = albedo / mfp[c];
       sigma_a[c] = (1.f - albedo) / mfp[c];
     }
+  } else {
+    sigma_a *= scale;
+    sigma_s *= scale;
   }
+  if (!valid_coefficient(sigma_a) || !valid_coefficient(sigma_s))
+    ctx.fail("subsurface coefficients must be finite and not negative");
   Medium medium;
-  medium.sigma_a = scale * glm::max(sigma_a, Rgb(0.f));
-  medium.sigma_s = scale * glm::max(sigma_s, Rgb(0.f));
+  medium.sigma_a = sigma_a;
+  medium.sigma_s = sigma_s;
+  medium.subsurface = 1;
   medium.g = std::clamp(params.get_float("g", 0.f), -0.99f, 0.99f);
   if (!std::isfinite(medium.g)) ctx.fail("subsurface \"g\" must be finite");
   if (ctx.scene.media.size() >= static_cast<size_t>(INT16_MAX)) ctx.fail("too many media (at most 32767)");

@@ -68,11 +68,6 @@ const MeasuredMedium kPresets[] = {
     {"Pacific Ocean Surface Water", {0.0001764f, 0.00032095f, 0.00019617f}, {0.031845f, 0.031324f, 0.030147f}},
 };
 
-bool valid_coefficient(const Rgb& c) {
-  for (int i = 0; i < 3; ++i)
-    if (!(c[i] >= 0.f) || !std::isfinite(c[i])) return false;
-  return true;
-}
 
 // The inverse of the CTM at MakeNamedMedium (pbrt-v4's medium space).
 Mat4 medium_from_world_of(const Mat4& world_from_medium, const DirectiveContext& ctx) {
@@ -317,6 +312,12 @@ int32_t read_nanovdb(const ParamSet& params, const Mat4& world_from_medium, Medi
 }
 
 }  // namespace
+
+bool valid_coefficient(const Rgb& c) {
+  for (int i = 0; i < 3; ++i)
+    if (!(c[i] >= 0.f) || !std::isfinite(c[i])) return false;
+  return true;
+}
 
 bool medium_preset(const std::string& name, Rgb* sigma_a, Rgb* sigma_s) {
   for (const MeasuredMedium& m : kPresets) {

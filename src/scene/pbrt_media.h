@@ -18,4 +18,7 @@ Medium make_medium(const std::string& type, const ParamSet& params, const Mat4& 
 // GetMediumScatteringProperties gives them; false for an unknown name.
 bool medium_preset(const std::string& name, Rgb* sigma_a, Rgb* sigma_s);
 
+// A scattering or absorption coefficient: finite and not negative in every channel.
+bool valid_coefficient(const Rgb& c);
+
 }  // namespace tessera

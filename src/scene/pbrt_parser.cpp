@@ -388,7 +388,7 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     std::string type = read_string(tokens, pos, at);
     ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
     if (state_.ctm_end != state_.ctm) warn("a moving light stays where it starts (pbrt-v4 uses its start transform too)");
-    if (auto light = make_light(type, ps, ctm, context(at, including_dir))) {
+    if (auto light = make_light(type, ps, ctm, Mat4(render_from_world_), context(at, including_dir))) {
       if (!open_instance_.empty()) warn("lights inside ObjectBegin are not instanced; added once");
       light->medium = state_.media.outside;  // resolved with the other medium names in resolve_media()
       scene_.lights.push_back(*light);
@@ -520,9 +520,10 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
   scene_.camera.projection = projection;
   // pbrt-v4's CameraBase parameters.
   if (const std::vector<Float> w = params.get_floats("screenwindow"); !w.empty()) {
-    if (w.size() != 4 || !(w[1] > w[0]) || !(w[3] > w[2]) || !std::isfinite(w[0]) || !std::isfinite(w[1]) ||
+    // pbrt-v4 takes a reversed window too (a mirrored image); an empty one has no pixels.
+    if (w.size() != 4 || !(w[1] != w[0]) || !(w[3] != w[2]) || !std::isfinite(w[0]) || !std::isfinite(w[1]) ||
         !std::isfinite(w[2]) || !std::isfinite(w[3]))
-      fail(at, "camera \"screenwindow\" needs four finite values x0 < x1, y0 < y1");
+      fail(at, "camera \"screenwindow\" needs four finite values x0 x1 y0 y1 with x0 != x1, y0 != y1");
     scene_.camera.has_screen_window = true;
     scene_.camera.screen_window = Vec4(w[0], w[1], w[2], w[3]);
   }

@@ -274,10 +274,21 @@ MeshDesc curve_mesh(const ParamSet& params, const ShapeContext& ctx) {
   if (!(c.width0 >= 0.f) || !(c.width1 >= 0.f) || !std::isfinite(c.width0) || !std::isfinite(c.width1))
     fail(ctx, "curve widths must be finite and not negative");
   c.split_depth = params.get_int("splitdepth", 3);
-  if (type == CurveType::Flat)
-    warn(ctx, "\"flat\" curves are rendered as round tubes: the same silhouette, and for hair the same "
-              "offsets across the fibre; other materials shade as on a cylinder");
-  return tessellate_curve(c);
+  if (type == CurveType::Flat) {
+    // Once per scene: hair files hold thousands of curves.
+    const std::string note = "\"flat\" curves are rendered as round tubes";
+    bool said = false;
+    if (ctx.warnings)
+      for (const std::string& w : *ctx.warnings) said = said || w.find(note) != std::string::npos;
+    if (!said)
+      warn(ctx, note + ": the same silhouette, and for hair the same offsets across the fibre; other materials "
+                       "shade as on a cylinder (said once for all curves)");
+  }
+  try {
+    return tessellate_curve(c);
+  } catch (const SceneError& e) {
+    fail(ctx, e.what());
+  }
 }
 
 Mat3 normal_matrix(const Mat4& m) { return glm::transpose(glm::inverse(Mat3(m))); }

@@ -1,6 +1,6 @@
 #include "worker/embree_backend.h"
 
-#include "kernels/alpha.h"
+#include "kernels/hit_filter.h"
 
 #include <cstring>
 #include <stdexcept>

@@ -183,6 +183,26 @@ TEST(FarmProtocol, SceneSurvivesTheWire) {
   EXPECT_EQ(d_back.view().camera.film_width, 18);
   EXPECT_FALSE(d_back.view().layered_mis_balance);
   EXPECT_EQ(c.view().lights[0].L, d_back.view().lights[0].L);
+  // The camera's projection and screen window, curve tubes' one-way faces,
+  // a portal, a subsurface medium.
+  SceneDesc f = load_pbrt_string(
+      "Camera \"orthographic\" \"float screenwindow\" [ -2 2 -1 1 ] \"float frameaspectratio\" 2\nWorldBegin\n"
+      "LightSource \"infinite\" \"point3 portal\" [ 0 1 0  1 1 0  1 1 1  0 1 1 ]\n"
+      "Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"string type\" \"cylinder\"\n"
+      "Material \"subsurface\"\nShape \"sphere\"\n",
+      "wire2.pbrt", ".");
+  SceneDesc f_back = decode_scene(encode_scene(f));
+  EXPECT_EQ(f_back.camera.projection, CameraProjection::Orthographic);
+  EXPECT_TRUE(f_back.camera.has_screen_window);
+  EXPECT_EQ(f_back.camera.screen_window, f.camera.screen_window);
+  EXPECT_EQ(f_back.camera.frame_aspect_ratio, 2.f);
+  EXPECT_TRUE(f_back.meshes[0].invisible_from_inside);
+  EXPECT_EQ(f_back.meshes[1].media.inside, f.meshes[1].media.inside);
+  SceneData g(std::move(f)), g_back(std::move(f_back));
+  EXPECT_EQ(g.fingerprint(), g_back.fingerprint());
+  EXPECT_EQ(g.film_fingerprint(), g_back.film_fingerprint());
+  EXPECT_EQ(g.view().lights[0].portal_area, g_back.view().lights[0].portal_area);
+  EXPECT_TRUE(g_back.view().has_one_way_faces);
 }
 
 TEST(FarmProtocol, WorkerFailureReachesTheMaster) {

@@ -202,7 +202,7 @@ TEST(HairSampling, WeightsAreOneWithoutAbsorption) {
 // pbrt-v4's Hair.SamplingConsistency, per channel, with absorption and a
 // non-uniform incident radiance: the importance-sampled estimate of the
 // reflected radiance agrees with the stratified uniform one within 3 standard
-// errors of the former plus 0.5 % (the latter's own error, measured ~0.1 %).
+// errors of the former plus 0.5 % (a bound on the latter's own error).
 TEST(HairSampling, ConsistentWithUniformSampling) {
   Rng rng = Rng::for_sample(23, 0, 0);
   auto li = [](const Vec3& w) { return (1.2f + w.y) * (1.2f + 0.5f * w.x); };

@@ -39,13 +39,14 @@ TEST(CameraProjection, OrthographicRaysAreParallelFromTheScreenWindow) {
   EXPECT_DIR_NEAR(corner.d, Vec3(0.f, 0.f, 1.f));
   const Ray centre = generate_camera_ray(c, Vec2(10.f, 5.f));
   EXPECT_DIR_NEAR(centre.o, c.origin);
-  // A lens focused at 4: every lens point's ray meets the pinhole ray there.
+  // A lens focused at 4: every lens point's ray meets the pinhole ray there,
+  // leaving (as pbrt-v4 writes it) from the lens around the camera's origin.
   const Ray pinhole = generate_camera_ray(c, Vec2(15.f, 2.f));
   c.lens_radius = 0.3f;
   c.focal_distance = 4.f;
   for (Vec2 u : {Vec2(0.1f, 0.7f), Vec2(0.9f, 0.2f)}) {
     const Ray r = generate_camera_ray(c, Vec2(15.f, 2.f), u);
-    EXPECT_GT(glm::length(r.o - pinhole.o), 0.f);
+    EXPECT_LE(glm::length(r.o - c.origin), 0.3f + 1e-6f);
     const Vec3 focus = r.o + r.d * ((c.origin.z + 4.f - r.o.z) / r.d.z);
     EXPECT_DIR_NEAR(focus, pinhole.o + Vec3(0.f, 0.f, 4.f));
   }
@@ -130,7 +131,7 @@ Shape "trianglemesh" "point3 P" [ -1000 5 -1000  1000 5 -1000  1000 5 1000  -100
 TEST(CameraProjection, BadParametersAreErrors) {
   auto error = [](const std::string& camera) {
     try {
-      load_pbrt_string(camera + "\nWorldBegin\n", "cam.pbrt", ".");
+      load_pbrt_string(camera + "\nWorldBegin\nLightSource \"infinite\"\n", "cam.pbrt", ".");
     } catch (const SceneError& e) {
       return std::string(e.what());
     }
@@ -138,8 +139,9 @@ TEST(CameraProjection, BadParametersAreErrors) {
   };
   EXPECT_NE(error("Camera \"spherical\" \"string mapping\" \"cubemap\"").find("cam.pbrt:1: spherical camera \"mapping\""),
             std::string::npos);
-  EXPECT_NE(error("Camera \"orthographic\" \"float screenwindow\" [ 1 -1 -1 1 ]").find("\"screenwindow\" needs"),
+  EXPECT_NE(error("Camera \"orthographic\" \"float screenwindow\" [ 1 1 -1 1 ]").find("\"screenwindow\" needs"),
             std::string::npos);
+  EXPECT_EQ(error("Camera \"orthographic\" \"float screenwindow\" [ 1 -1 -1 1 ]"), "");  // mirrored, as pbrt-v4
   EXPECT_NE(error("Camera \"perspective\" \"float frameaspectratio\" -2").find("\"frameaspectratio\" must be positive"),
             std::string::npos);
 }

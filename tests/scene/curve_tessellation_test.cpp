@@ -144,6 +144,36 @@ TEST(CurveTessellation, ErrorsNameTheFileAndLine) {
   EXPECT_NE(test::load_error(head + "Shape \"curve\"\n").find("curve needs \"point3 P\""), std::string::npos);
 }
 
+TEST(CurveTessellation, TaperedCurvesCloseToAPoint) {
+  SceneDesc s = load_world("Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"string type\" \"cylinder\" "
+                           "\"float width0\" 0.1 \"float width1\" 0\n");
+  ASSERT_EQ(s.meshes.size(), 1u);
+  EXPECT_FALSE(s.meshes[0].indices.empty());
+  EXPECT_NEAR(glm::length(s.meshes[0].p.back() - Vec3(3, 0, 0)), 0.f, 1e-6f);  // the tip
+}
+
+TEST(CurveTessellation, HostileInputIsAnError) {
+  const std::string head = "WorldBegin\n";
+  EXPECT_NE(test::load_error(head + "Shape \"curve\" \"point3 P\" [ 0 0 0  1 nan 0  2 0 0  3 0 0 ]\n").find("bad.pbrt:2:"),
+            std::string::npos);
+  // Finite points whose transform overflows.
+  EXPECT_NE(test::load_error(head + "Scale 1e30 1e30 1e30\nShape \"curve\" \"point3 P\" [ 0 0 0  1e10 0 0  2e10 0 0  3e10 0 0 ]\n")
+                .find("bad.pbrt:3:"),
+            std::string::npos);
+  EXPECT_NE(test::load_error(head + "Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"string type\" \"ribbon\" "
+                                    "\"normal N\" [ 0 0 0  0 1 0 ]\n")
+                .find("finite and not zero"),
+            std::string::npos);
+  EXPECT_NE(test::load_error(head + "Shape \"curve\" \"point3 P\" [ 0 0 0  1 0 0  2 0 0  3 0 0 ] \"string type\" \"ribbon\" "
+                                    "\"normal N\" [ 0 1 0  0 -1 0 ]\n")
+                .find("are opposite"),
+            std::string::npos);
+  // A huge point count with the deepest split is refused before it is tessellated.
+  std::string many = "Shape \"curve\" \"integer splitdepth\" 8 \"point3 P\" [ ";
+  for (int i = 0; i < 3 * 12000 + 1; ++i) many += std::to_string(i) + " 0 0 ";
+  EXPECT_NE(test::load_error(head + many + "]\n").find("triangles (at most"), std::string::npos);
+}
+
 TEST(CurveTessellation, DegenerateSegmentsMakeNoTriangles) {
   CurveSegments c = curve_segments({{1, 1, 1}, {1, 1, 1}, {1, 1, 1}, {1, 1, 1}, {2, 1, 1}, {3, 1, 1}, {4, 1, 1}},
                                    "bezier", 3, CurveType::Cylinder, {});

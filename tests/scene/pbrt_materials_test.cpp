@@ -320,8 +320,7 @@ TEST(PbrtMaterials, SubsurfaceMakesAMediumInsideItsShapes) {
   EXPECT_EQ(s.meshes.back().media.inside, m.subsurface_medium);
   EXPECT_EQ(s.meshes.back().media.outside, -1);
   EXPECT_VEC3_NEAR(s.media[m.subsurface_medium].sigma_s, Vec3(2.55f, 3.21f, 3.77f), 1e-6f);
-  EXPECT_GT(m.exit_norm, 0.5f);  // 1 - 2 (Fresnel moment): about 0.8 for eta 1.33
-  EXPECT_LT(m.exit_norm, 1.f);
+  EXPECT_NEAR(m.exit_norm, 0.934f, 0.002f);  // 1 - 2 x Fresnel's first moment at eta 1.33
   EXPECT_TRUE(s.warnings.empty());
 
   s = load_world(std::string("Material \"subsurface\" \"string name\" \"Ketchup\" \"float scale\" 2 \"float g\" 0.5\n") + kTriangle);
@@ -340,8 +339,18 @@ TEST(PbrtMaterials, SubsurfaceMakesAMediumInsideItsShapes) {
   EXPECT_NE(test::load_error("WorldBegin\nMaterial \"subsurface\" \"string name\" \"Jam\"\n").find("\"Jam\" is not a known medium"),
             std::string::npos);
   EXPECT_NE(test::load_error("WorldBegin\nMaterial \"subsurface\" \"rgb reflectance\" [ 1 1 1 ] \"float mfp\" 0\n")
-                .find("\"mfp\" must be positive"),
+                .find("\"mfp\" times \"scale\" must be positive"),
             std::string::npos);
+  EXPECT_NE(test::load_error("WorldBegin\nMaterial \"subsurface\" \"rgb sigma_a\" [ 1 1 1 ]\n").find("needs both"),
+            std::string::npos);
+  EXPECT_NE(test::load_error("WorldBegin\nMaterial \"subsurface\" \"float eta\" 0\n").find("\"eta\" must be positive"),
+            std::string::npos);
+  // pbrt-v4: the mean free path is scale x mfp.
+  s = load_world(std::string("Material \"subsurface\" \"rgb reflectance\" [ 0.5 0.5 0.5 ] \"float mfp\" 0.5 \"float scale\" 4\n") +
+                 kTriangle);
+  const Medium& scaled = s.media[material_of_last_mesh(s).subsurface_medium];
+  EXPECT_VEC3_NEAR(scaled.sigma_a + scaled.sigma_s, Vec3(0.5f), 1e-5f);
+  EXPECT_EQ(scaled.subsurface, 1);
 }
 
 }  // namespace

@@ -1,0 +1,31 @@
+// Candidate hits a ray query skips, for every backend: alpha cutouts
+// (alpha.h) and the one-way faces of curve tubes (kTriInvisibleFromInside).
+#pragma once
+
+#include "alpha.h"
+
+namespace tessera {
+
+// Whether a ray query skips this candidate hit: a one-way face met from
+// inside (along its outward normal, at the ray's time for a moving tube), or
+// an alpha cutout. Backends call it for every candidate when the scene has
+// either (SceneView::triangle_alpha, has_one_way_faces).
+TESSERA_HOST_DEVICE inline bool hit_ignored(const SceneView& s, uint32_t tri, Float b1, Float b2, const Vec3& o,
+                                            const Vec3& d, Float time) {
+  const TriangleInfo& info = s.triangles[tri];
+  if (info.flags & kTriInvisibleFromInside) {
+    Vec3 n = s.face_normals[tri];
+    if (s.positions_end && time > 0.f) {
+      const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
+      Vec3 moved;
+      if (triangle_normal(glm::mix(s.positions[idx[0]], s.positions_end[idx[0]], time),
+                          glm::mix(s.positions[idx[1]], s.positions_end[idx[1]], time),
+                          glm::mix(s.positions[idx[2]], s.positions_end[idx[2]], time), &moved, nullptr))
+        n = (info.flags & kTriFlipNormal) ? -moved : moved;
+    }
+    if (glm::dot(d, n) > 0.f) return true;
+  }
+  return s.triangle_alpha && alpha_ignores_hit(s, tri, b1, b2, o, d, time);
+}
+
+}  // namespace tessera
