@@ -21,6 +21,7 @@
 
 #include "kernels/bsdf.h"
 #include "kernels/rng.h"
+#include "chi2.h"
 
 using namespace tessera;
 
@@ -91,36 +92,6 @@ Vec3 spherical(double theta, double phi) {
 bool finite3(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // ------------------------------------------------------ chi^2 machinery ---
-// Regularised lower incomplete gamma P(a, x) (Numerical Recipes gser/gcf).
-double gamma_p(double a, double x) {
-  if (x <= 0.0) return 0.0;
-  double gln = std::lgamma(a);
-  if (x < a + 1.0) {
-    double ap = a, sum = 1.0 / a, del = sum;
-    for (int n = 0; n < 100000; ++n) {
-      ap += 1.0;
-      del *= x / ap;
-      sum += del;
-      if (std::abs(del) < std::abs(sum) * 1e-15) break;
-    }
-    return sum * std::exp(-x + a * std::log(x) - gln);
-  }
-  double b = x + 1.0 - a, c = 1.0 / 1e-300, d = 1.0 / b, h = d;
-  for (int i = 1; i < 100000; ++i) {
-    double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < 1e-300) d = 1e-300;
-    c = b + an / c;
-    if (std::abs(c) < 1e-300) c = 1e-300;
-    d = 1.0 / d;
-    double del = d * c;
-    h *= del;
-    if (std::abs(del - 1.0) < 1e-15) break;
-  }
-  return 1.0 - std::exp(-x + a * std::log(x) - gln) * h;
-}
-double chi2_survival(double chsq, int dof) { return 1.0 - gamma_p(0.5 * dof, 0.5 * chsq); }
 
 constexpr int kThetaRes = 20, kPhiRes = 40;
 constexpr int kSamples = 500000;
@@ -221,7 +192,7 @@ Chi2Outcome chi2_test(const BsdfParams& sampled, const BsdfParams& claimed, cons
     ++dof;
   }
   dof -= 1;
-  out.pvalue = dof > 0 ? chi2_survival(chsq, dof) : 1.0;
+  out.pvalue = dof > 0 ? chi2::chi2_survival(chsq, dof) : 1.0;
   char buf[256];
   std::snprintf(buf, sizeof buf, "chi2=%.1f dof=%d p=%.3g integral=%.5f sampled=%.5f stray=%.2g", chsq, dof,
                 out.pvalue, out.pdf_integral, out.sampled_fraction, out.stray);

@@ -30,6 +30,7 @@
 #include "kernels/hair.h"
 #include "kernels/rng.h"
 #include "kernels/sampling.h"
+#include "chi2.h"
 
 using namespace tessera;
 
@@ -278,35 +279,6 @@ TEST(HairSampling, PdfIntegratesToOneAndMatchesSample) {
 // with a Sidak correction for the number of tests.
 namespace {
 
-double gamma_p(double a, double x) {  // regularised lower incomplete gamma (Numerical Recipes)
-  if (x <= 0.0) return 0.0;
-  const double gln = std::lgamma(a);
-  if (x < a + 1.0) {
-    double ap = a, sum = 1.0 / a, del = sum;
-    for (int n = 0; n < 100000; ++n) {
-      ap += 1.0;
-      del *= x / ap;
-      sum += del;
-      if (std::abs(del) < std::abs(sum) * 1e-15) break;
-    }
-    return sum * std::exp(-x + a * std::log(x) - gln);
-  }
-  double b = x + 1.0 - a, c = 1.0 / 1e-300, d = 1.0 / b, h = d;
-  for (int i = 1; i < 100000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < 1e-300) d = 1e-300;
-    c = b + an / c;
-    if (std::abs(c) < 1e-300) c = 1e-300;
-    d = 1.0 / d;
-    const double del = d * c;
-    h *= del;
-    if (std::abs(del - 1.0) < 1e-15) break;
-  }
-  return 1.0 - std::exp(-x + a * std::log(x) - gln) * h;
-}
-
 constexpr int kURes = 40, kPhiRes = 80, kChi2Samples = 400000, kSimpsonSub = 10;
 constexpr int kNumChi2Tests = 4;
 
@@ -371,7 +343,7 @@ Chi2Outcome chi2_test(const HairFiber& sampled, const HairFiber& claimed, const 
   }
   dof -= 1;
   Chi2Outcome out;
-  out.pvalue = dof > 0 ? 1.0 - gamma_p(0.5 * dof, 0.5 * chsq) : 1.0;
+  out.pvalue = dof > 0 ? chi2::chi2_survival(chsq, dof) : 1.0;
   out.pdf_integral = total;
   out.accepted = double(accepted) / kChi2Samples;
   char buf[160];
