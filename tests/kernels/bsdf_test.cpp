@@ -96,7 +96,7 @@ bool finite3(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) &&
 constexpr int kThetaRes = 20, kPhiRes = 40;
 constexpr int kSamples = 500000;
 constexpr int kSimpsonSub = 20;    // Simpson sub-intervals per cell edge (even)
-constexpr int kNumChi2Tests = 36;  // configurations x wo in the BsdfChi2 tests (Sidak correction)
+constexpr int kNumChi2Tests = 39;  // configurations x wo in the BsdfChi2 tests (Sidak correction)
 
 struct Chi2Outcome {
   double pvalue = 0;
@@ -230,6 +230,22 @@ TEST(BsdfChi2, DiffuseTransmission) {
   }
 }
 
+// Where a subsurface walk leaves: the boundary's outer hemisphere (z > 0),
+// whichever side wo (inside, z < 0) is on.
+BsdfParams subsurface_exit(Float ior) {
+  BsdfParams b;
+  b.type = BsdfType::SubsurfaceExit;
+  b.ior = ior;
+  double moment = 0.0;  // c = 1 - 2 int F(mu) mu dmu, as the loader computes it
+  for (int i = 0; i < 4096; ++i) moment += fr_dielectric(static_cast<Float>((i + 0.5) / 4096), ior) * (i + 0.5) / 4096 / 4096;
+  b.exit_norm = static_cast<Float>(1.0 - 2.0 * moment);
+  return b;
+}
+
+TEST(BsdfChi2, SubsurfaceExit) {
+  for (double t : kWoThetas) expect_chi2("subsurface exit", subsurface_exit(1.33f), spherical(M_PI - t, 0.4), 41);
+}
+
 TEST(BsdfChi2, RoughConductor) {
   const BsdfParams cfgs[3] = {conductor(0.05f, 0.05f), conductor(0.3f, 0.3f), conductor(0.1f, 0.4f)};
   for (const BsdfParams& b : cfgs)
@@ -355,6 +371,21 @@ TEST(BsdfEnergy, DiffuseTransmissionReflectsRAndTransmitsT) {
   }
   // Transmission only: every sample crosses the surface.
   EXPECT_EQ(bsdf_lobes(diffuse_transmission(Rgb(0.f), Rgb(0.5f))), kLobeTransmission | kLobeDiffuse);
+}
+
+TEST(BsdfEnergy, SubsurfaceExitIsNormalised) {
+  // Its energy albedo (radiance's eta^2 for leaving the denser medium taken
+  // out, as albedo() does for every transmission) is exactly 1.
+  for (double t : {0.2, 1.0, 1.5}) {
+    Rgb se;
+    const Rgb a = albedo(subsurface_exit(1.33f), spherical(M_PI - t, 0.3), 40000, 17, &se);
+    EXPECT_NEAR(a.x, 1.0, 0.005);
+  }
+  // The radiance it carries out is eta^2 times that.
+  const Vec3 wo = spherical(M_PI - 0.5, 0.3), wi = spherical(0.7, 1.0);
+  EXPECT_NEAR(bsdf_eval(subsurface_exit(1.33f), wo, wi).x,
+              (1.0 - fr_dielectric(wi.z, 1.33f)) * 1.33 * 1.33 / (subsurface_exit(1.33f).exit_norm * M_PI), 1e-5);
+  EXPECT_EQ(bsdf_lobes(subsurface_exit(1.5f)), kLobeTransmission | kLobeDiffuse);
 }
 
 TEST(BsdfEnergy, WhiteFurnaces) {
