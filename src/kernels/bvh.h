@@ -1,0 +1,171 @@
+// A bounding volume hierarchy over the scene's triangles, built on the host
+// (worker/bvh_build.h) and traversed by code that g++ and nvcc compile
+// alike: the ray queries of the portable backend, on the CPU (where tests
+// compare it with Embree) and on the GPU. Ours, because the GPU needs one
+// (Embree is CPU-only, OptiX is not in Debian); its rules are Embree's:
+// hits at t in (0, tmax], the same candidate filter (hit_filter.h), moving
+// triangles interpolated linearly at the ray's time, and the same
+// barycentrics (b1, b2 of vertices 1 and 2), so the integrator's ray
+// offsets and surface reconstruction serve both.
+#pragma once
+
+#include "hit_filter.h"
+#include "surface.h"
+
+namespace tessera {
+
+// 32 bytes. Inner nodes: the left child follows the node, `offset` is the
+// right child; `count_axis` is kBvhInner | the split axis. Leaves: `offset`
+// indexes BvhView::triangles, `count_axis` is the triangle count (>= 1).
+struct BvhNode {
+  Vec3 lo{0.f};
+  uint32_t offset = 0;
+  Vec3 hi{0.f};
+  uint32_t count_axis = 0;
+};
+
+constexpr uint32_t kBvhInner = 0x80000000u;
+// The traversal stack; the builder keeps the tree shallower than this.
+constexpr int kBvhStackSize = 64;
+
+struct BvhView {
+  const BvhNode* nodes = nullptr;
+  const uint32_t* triangles = nullptr;  // triangle indices, leaf by leaf
+  uint32_t num_nodes = 0;
+};
+
+namespace bvh_detail {
+
+// The ray's entry and exit of a box, as pbrt-v4's Bounds3::IntersectP: the
+// exit widened by 2 gamma(3) so that rounding never culls a box the ray
+// grazes; NaN (0 * inf on a slab's plane) is dropped by fminf/fmaxf.
+TESSERA_HOST_DEVICE inline bool hits_box(const Vec3& lo, const Vec3& hi, const Vec3& o, const Vec3& inv_d, Float tmax) {
+  constexpr Float kWiden = 1.f + 2.f * (3.f * 0x1p-24f) / (1.f - 3.f * 0x1p-24f);
+  Float t0 = 0.f, t1 = tmax;
+  for (int a = 0; a < 3; ++a) {
+    Float near = (lo[a] - o[a]) * inv_d[a], far = (hi[a] - o[a]) * inv_d[a];
+    if (near > far) {
+      const Float tmp = near;
+      near = far;
+      far = tmp;
+    }
+    far *= kWiden;
+    t0 = fmaxf(t0, near);
+    t1 = fminf(t1, far);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+// Watertight ray/triangle intersection (Woop, Benthin and Wald 2013): the
+// edge functions of the triangle sheared into ray space, redone in double
+// where one is exactly 0, so a ray through a shared edge or vertex meets
+// exactly one of its triangles. On a hit in (0, tmax): *t and the
+// barycentrics of vertices 1 and 2.
+TESSERA_HOST_DEVICE inline bool hits_triangle(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& o,
+                                              const Vec3& d, Float tmax, Float* t, Float* b1, Float* b2) {
+  const Vec3 ad = abs3(d);
+  int kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
+  int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
+  if (d[kz] < 0.f) {
+    const int tmp = kx;
+    kx = ky;
+    ky = tmp;
+  }
+  if (d[kz] == 0.f) return false;
+  const Float sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.f / d[kz];
+  const Vec3 a = p0 - o, b = p1 - o, c = p2 - o;
+  const Float ax = a[kx] - sx * a[kz], ay = a[ky] - sy * a[kz];
+  const Float bx = b[kx] - sx * b[kz], by = b[ky] - sy * b[kz];
+  const Float cx = c[kx] - sx * c[kz], cy = c[ky] - sy * c[kz];
+  Float u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
+  if (u == 0.f || v == 0.f || w == 0.f) {
+    u = static_cast<Float>(double(cx) * double(by) - double(cy) * double(bx));
+    v = static_cast<Float>(double(ax) * double(cy) - double(ay) * double(cx));
+    w = static_cast<Float>(double(bx) * double(ay) - double(by) * double(ax));
+  }
+  if ((u < 0.f || v < 0.f || w < 0.f) && (u > 0.f || v > 0.f || w > 0.f)) return false;
+  const Float det = u + v + w;
+  if (det == 0.f) return false;
+  const Float scaled_t = u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz]);
+  // t = scaled_t / det in (0, tmax), compared without the division.
+  if (det > 0.f ? (scaled_t <= 0.f || scaled_t > tmax * det) : (scaled_t >= 0.f || scaled_t < tmax * det)) return false;
+  const Float inv = 1.f / det;
+  *t = scaled_t * inv;
+  *b1 = v * inv;
+  *b2 = w * inv;
+  return *t > 0.f && *t <= tmax;
+}
+
+TESSERA_HOST_DEVICE inline void triangle_at(const SceneView& s, uint32_t tri, Float time, Vec3* p0, Vec3* p1, Vec3* p2) {
+  const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
+  *p0 = s.positions[idx[0]];
+  *p1 = s.positions[idx[1]];
+  *p2 = s.positions[idx[2]];
+  if (s.positions_end && time > 0.f) {
+    *p0 = glm::mix(*p0, s.positions_end[idx[0]], time);
+    *p1 = glm::mix(*p1, s.positions_end[idx[1]], time);
+    *p2 = glm::mix(*p2, s.positions_end[idx[2]], time);
+  }
+}
+
+}  // namespace bvh_detail
+
+// The closest hit in (0, tmax], or with any_hit the first one found (shadow
+// rays). Candidates the scene filters (alpha, one-way faces) are skipped.
+TESSERA_HOST_DEVICE inline bool bvh_trace(const BvhView& bvh, const SceneView& s, const Vec3& o, const Vec3& d,
+                                          Float tmax, Float time, bool any_hit, TraceHit* hit) {
+  if (bvh.num_nodes == 0 || !(tmax > 0.f)) return false;
+  const Vec3 inv_d(1.f / d.x, 1.f / d.y, 1.f / d.z);
+  const bool filtered = s.triangle_alpha || s.has_one_way_faces;
+  uint32_t stack[kBvhStackSize];
+  int top = 0;
+  uint32_t node = 0;
+  bool found = false;
+  for (;;) {
+    const BvhNode& n = bvh.nodes[node];
+    if (bvh_detail::hits_box(n.lo, n.hi, o, inv_d, tmax)) {
+      if (n.count_axis & kBvhInner) {
+        // Nearer child first: the far one waits on the stack.
+        const uint32_t axis = n.count_axis & 3u;
+        const bool right_first = d[axis] < 0.f;
+        if (top < kBvhStackSize) stack[top++] = right_first ? node + 1 : n.offset;
+        node = right_first ? n.offset : node + 1;
+        continue;
+      }
+      for (uint32_t i = 0; i < n.count_axis; ++i) {
+        const uint32_t tri = bvh.triangles[n.offset + i];
+        Vec3 p0, p1, p2;
+        bvh_detail::triangle_at(s, tri, time, &p0, &p1, &p2);
+        Float t, b1, b2;
+        if (!bvh_detail::hits_triangle(p0, p1, p2, o, d, tmax, &t, &b1, &b2)) continue;
+        if (filtered && hit_ignored(s, tri, b1, b2, o, d, time)) continue;
+        tmax = t;
+        hit->t = t;
+        hit->triangle = tri;
+        hit->b1 = b1;
+        hit->b2 = b2;
+        found = true;
+        if (any_hit) return true;
+      }
+    }
+    if (top == 0) return found;
+    node = stack[--top];
+  }
+}
+
+// The ray query interface the integrator takes (EmbreeTracer's), over a BVH.
+struct BvhTracer {
+  BvhView bvh;
+  const SceneView* scene = nullptr;
+
+  TESSERA_HOST_DEVICE bool intersect(const Vec3& o, const Vec3& d, Float tmax, TraceHit* hit, Float time = 0.f) const {
+    return bvh_trace(bvh, *scene, o, d, tmax, time, false, hit);
+  }
+  TESSERA_HOST_DEVICE bool occluded(const Vec3& o, const Vec3& d, Float tmax, Float time = 0.f) const {
+    TraceHit hit;
+    return bvh_trace(bvh, *scene, o, d, tmax, time, true, &hit);
+  }
+};
+
+}  // namespace tessera
