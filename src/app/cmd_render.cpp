@@ -31,6 +31,7 @@
 #include "scene/light_paths.h"
 #include "scene/spectral_choice.h"
 #include "worker/cpu_affinity.h"
+#include "worker/bvh_build.h"
 #include "worker/farm_worker.h"
 
 namespace tessera {
@@ -42,6 +43,7 @@ struct RenderArgs {
   int64_t seed = -1;
   std::string sampler;  // "" = the scene's
   std::string spectral = "auto";
+  std::string backend = "auto";  // auto, embree, bvh, cuda
   std::string light_paths = "auto";
   double time = 0.0;
   double target_error = 0.0;
@@ -399,9 +401,26 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, const EmbreeS
   return r;
 }
 
+// The ray-query backend a render asks for: "auto" is Embree until the
+// CUDA backend exists (a build without it refuses "cuda" in one line).
+std::string chosen_backend(const RenderArgs& a) {
+  if (a.backend == "cuda") throw std::runtime_error("--backend cuda: this build has no CUDA backend");
+  return a.backend == "bvh" ? "bvh" : "embree";
+}
+
 int run_render_local(const RenderArgs& a) {
+  const std::string backend = chosen_backend(a);
   MasterSetup m = prepare_master(a, nullptr);
   EmbreeScene embree(*m.scene);
+  std::fprintf(stderr, "tessera: backend: %s\n", backend.c_str());
+  if (backend == "bvh") {
+    // The portable BVH on this process's threads (the GPU's traversal, run on the CPU).
+    const BvhBuild bvh = build_bvh(m.scene->view());
+    const BvhTracer tracer{bvh.view(), &m.scene->view()};
+    LocalPassExecutor executor(tracer, m.scene->view(), render_threads(m.opt));
+    render_and_write(a, m, embree, &executor, [](RenderStats& s) { s.backend = "bvh"; });
+    return 0;
+  }
   render_and_write(a, m, embree, nullptr);
   return 0;
 }
@@ -410,6 +429,7 @@ int run_render_local(const RenderArgs& a) {
 // starting guide to every rank, schedules tiles, renders too, and writes
 // all outputs; the other ranks render tiles.
 int run_render_farm(const RenderArgs& a) {
+  if (chosen_backend(a) != "embree") throw std::runtime_error("--backend bvh renders locally only (a farm traces with embree)");
   MpiSession mpi;
   std::unique_ptr<Transport> t = mpi.world();
   const bool master = t->rank() == 0;
@@ -490,6 +510,10 @@ CommandRunner add_render_command(CLI::App& app) {
   auto a = std::make_shared<RenderArgs>();
   CLI::App* c = app.add_subcommand("render", "Render a pbrt-v4 scene (default: the built-in Cornell box) to OpenEXR + PNG; under mpirun, as a farm");
   c->add_option("scene", a->scene, "Scene file in pbrt-v4 syntax (omit for the built-in Cornell box)");
+  c->add_option("--backend", a->backend,
+                "Ray queries: auto (embree), embree, bvh (the portable BVH on the CPU, served by the full integrator), "
+                "cuda (not in this build)")
+      ->check(CLI::IsMember({"auto", "embree", "bvh", "cuda"}));
   c->add_option("-o,--output", a->output, "Output EXR (default: the scene's Film filename in the current directory)");
   c->add_option("--spp", a->spp, "Samples per pixel (overrides the scene's Sampler)")->check(CLI::Range(0, 1 << 30));
   c->add_option("--time", a->time, "Time budget in seconds: render whole passes until it is spent")->check(positive_number());

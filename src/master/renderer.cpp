@@ -55,6 +55,9 @@ uint32_t pass_spp_for(uint32_t pass, uint32_t max_pass_spp) {
 LocalPassExecutor::LocalPassExecutor(const EmbreeScene& embree, const SceneView& view, int32_t threads)
     : tracer_(embree.tracer()), view_(view), threads_(std::max(1, threads)) {}
 
+LocalPassExecutor::LocalPassExecutor(const BvhTracer& bvh, const SceneView& view, int32_t threads)
+    : bvh_(&bvh), view_(view), threads_(std::max(1, threads)) {}
+
 void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film,
                                     TileCounters* counters, const std::function<void(uint64_t)>& on_tile_done) {
   std::mutex counters_mutex;
@@ -67,8 +70,9 @@ void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vec
   std::atomic<bool> failed{false};  // a tile threw: the others stop taking tiles
   auto render_one = [&](size_t i) {
     std::vector<Splat> tile_splats;
-    TileCounters tc = render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]),
-                                  light_paths ? &tile_splats : nullptr);
+    std::vector<Splat>* sp = light_paths ? &tile_splats : nullptr;
+    TileCounters tc = bvh_ ? render_tile(view_, *bvh_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]), sp)
+                           : render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]), sp);
     if (light_paths) splats.add(i, std::move(tile_splats), job_light_paths(settings, jobs[i]));
     {
       std::lock_guard<std::mutex> lock(counters_mutex);

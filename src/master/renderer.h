@@ -56,6 +56,7 @@ struct PassStats {
 };
 
 struct RenderStats {
+  std::string backend = "embree";  // the ray queries' backend (embree, bvh)
   uint32_t spp = 0;
   uint32_t passes = 0;
   double seconds = 0.0;
@@ -129,12 +130,15 @@ class PassExecutor {
 class LocalPassExecutor : public PassExecutor {
  public:
   LocalPassExecutor(const EmbreeScene& embree, const SceneView& view, int32_t threads);
+  // Over the portable BVH instead (`bvh` outlives the executor).
+  LocalPassExecutor(const BvhTracer& bvh, const SceneView& view, int32_t threads);
   void render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film, TileCounters* counters,
                    const std::function<void(uint64_t)>& on_tile_done) override;
   int32_t total_threads() const override { return threads_; }
 
  private:
   EmbreeTracer tracer_;
+  const BvhTracer* bvh_ = nullptr;  // set: tiles trace the BVH
   const SceneView& view_;
   int32_t threads_;
 };

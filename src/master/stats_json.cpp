@@ -55,6 +55,7 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
   j["effects"] = (describe_effects(s.effects));
   j["specialisation"] = (describe_specialisation(s.specialisation));
   j["transport"] = (s.spectral ? "spectral" : "rgb");
+  j["backend"] = s.backend;
   j["guide"] = (s.guide_mode);
   if (s.guide_mode != "none") {
     j["guide_cache_bytes"] = (s.guide.bytes);

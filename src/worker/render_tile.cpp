@@ -37,8 +37,8 @@ void merge_splats_by_pixel(std::vector<Splat>& splats, size_t first) {
   splats.resize(out + 1);
 }
 
-template <uint32_t Spec>
-TileCounters render_tile_spec(const SceneView& s, const EmbreeTracer& tracer, const TileSettings& settings,
+template <uint32_t Spec, class Tracer>
+TileCounters render_tile_spec(const SceneView& s, const Tracer& tracer, const TileSettings& settings,
                               const TileJob& job, TilePixels pixels, std::vector<Splat>* splats) {
   TileCounters tc;
   PathSettings path = settings.path;
@@ -113,7 +113,7 @@ constexpr uint32_t instantiated_spec(uint32_t s) {
 
 template <size_t... I>
 constexpr std::array<TileFn, sizeof...(I)> make_table(std::index_sequence<I...>) {
-  return {&render_tile_spec<instantiated_spec(static_cast<uint32_t>(I))>...};
+  return {&render_tile_spec<instantiated_spec(static_cast<uint32_t>(I)), EmbreeTracer>...};
 }
 
 // One instantiation per specialisation; chosen once per tile.
@@ -126,6 +126,18 @@ TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, con
   if (settings.path.light_traced_caustics && !splats)
     throw std::logic_error("render_tile: light-traced caustics need a splat list");
   return kTileFns[settings.specialisation & kSpecAll](scene, tracer, settings, job, pixels, splats);
+}
+
+TileCounters render_tile(const SceneView& scene, const BvhTracer& tracer, const TileSettings& settings,
+                         const TileJob& job, TilePixels pixels, std::vector<Splat>* splats) {
+  if (settings.path.light_traced_caustics && !splats)
+    throw std::logic_error("render_tile: light-traced caustics need a splat list");
+  // The portable backend is served by the full integrator (guided or not):
+  // two instantiations instead of one per effects set keep the build short.
+  constexpr uint32_t kFull = instantiated_spec(kSpecAll & ~kSpecGuiding), kFullGuided = instantiated_spec(kSpecAll);
+  return (settings.specialisation & kSpecGuiding)
+             ? render_tile_spec<kFullGuided, BvhTracer>(scene, tracer, settings, job, pixels, splats)
+             : render_tile_spec<kFull, BvhTracer>(scene, tracer, settings, job, pixels, splats);
 }
 
 }  // namespace tessera

@@ -8,6 +8,7 @@
 
 #include "kernels/integrator.h"
 #include "master/film.h"
+#include "kernels/bvh.h"
 #include "worker/embree_backend.h"
 
 namespace tessera {
@@ -108,6 +109,10 @@ inline TilePixels film_tile(Film& film, const TileJob& job) { return {&film.at(j
 // path, whose contributions to any pixel of the image are appended to
 // *splats in order (film_add_splats adds them, tile by tile in job order).
 TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, const TileSettings& settings,
+                         const TileJob& job, TilePixels pixels, std::vector<Splat>* splats = nullptr);
+// The same over the portable BVH (kernels/bvh.h): statistically the same
+// image, not bit for bit (it runs the full integrator whatever the effects).
+TileCounters render_tile(const SceneView& scene, const BvhTracer& tracer, const TileSettings& settings,
                          const TileJob& job, TilePixels pixels, std::vector<Splat>* splats = nullptr);
 
 // Light paths a job traces: one per camera sample when caustics are light-traced.

@@ -433,4 +433,15 @@ TEST_F(CliTest, SceneTooLargeForMemoryFailsBeforeBuilding) {
 }
 
 }  // namespace
+TEST_F(CliTest, BackendsRenderOrRefuseInOneLine) {
+  // The portable BVH renders and says so; CUDA is refused in a build without it.
+  const std::string out = (dir_ / "bvh.exr").string(), stats = (dir_ / "bvh.json").string();
+  const RunResult bvh = run("render -q --backend bvh --spp 4 --res 16x12 --no-preview -o " + out + " --stats " + stats);
+  EXPECT_EQ(bvh.exit_code, 0) << bvh.output;
+  std::ifstream in(stats);
+  const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(json.find("\"backend\": \"bvh\""), std::string::npos);
+  expect_one_line_error(run("render -q --backend cuda --spp 4 --res 16x12 --no-preview -o " + out), "--backend cuda");
+}
+
 }  // namespace tessera
