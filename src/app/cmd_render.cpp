@@ -30,8 +30,8 @@
 #include "app/memory_check.h"
 #include "scene/light_paths.h"
 #include "scene/spectral_choice.h"
-#include "worker/cpu_affinity.h"
 #include "worker/bvh_build.h"
+#include "worker/cpu_affinity.h"
 #include "worker/farm_worker.h"
 
 namespace tessera {
@@ -411,6 +411,8 @@ std::string chosen_backend(const RenderArgs& a) {
 int run_render_local(const RenderArgs& a) {
   const std::string backend = chosen_backend(a);
   MasterSetup m = prepare_master(a, nullptr);
+  // The BVH runs the full integrator: the log, metadata and stats say so.
+  if (backend == "bvh") m.opt.force_full_specialisation = true;
   EmbreeScene embree(*m.scene);
   std::fprintf(stderr, "tessera: backend: %s\n", backend.c_str());
   if (backend == "bvh") {

@@ -60,7 +60,8 @@ TESSERA_HOST_DEVICE inline bool hits_box(const Vec3& lo, const Vec3& hi, const V
 // Watertight ray/triangle intersection (Woop, Benthin and Wald 2013): the
 // edge functions of the triangle sheared into ray space, redone in double
 // where one is exactly 0, so a ray through a shared edge or vertex meets
-// exactly one of its triangles. On a hit in (0, tmax): *t and the
+// exactly one of its triangles (on the host; nvcc's contracted
+// multiply-adds may break ties differently). On a hit in (0, tmax]: *t and the
 // barycentrics of vertices 1 and 2.
 TESSERA_HOST_DEVICE inline bool hits_triangle(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& o,
                                               const Vec3& d, Float tmax, Float* t, Float* b1, Float* b2) {
@@ -115,7 +116,8 @@ TESSERA_HOST_DEVICE inline void triangle_at(const SceneView& s, uint32_t tri, Fl
 // rays). Candidates the scene filters (alpha, one-way faces) are skipped.
 TESSERA_HOST_DEVICE inline bool bvh_trace(const BvhView& bvh, const SceneView& s, const Vec3& o, const Vec3& d,
                                           Float tmax, Float time, bool any_hit, TraceHit* hit) {
-  if (bvh.num_nodes == 0 || !(tmax > 0.f)) return false;
+  // A non-finite ray would pass every box (NaN slabs are dropped): none is traced.
+  if (bvh.num_nodes == 0 || !(tmax > 0.f) || !is_finite(o) || !is_finite(d)) return false;
   const Vec3 inv_d(1.f / d.x, 1.f / d.y, 1.f / d.z);
   const bool filtered = s.triangle_alpha || s.has_one_way_faces;
   uint32_t stack[kBvhStackSize];
@@ -129,6 +131,7 @@ TESSERA_HOST_DEVICE inline bool bvh_trace(const BvhView& bvh, const SceneView& s
         // Nearer child first: the far one waits on the stack.
         const uint32_t axis = n.count_axis & 3u;
         const bool right_first = d[axis] < 0.f;
+        // The builder keeps leaves above kBvhStackSize - 1 levels, so the stack never fills.
         if (top < kBvhStackSize) stack[top++] = right_first ? node + 1 : n.offset;
         node = right_first ? n.offset : node + 1;
         continue;

@@ -127,9 +127,11 @@ class Builder {
       return std::min(kBins - 1, static_cast<int>(kBins * ((p.centre[best_axis] - lo) / extent))) <= best_bin;
     };
     const auto split = std::partition(prims_.begin() + begin, prims_.begin() + end, in_left);
+    const size_t mid = static_cast<size_t>(split - prims_.begin());
+    if (mid == begin || mid == end) return false;
     *axis_out = best_axis;
-    *mid_out = static_cast<size_t>(split - prims_.begin());
-    return *mid_out > begin && *mid_out < end;
+    *mid_out = mid;
+    return true;
   }
 
   std::vector<Prim>& prims_;
@@ -151,6 +153,7 @@ BvhBuild build_bvh(const SceneView& s) {
       if (s.positions_end) p.box.grow(s.positions_end[idx[k]]);
     }
     p.centre = 0.5f * (p.box.lo + p.box.hi);
+    if (!is_finite(p.centre)) continue;  // the loader refuses non-finite vertices; never bin one
     prims.push_back(p);
   }
   if (prims.empty()) return out;

@@ -132,12 +132,18 @@ TileCounters render_tile(const SceneView& scene, const BvhTracer& tracer, const 
                          const TileJob& job, TilePixels pixels, std::vector<Splat>* splats) {
   if (settings.path.light_traced_caustics && !splats)
     throw std::logic_error("render_tile: light-traced caustics need a splat list");
-  // The portable backend is served by the full integrator (guided or not):
-  // two instantiations instead of one per effects set keep the build short.
-  constexpr uint32_t kFull = instantiated_spec(kSpecAll & ~kSpecGuiding), kFullGuided = instantiated_spec(kSpecAll);
-  return (settings.specialisation & kSpecGuiding)
-             ? render_tile_spec<kFullGuided, BvhTracer>(scene, tracer, settings, job, pixels, splats)
-             : render_tile_spec<kFull, BvhTracer>(scene, tracer, settings, job, pixels, splats);
+  // The portable backend is served by the full surface integrator, or the
+  // media one for scenes with media, guided or not (what
+  // RenderOptions::force_full_specialisation selects): four instantiations
+  // instead of one per effects set keep the build short.
+  constexpr uint32_t kSurface = kSpecSurfaceAll & ~kSpecGuiding;
+  constexpr uint32_t kMedia = instantiated_spec(kSpecMedia | kSurface);
+  const bool media = (settings.specialisation & kSpecMedia) != 0, guided = (settings.specialisation & kSpecGuiding) != 0;
+  if (media)
+    return guided ? render_tile_spec<kMedia | kSpecGuiding, BvhTracer>(scene, tracer, settings, job, pixels, splats)
+                  : render_tile_spec<kMedia, BvhTracer>(scene, tracer, settings, job, pixels, splats);
+  return guided ? render_tile_spec<kSurface | kSpecGuiding, BvhTracer>(scene, tracer, settings, job, pixels, splats)
+                : render_tile_spec<kSurface, BvhTracer>(scene, tracer, settings, job, pixels, splats);
 }
 
 }  // namespace tessera

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "kernels/integrator.h"
-#include "master/film.h"
 #include "kernels/bvh.h"
+#include "master/film.h"
 #include "worker/embree_backend.h"
 
 namespace tessera {
@@ -110,8 +110,9 @@ inline TilePixels film_tile(Film& film, const TileJob& job) { return {&film.at(j
 // *splats in order (film_add_splats adds them, tile by tile in job order).
 TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, const TileSettings& settings,
                          const TileJob& job, TilePixels pixels, std::vector<Splat>* splats = nullptr);
-// The same over the portable BVH (kernels/bvh.h): statistically the same
-// image, not bit for bit (it runs the full integrator whatever the effects).
+// The same over the portable BVH (kernels/bvh.h), with the full integrator
+// (surface, or media for scenes with media) whatever settings.specialisation
+// narrows: statistically the same image, not bit for bit.
 TileCounters render_tile(const SceneView& scene, const BvhTracer& tracer, const TileSettings& settings,
                          const TileJob& job, TilePixels pixels, std::vector<Splat>* splats = nullptr);
 

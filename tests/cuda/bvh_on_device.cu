@@ -2,7 +2,7 @@
 // GPU must find what the host build finds: closest hits (triangle and
 // distance) and shadow-ray answers for random rays through a scene of
 // random triangles and a tessellated sphere. Also prints rays per second on
-// the device and on one host core, the first figure of the GPU backend.
+// the device and on one host core.
 // Not GoogleTest (host-only); exits 0 when all agree, 1 on a failure, 77
 // (CTest's skip) without a device.
 #include <cuda_runtime.h>
@@ -17,7 +17,10 @@
 #include "kernels/sampling.h"
 #include "worker/bvh_build.h"
 
+#include "cuda_check.h"
+
 using namespace tessera;
+using cuda_check::to_device;
 
 namespace {
 
@@ -31,22 +34,11 @@ __global__ void trace_kernel(BvhView bvh, const SceneView* scene, const Vec3* o,
   TraceHit h{};
   found[i] = t.intersect(o[i], d[i], kInfinity, &h) ? 1 : 0;
   hits[i] = h;
-  occluded[i] = t.occluded(o[i], d[i], found[i] ? 0.5f * h.t : 100.f) ? 1 : 0;
+  // Short of the closest hit (free) and past it (blocked).
+  occluded[i] = (t.occluded(o[i], d[i], found[i] ? 0.5f * h.t : 100.f) ? 1 : 0) +
+                (found[i] && t.occluded(o[i], d[i], 2.f * h.t) ? 2 : 0);
 }
 
-bool check_cuda(cudaError_t e, const char* what) {
-  if (e == cudaSuccess) return true;
-  std::printf("FAIL %s: %s\n", what, cudaGetErrorString(e));
-  return false;
-}
-
-template <class T>
-T* to_device(const std::vector<T>& v) {
-  T* d = nullptr;
-  cudaMalloc(&d, v.size() * sizeof(T));
-  cudaMemcpy(d, v.data(), v.size() * sizeof(T), cudaMemcpyHostToDevice);
-  return d;
-}
 
 // 200k random small triangles in a 10-unit cube and a sphere of 64 x 128 quads.
 struct Scene {
@@ -124,7 +116,8 @@ int main() {
   for (int i = 0; i < kRays; ++i) {
     host[i] = TraceHit{};
     host_found[i] = ht.intersect(o[i], d[i], kInfinity, &host[i]) ? 1 : 0;
-    host_occluded[i] = ht.occluded(o[i], d[i], host_found[i] ? 0.5f * host[i].t : 100.f) ? 1 : 0;
+    host_occluded[i] = (ht.occluded(o[i], d[i], host_found[i] ? 0.5f * host[i].t : 100.f) ? 1 : 0) +
+                       (host_found[i] && ht.occluded(o[i], d[i], 2.f * host[i].t) ? 2 : 0);
   }
   const double host_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - h0).count();
 
@@ -147,7 +140,7 @@ int main() {
   cudaMalloc(&d_found, kRays * sizeof(int));
   cudaMalloc(&d_occluded, kRays * sizeof(int));
   trace_kernel<<<(kRays + 127) / 128, 128>>>(dbvh, dscene, d_o, d_d, kRays, d_hits, d_found, d_occluded);  // warm-up
-  if (!check_cuda(cudaDeviceSynchronize(), "trace_kernel")) return 1;
+  if (!cuda_check::ok(cudaDeviceSynchronize(), "trace_kernel")) return 1;
   cudaEvent_t e0, e1;
   cudaEventCreate(&e0);
   cudaEventCreate(&e1);
@@ -156,7 +149,7 @@ int main() {
   for (int r = 0; r < kRepeats; ++r)
     trace_kernel<<<(kRays + 127) / 128, 128>>>(dbvh, dscene, d_o, d_d, kRays, d_hits, d_found, d_occluded);
   cudaEventRecord(e1);
-  if (!check_cuda(cudaEventSynchronize(e1), "timing")) return 1;
+  if (!cuda_check::ok(cudaEventSynchronize(e1), "timing")) return 1;
   float ms = 0.f;
   cudaEventElapsedTime(&ms, e0, e1);
   std::vector<TraceHit> dev(kRays);

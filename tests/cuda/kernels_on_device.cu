@@ -17,7 +17,10 @@
 #include "kernels/bsdf.h"
 #include "kernels/sampler.h"
 
+#include "cuda_check.h"
+
 using namespace tessera;
+using cuda_check::to_device;
 
 namespace {
 
@@ -65,28 +68,15 @@ __global__ void bsdf_kernel(BsdfParams b, const Vec4* in, const Vec3* wo, int n,
   if (i < n) run_bsdf_case(b, in[i], wo[i], &out[i]);
 }
 
-bool check_cuda(cudaError_t e, const char* what) {
-  if (e == cudaSuccess) return true;
-  std::printf("FAIL %s: %s\n", what, cudaGetErrorString(e));
-  return false;
-}
-
-template <class T>
-T* to_device(const std::vector<T>& v) {
-  T* d = nullptr;
-  cudaMalloc(&d, v.size() * sizeof(T));
-  cudaMemcpy(d, v.data(), v.size() * sizeof(T), cudaMemcpyHostToDevice);
-  return d;
-}
 
 bool check_sampler(const char* name, SamplerSetup setup) {
   const int n = kSide * kSide * kSamples;
   std::vector<Float> host(static_cast<size_t>(n) * kDims), dev(host.size());
   for (int i = 0; i < n; ++i) draw_sample_numbers(setup, i, host.data());
   Float* d = nullptr;
-  if (!check_cuda(cudaMalloc(&d, dev.size() * sizeof(Float)), "cudaMalloc")) return false;
+  if (!cuda_check::ok(cudaMalloc(&d, dev.size() * sizeof(Float)), "cudaMalloc")) return false;
   sampler_kernel<<<(n + 127) / 128, 128>>>(setup, n, d);
-  const bool launched = check_cuda(cudaDeviceSynchronize(), name);
+  const bool launched = cuda_check::ok(cudaDeviceSynchronize(), name);
   cudaMemcpy(dev.data(), d, dev.size() * sizeof(Float), cudaMemcpyDeviceToHost);
   cudaFree(d);
   if (!launched) return false;
@@ -118,7 +108,7 @@ bool check_bsdf(const char* name, const BsdfParams& b) {
   Vec3* d_wo = to_device(wo);
   BsdfResult* d_out = to_device(dev);
   bsdf_kernel<<<(kBsdfCases + 127) / 128, 128>>>(b, d_in, d_wo, kBsdfCases, d_out);
-  const bool launched = check_cuda(cudaDeviceSynchronize(), name);
+  const bool launched = cuda_check::ok(cudaDeviceSynchronize(), name);
   cudaMemcpy(dev.data(), d_out, dev.size() * sizeof(BsdfResult), cudaMemcpyDeviceToHost);
   cudaFree(d_in);
   cudaFree(d_wo);
