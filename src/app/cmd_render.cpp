@@ -368,10 +368,10 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
 
 // Renders on this process (executor: its threads, or the farm) and writes
 // the outputs; checkpoints after passes when asked.
-RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, const EmbreeScene& embree, PassExecutor* executor,
+RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, PassExecutor& executor,
                               const std::function<void(RenderStats&)>& add_stats = {}) {
   const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide != nullptr);
-  log_setup(m, spec, executor ? executor->ranks() : 1, executor ? executor->machines() : 1);
+  log_setup(m, spec, executor.ranks(), executor.machines());
   double last_checkpoint = m.resume ? m.resume->so_far.stats.seconds : 0.0;
   uint32_t checkpointed_spp = ~0u;  // spp of the last checkpoint this run wrote (none yet)
   std::optional<SnapshotWriter> snapshots;
@@ -386,7 +386,7 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, const EmbreeS
       checkpointed_spp = so_far.stats.spp;
     };
   }
-  RenderResult r = render(*m.scene, embree, m.opt, m.guide.get(), executor, m.resume ? &m.resume->so_far : nullptr, hook);
+  RenderResult r = render(*m.scene, executor, m.opt, m.guide.get(), m.resume ? &m.resume->so_far : nullptr, hook);
   if (r.stats.stop_reason == "interrupted" && r.stats.spp == 0) {
     // Interrupted while loading: an empty image must not replace earlier outputs.
     std::fprintf(stderr, "tessera: interrupted before the first pass: nothing written\n");
@@ -411,19 +411,20 @@ std::string chosen_backend(const RenderArgs& a) {
 int run_render_local(const RenderArgs& a) {
   const std::string backend = chosen_backend(a);
   MasterSetup m = prepare_master(a, nullptr);
-  // The BVH runs the full integrator: the log, metadata and stats say so.
-  if (backend == "bvh") m.opt.force_full_specialisation = true;
-  EmbreeScene embree(*m.scene);
   std::fprintf(stderr, "tessera: backend: %s\n", backend.c_str());
   if (backend == "bvh") {
-    // The portable BVH on this process's threads (the GPU's traversal, run on the CPU).
+    // The portable BVH on this process's threads (the GPU's traversal, run on
+    // the CPU), with the full integrator: the log, metadata and stats say so.
+    m.opt.force_full_specialisation = true;
     const BvhBuild bvh = build_bvh(m.scene->view());
     const BvhTracer tracer{bvh.view(), &m.scene->view()};
     LocalPassExecutor executor(tracer, m.scene->view(), render_threads(m.opt));
-    render_and_write(a, m, embree, &executor, [](RenderStats& s) { s.backend = "bvh"; });
+    render_and_write(a, m, executor, [](RenderStats& s) { s.backend = "bvh"; });
     return 0;
   }
-  render_and_write(a, m, embree, nullptr);
+  EmbreeScene embree(*m.scene);
+  LocalPassExecutor executor(embree, m.scene->view(), render_threads(m.opt));
+  render_and_write(a, m, executor);
   return 0;
 }
 
@@ -481,7 +482,7 @@ int run_render_farm(const RenderArgs& a) {
       return 0;
     }
     FarmMaster farm(*t, embree, m.scene->view(), std::max(1, threads), sync);
-    render_and_write(a, m, embree, &farm, [&](RenderStats& s) {
+    render_and_write(a, m, farm, [&](RenderStats& s) {
       s.guide_sync = a.guide_sync;
       s.guide_sync_seconds = farm.sync_seconds();
       s.guide_sync_bytes = farm.sync_bytes();

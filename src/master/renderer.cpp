@@ -97,6 +97,14 @@ void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vec
 
 RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& opt, GuideField* guide,
                     PassExecutor* executor, const RenderResult* resume, const PassEndHook& on_pass_end) {
+  if (executor) return render(scene, *executor, opt, guide, resume, on_pass_end);
+  LocalPassExecutor local(embree, scene.view(), render_threads(opt));
+  return render(scene, local, opt, guide, resume, on_pass_end);
+}
+
+RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const RenderOptions& opt, GuideField* guide,
+                    const RenderResult* resume, const PassEndHook& on_pass_end) {
+  PassExecutor* executor = &executor_ref;
   const SceneView& view = scene.view();
   const int32_t w = view.camera.film_width, h = view.camera.film_height;
   RenderResult result;
@@ -111,11 +119,6 @@ RenderResult render(const SceneData& scene, const EmbreeScene& embree, const Ren
   stats.spectral = scene.desc().spectral;
   stats.specialisation = effective_specialisation(scene, opt, guide != nullptr);
 
-  std::unique_ptr<LocalPassExecutor> local;
-  if (!executor) {
-    local = std::make_unique<LocalPassExecutor>(embree, view, render_threads(opt));
-    executor = local.get();
-  }
   stats.threads = executor->total_threads();
   stats.ranks = executor->ranks();
   stats.machines = executor->machines();

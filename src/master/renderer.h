@@ -155,5 +155,9 @@ using PassEndHook = std::function<void(const RenderResult& so_far, const GuideFi
 RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& options,
                     GuideField* guide = nullptr, PassExecutor* executor = nullptr,
                     const RenderResult* resume = nullptr, const PassEndHook& on_pass_end = {});
+// The same over any executor (this process's threads on any backend, a farm): no Embree scene needed.
+RenderResult render(const SceneData& scene, PassExecutor& executor, const RenderOptions& options,
+                    GuideField* guide = nullptr, const RenderResult* resume = nullptr,
+                    const PassEndHook& on_pass_end = {});
 
 }  // namespace tessera
