@@ -98,18 +98,6 @@ TESSERA_HOST_DEVICE inline bool hits_triangle(const Vec3& p0, const Vec3& p1, co
   return *t > 0.f && *t <= tmax;
 }
 
-TESSERA_HOST_DEVICE inline void triangle_at(const SceneView& s, uint32_t tri, Float time, Vec3* p0, Vec3* p1, Vec3* p2) {
-  const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
-  *p0 = s.positions[idx[0]];
-  *p1 = s.positions[idx[1]];
-  *p2 = s.positions[idx[2]];
-  if (s.positions_end && time > 0.f) {
-    *p0 = glm::mix(*p0, s.positions_end[idx[0]], time);
-    *p1 = glm::mix(*p1, s.positions_end[idx[1]], time);
-    *p2 = glm::mix(*p2, s.positions_end[idx[2]], time);
-  }
-}
-
 }  // namespace bvh_detail
 
 // The closest hit in (0, tmax], or with any_hit the first one found (shadow
@@ -139,7 +127,7 @@ TESSERA_HOST_DEVICE inline bool bvh_trace(const BvhView& bvh, const SceneView& s
       for (uint32_t i = 0; i < n.count_axis; ++i) {
         const uint32_t tri = bvh.triangles[n.offset + i];
         Vec3 p0, p1, p2;
-        bvh_detail::triangle_at(s, tri, time, &p0, &p1, &p2);
+        triangle_vertices_at(s, tri, time, &p0, &p1, &p2);
         Float t, b1, b2;
         if (!bvh_detail::hits_triangle(p0, p1, p2, o, d, tmax, &t, &b1, &b2)) continue;
         if (filtered && hit_ignored(s, tri, b1, b2, o, d, time)) continue;

@@ -16,12 +16,9 @@ TESSERA_HOST_DEVICE inline bool hit_ignored(const SceneView& s, uint32_t tri, Fl
   if (info.flags & kTriInvisibleFromInside) {
     Vec3 n = s.face_normals[tri];
     if (s.positions_end && time > 0.f) {
-      const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
-      Vec3 moved;
-      if (triangle_normal(glm::mix(s.positions[idx[0]], s.positions_end[idx[0]], time),
-                          glm::mix(s.positions[idx[1]], s.positions_end[idx[1]], time),
-                          glm::mix(s.positions[idx[2]], s.positions_end[idx[2]], time), &moved, nullptr))
-        n = (info.flags & kTriFlipNormal) ? -moved : moved;
+      Vec3 p0, p1, p2, moved;
+      triangle_vertices_at(s, tri, time, &p0, &p1, &p2);
+      if (triangle_normal(p0, p1, p2, &moved, nullptr)) n = (info.flags & kTriFlipNormal) ? -moved : moved;
     }
     if (glm::dot(d, n) > 0.f) return true;
   }

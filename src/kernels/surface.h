@@ -67,6 +67,22 @@ TESSERA_HOST_DEVICE inline void refine_huge_triangle_hit(SurfaceHit& h, const Ve
   h.p_error = kGamma7 * abs3(h.p) + ray_error;
 }
 
+// A triangle's vertices at a ray's time: a moving triangle's interpolated
+// linearly between its two placements, as Embree intersects it. Every
+// backend and the hit reconstruction read them here.
+TESSERA_HOST_DEVICE inline void triangle_vertices_at(const SceneView& s, uint32_t tri, Float time, Vec3* p0, Vec3* p1,
+                                                     Vec3* p2) {
+  const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
+  *p0 = s.positions[idx[0]];
+  *p1 = s.positions[idx[1]];
+  *p2 = s.positions[idx[2]];
+  if (s.positions_end && time > 0.f) {
+    *p0 = glm::mix(*p0, s.positions_end[idx[0]], time);
+    *p1 = glm::mix(*p1, s.positions_end[idx[1]], time);
+    *p2 = glm::mix(*p2, s.positions_end[idx[2]], time);
+  }
+}
+
 // b1, b2: barycentrics of vertices 1 and 2 (Embree's u, v); time: the ray's
 // (Ray::time); ray: the ray that found the hit, if a ray did (huge
 // triangles take their point from it).
@@ -75,14 +91,9 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& 
   const uint32_t* idx = s.indices + 3 * static_cast<size_t>(tri);
   const TriangleInfo& info = s.triangles[tri];
   Float b0 = 1.f - b1 - b2;
-  Vec3 p0 = s.positions[idx[0]], p1 = s.positions[idx[1]], p2 = s.positions[idx[2]];
-  // A moving triangle at this time: its vertices interpolated linearly, as Embree intersects it.
+  Vec3 p0, p1, p2;
+  triangle_vertices_at(s, tri, time, &p0, &p1, &p2);
   const bool moving = s.positions_end && time > 0.f;
-  if (moving) {
-    p0 = glm::mix(p0, s.positions_end[idx[0]], time);
-    p1 = glm::mix(p1, s.positions_end[idx[1]], time);
-    p2 = glm::mix(p2, s.positions_end[idx[2]], time);
-  }
   SurfaceHit h;
   h.triangle = tri;
   h.p = b0 * p0 + b1 * p1 + b2 * p2;

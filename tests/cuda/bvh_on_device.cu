@@ -92,11 +92,7 @@ Scene make_scene() {
 }  // namespace
 
 int main() {
-  int devices = 0;
-  if (cudaGetDeviceCount(&devices) != cudaSuccess || devices == 0) {
-    std::printf("skip: no CUDA device\n");
-    return 77;
-  }
+  if (!cuda_check::device_present()) return 77;
   const Scene scene = make_scene();
   const SceneView view = scene.view();
   const BvhBuild build = build_bvh(view);

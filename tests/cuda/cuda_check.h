@@ -8,6 +8,15 @@
 
 namespace tessera::cuda_check {
 
+// Whether a CUDA device is present; prints the skip line when not (the
+// programs then exit 77, CTest's skip).
+inline bool device_present() {
+  int devices = 0;
+  if (cudaGetDeviceCount(&devices) == cudaSuccess && devices > 0) return true;
+  std::printf("skip: no CUDA device\n");
+  return false;
+}
+
 // Prints a failure line for a CUDA error; true when there was none.
 inline bool ok(cudaError_t e, const char* what) {
   if (e == cudaSuccess) return true;

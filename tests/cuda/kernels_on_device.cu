@@ -157,11 +157,7 @@ bool check_bsdf(const char* name, const BsdfParams& b) {
 }  // namespace
 
 int main() {
-  int devices = 0;
-  if (cudaGetDeviceCount(&devices) != cudaSuccess || devices == 0) {
-    std::printf("skip: no CUDA device\n");
-    return 77;
-  }
+  if (!cuda_check::device_present()) return 77;
   cudaDeviceProp prop{};
   cudaGetDeviceProperties(&prop, 0);
   std::printf("device: %s (sm_%d%d)\n", prop.name, prop.major, prop.minor);
