@@ -15,6 +15,7 @@
 #include "kernels/guide_diagnostic.h"
 #include "master/image_output.h"
 #include "master/renderer.h"
+#include "worker/embree_backend.h"
 #include "scene/sampler_setup.h"
 
 namespace tessera {
@@ -66,7 +67,7 @@ void write_distribution(const VizArgs& a, const GuideField& field, const glm::dv
   std::printf("wrote %s\n", a.distribution.c_str());
 }
 
-void write_diagnostic(const VizArgs& a, const SceneData& scene, const EmbreeScene& embree, GuideField& field) {
+void write_diagnostic(const VizArgs& a, const SceneData& scene, const EmbreeBackend& embree, GuideField& field) {
   const SceneView& s = scene.view();
   const GuideView g = field.view();
   const EmbreeTracer tracer = embree.tracer();
@@ -92,7 +93,7 @@ int run_guide_viz(VizArgs a) {
   if (a.distribution.empty() && a.diagnostic.empty())
     throw std::runtime_error("guide-viz: nothing to do; give --distribution FILE.exr and/or --diagnostic FILE.exr");
   SceneData scene(load_scene_or_builtin(a.scene));
-  EmbreeScene embree(scene);
+  EmbreeBackend embree(scene);
   if (a.guide.mode == "auto" || a.guide.mode == "none") a.guide.mode = "qtable";
   std::string why;
   std::unique_ptr<GuideField> field = make_guide(a.guide, scene, &why);

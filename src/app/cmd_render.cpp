@@ -30,7 +30,7 @@
 #include "app/memory_check.h"
 #include "scene/light_paths.h"
 #include "scene/spectral_choice.h"
-#include "worker/bvh_build.h"
+#include "worker/backends.h"
 #include "worker/cpu_affinity.h"
 #include "worker/farm_worker.h"
 
@@ -401,29 +401,23 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, PassExecutor&
   return r;
 }
 
-// The ray-query backend a render asks for: "auto" is Embree until the
-// CUDA backend exists (a build without it refuses "cuda" in one line).
-std::string chosen_backend(const RenderArgs& a) {
-  if (a.backend == "cuda") throw std::runtime_error("--backend cuda: this build has no CUDA backend");
-  return a.backend == "bvh" ? "bvh" : "embree";
+// This process's backend (--backend), built over the scene; the log says
+// which and, for auto, why.
+std::unique_ptr<TileBackend> backend_for(const RenderArgs& a, const MasterSetup& m, bool log) {
+  std::string why;
+  const std::string name = resolve_backend(a.backend, m.scene.get(), m.opt.light_paths, &why);
+  if (log) std::fprintf(stderr, "tessera: backend: %s%s%s\n", name.c_str(), why.empty() ? "" : " (", why.empty() ? "" : (why + ")").c_str());
+  return make_tile_backend(name, *m.scene, render_threads(m.opt));
 }
 
 int run_render_local(const RenderArgs& a) {
-  const std::string backend = chosen_backend(a);
+  resolve_backend(a.backend);  // an unavailable backend fails before the scene loads
   MasterSetup m = prepare_master(a, nullptr);
-  std::fprintf(stderr, "tessera: backend: %s\n", backend.c_str());
-  if (backend == "bvh") {
-    // The portable BVH on this process's threads (the GPU's traversal, run on
-    // the CPU), with the full integrator: the log, metadata and stats say so.
-    m.opt.force_full_specialisation = true;
-    const BvhBuild bvh = build_bvh(m.scene->view());
-    const BvhTracer tracer{bvh.view(), &m.scene->view()};
-    LocalPassExecutor executor(tracer, m.scene->view(), render_threads(m.opt));
-    render_and_write(a, m, executor, [](RenderStats& s) { s.backend = "bvh"; });
-    return 0;
-  }
-  EmbreeScene embree(*m.scene);
-  LocalPassExecutor executor(embree, m.scene->view(), render_threads(m.opt));
+  std::unique_ptr<TileBackend> backend = backend_for(a, m, true);
+  // The portable BVH and the device run the full integrator: the metadata
+  // and stats say so.
+  if (backend->serves_full_integrator()) m.opt.force_full_specialisation = true;
+  LocalPassExecutor executor(*backend, render_threads(m.opt));
   render_and_write(a, m, executor);
   return 0;
 }
@@ -432,7 +426,7 @@ int run_render_local(const RenderArgs& a) {
 // starting guide to every rank, schedules tiles, renders too, and writes
 // all outputs; the other ranks render tiles.
 int run_render_farm(const RenderArgs& a) {
-  if (chosen_backend(a) != "embree") throw std::runtime_error("--backend bvh renders locally only (a farm traces with embree)");
+  resolve_backend(a.backend);  // an unavailable backend fails before the farm starts
   MpiSession mpi;
   std::unique_ptr<Transport> t = mpi.world();
   const bool master = t->rank() == 0;
@@ -473,15 +467,16 @@ int run_render_farm(const RenderArgs& a) {
     const bool widened = widen_affinity_if_alone(t->ranks_on_this_machine());
     if (widened && master)
       std::fprintf(stderr, "tessera: farm: rank 0 is alone on its machine; using all its cores (mpirun had bound it to fewer)\n");
-    EmbreeScene embree(*m.scene);
-      const int32_t threads = render_threads(m.opt, t->ranks_on_this_machine());
+    // Each rank renders with its own backend (a GPU where it has one).
+    std::unique_ptr<TileBackend> backend = backend_for(a, m, master);
+    const int32_t threads = render_threads(m.opt, t->ranks_on_this_machine());
     if (!master) {
       const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide != nullptr);
-      run_farm_worker(*t, m.scene->view(), embree, make_tile_settings(m.opt, spec, m.guide != nullptr), m.guide.get(),
-                      sync, threads);
+      run_farm_worker(*t, *backend, make_tile_settings(m.opt, spec, m.guide != nullptr), m.guide.get(), sync,
+                      std::max(1, threads));
       return 0;
     }
-    FarmMaster farm(*t, embree, m.scene->view(), std::max(1, threads), sync);
+    FarmMaster farm(*t, *backend, std::max(1, threads), sync);
     render_and_write(a, m, farm, [&](RenderStats& s) {
       s.guide_sync = a.guide_sync;
       s.guide_sync_seconds = farm.sync_seconds();
@@ -514,9 +509,10 @@ CommandRunner add_render_command(CLI::App& app) {
   CLI::App* c = app.add_subcommand("render", "Render a pbrt-v4 scene (default: the built-in Cornell box) to OpenEXR + PNG; under mpirun, as a farm");
   c->add_option("scene", a->scene, "Scene file in pbrt-v4 syntax (omit for the built-in Cornell box)");
   c->add_option("--backend", a->backend,
-                "Ray queries: auto (embree), embree, bvh (the portable BVH on the CPU, served by the full integrator), "
-                "cuda (not in this build)")
-      ->check(CLI::IsMember({"auto", "embree", "bvh", "cuda"}));
+                "What renders the tiles: auto (cuda where there is a device and the scene can go there, else embree), "
+                "embree, bvh (the GPU's BVH on the CPU), cuda, emulated-device (the GPU's kernel on the CPU, for "
+                "testing); bvh, cuda and emulated-device run the full integrator")
+      ->check(CLI::IsMember({"auto", "embree", "bvh", "cuda", "emulated-device"}));
   c->add_option("-o,--output", a->output, "Output EXR (default: the scene's Film filename in the current directory)");
   c->add_option("--spp", a->spp, "Samples per pixel (overrides the scene's Sampler)")->check(CLI::Range(0, 1 << 30));
   c->add_option("--time", a->time, "Time budget in seconds: render whole passes until it is spent")->check(positive_number());

@@ -2,7 +2,7 @@
 //
 //   setup     master -> all (broadcast): the parsed scene and the guide
 //             cache every rank starts from, or the error that stops them.
-//   Hello     worker -> master: how many threads it renders with.
+//   Hello     worker -> master: how many threads it renders with, and its backend.
 //   PassStart master -> worker: a pass begins (sample range is in the jobs),
 //             with the integrator specialisation it runs (--guide auto's
 //             trial renders some passes unguided).
@@ -48,9 +48,10 @@ struct FarmSetup {
 
 struct FarmHello {
   int32_t threads = 0;
+  std::string backend;  // embree, bvh, cuda
   template <class Archive>
   void serialize(Archive& ar) {
-    ar(threads);
+    ar(threads, backend);
   }
 };
 

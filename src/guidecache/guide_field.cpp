@@ -80,6 +80,8 @@ void GuideField::build_bin_dirs() {
 GuideView GuideField::view() {
   GuideView g;
   g.nodes = nodes_.data();
+  g.num_nodes = static_cast<uint32_t>(nodes_.size());
+  g.num_cells = num_cells();
   g.top_nodes = top_nodes_.data();
   g.lo = lo_;
   g.extent = extent_;

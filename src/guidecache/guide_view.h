@@ -74,6 +74,8 @@ struct GuideView {
   // Spatial octrees: nodes[0..5] are the roots of the normal classes; each
   // covers the cube [lo, lo + extent]^3.
   const GuideNode* nodes = nullptr;
+  uint32_t num_nodes = 0;
+  uint32_t num_cells = 0;  // entries of the per-cell arrays (copies to a device need them)
   // kGuideNormalClasses * kGuideTopCells node indices (null: start at the roots).
   const int32_t* top_nodes = nullptr;
   Vec3 lo{0.f};

@@ -416,7 +416,7 @@ TESSERA_HOST_DEVICE inline bool subsurface_exit_sample(const BsdfParams& b, cons
 
 }  // namespace bsdf_detail
 
-TESSERA_HOST_DEVICE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
   if (wo.z == 0.f || !is_finite(wo) || !is_finite(wi)) return Rgb(0.f);
   switch (b.type) {
     case BsdfType::Diffuse: return bsdf_detail::diffuse_f(b, wo, wi);
@@ -434,7 +434,7 @@ TESSERA_HOST_DEVICE inline Rgb bsdf_eval(const BsdfParams& b, const Vec3& wo, co
 
 // The value next-event estimation uses: bsdf_eval, except that the coated
 // BSDFs weigh their layer walk as pbrt-v4's LayeredBxDF::f does (layered.h).
-TESSERA_HOST_DEVICE inline Rgb bsdf_eval_light(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Rgb bsdf_eval_light(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
   if (wo.z == 0.f || !is_finite(wo) || !is_finite(wi)) return Rgb(0.f);
   switch (b.type) {
     case BsdfType::CoatedDiffuse: return bsdf_detail::coated_f(b, wo, wi, bsdf_detail::layered::LayerWeights::Pbrt);
@@ -444,7 +444,7 @@ TESSERA_HOST_DEVICE inline Rgb bsdf_eval_light(const BsdfParams& b, const Vec3& 
   }
 }
 
-TESSERA_HOST_DEVICE inline Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Float bsdf_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
   if (wo.z == 0.f || !is_finite(wo) || !is_finite(wi)) return 0.f;
   switch (b.type) {
     case BsdfType::Diffuse: return bsdf_detail::diffuse_pdf(b, wo, wi);
@@ -471,7 +471,7 @@ TESSERA_HOST_DEVICE inline bool bsdf_mis_estimated(const BsdfParams& b) {
 // then sum to 1 for every direction): bsdf_pdf, except for the coated BSDFs,
 // where pbrt-v4 weighs by its stochastic LayeredBxDF::PDF, which, since the
 // two layered values differ (layered.h), shapes its pictures.
-TESSERA_HOST_DEVICE inline Float bsdf_mis_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Float bsdf_mis_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
   if (wo.z == 0.f || !is_finite(wo) || !is_finite(wi)) return 0.f;
   switch (b.type) {
     case BsdfType::CoatedDiffuse: return bsdf_detail::coated_diffuse_pdf_estimate(b, wo, wi);
@@ -480,7 +480,7 @@ TESSERA_HOST_DEVICE inline Float bsdf_mis_pdf(const BsdfParams& b, const Vec3& w
   }
 }
 
-TESSERA_HOST_DEVICE inline bool bsdf_sample(const BsdfParams& b, const Vec3& wo, Float uc, Vec2 u, BsdfSample* out) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool bsdf_sample(const BsdfParams& b, const Vec3& wo, Float uc, Vec2 u, BsdfSample* out) {
   if (wo.z == 0.f || !is_finite(wo)) return false;
   uc = glm::clamp(uc, 0.f, 0x1.fffffep-1f);
   u = glm::clamp(u, Vec2(0.f), Vec2(0x1.fffffep-1f));

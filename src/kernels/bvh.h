@@ -102,7 +102,7 @@ TESSERA_HOST_DEVICE inline bool hits_triangle(const Vec3& p0, const Vec3& p1, co
 
 // The closest hit in (0, tmax], or with any_hit the first one found (shadow
 // rays). Candidates the scene filters (alpha, one-way faces) are skipped.
-TESSERA_HOST_DEVICE inline bool bvh_trace(const BvhView& bvh, const SceneView& s, const Vec3& o, const Vec3& d,
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool bvh_trace(const BvhView& bvh, const SceneView& s, const Vec3& o, const Vec3& d,
                                           Float tmax, Float time, bool any_hit, TraceHit* hit) {
   // A non-finite ray would pass every box (NaN slabs are dropped): none is traced.
   if (bvh.num_nodes == 0 || !(tmax > 0.f) || !is_finite(o) || !is_finite(d)) return false;

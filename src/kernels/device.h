@@ -7,9 +7,13 @@
 #if defined(__CUDACC__)
 #define TESSERA_HOST_DEVICE __host__ __device__
 #define TESSERA_INLINE __forceinline__
+// A large function called from many places: one copy in the device code,
+// not one per call site (ptxas time grows faster than the kernel's size).
+#define TESSERA_DEVICE_NOINLINE __noinline__
 #else
 #define TESSERA_HOST_DEVICE
 #define TESSERA_INLINE inline __attribute__((always_inline))
+#define TESSERA_DEVICE_NOINLINE
 #endif
 
 // TESSERA_PREFETCH hints that memory will be read soon: a no-op on the GPU,

@@ -84,6 +84,9 @@ struct SceneView {
   const Vec3* positions_end = nullptr;
   const Vec3* normals_end = nullptr;
   const Vec2* uvs = nullptr;
+  // Entries of positions (and positions_end), normals (and normals_end) and
+  // uvs: 0 where an array is absent. Copies to a device need them.
+  uint32_t num_vertices = 0, num_normals = 0, num_uvs = 0;
   const uint32_t* indices = nullptr;  // 3 per triangle
   const TriangleInfo* triangles = nullptr;
   // Unit geometric normal per triangle, normalize(cross(p0 - p2, p1 - p2)),
@@ -99,7 +102,9 @@ struct SceneView {
   const Material* materials = nullptr;
   uint32_t num_materials = 0;
   const Texture* textures = nullptr;
+  uint32_t num_textures = 0;
   const ImageView* images = nullptr;
+  uint32_t num_images = 0;
 
   const Light* lights = nullptr;
   uint32_t num_lights = 0;
@@ -124,6 +129,7 @@ struct SceneView {
   SpectralView spectral;
   // Measured spectra (conductors' eta and k), kSpectralSamples values each.
   const Float* spectra = nullptr;
+  uint32_t num_spectra = 0;
 };
 
 // What light l emits at the path's wavelengths, given its RGB emission rgb

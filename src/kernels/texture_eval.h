@@ -21,7 +21,7 @@ TESSERA_HOST_DEVICE inline bool odd_cell(Float x) {
 
 // Textures may nest (scale of a checkerboard of images...). The recursion
 // terminates because the loader only lets a texture reference earlier ones.
-TESSERA_HOST_DEVICE inline Rgb eval_texture(const SceneView& s, int32_t tex_index, const TexturePoint& tp) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Rgb eval_texture(const SceneView& s, int32_t tex_index, const TexturePoint& tp) {
   const Texture& t = s.textures[tex_index];
   auto slot = [&](const TextureSlot& v) { return v.texture >= 0 ? eval_texture(s, v.texture, tp) : v.value; };
   switch (t.type) {

@@ -1,19 +1,17 @@
 #include "master/farm_master.h"
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <atomic>
 #include <cstring>
 #include <chrono>
 #include <exception>
 #include <mutex>
+#include <string>
+#include <utility>
 #include <thread>
 
 #include "comm/farm_protocol.h"
 #include "master/interrupt.h"
 #include "master/ordered_splats.h"
-#include "worker/thread_guide_accumulators.h"
 
 namespace tessera {
 namespace {
@@ -32,21 +30,63 @@ uint64_t job_samples(const TileJob& j) {
 
 }  // namespace
 
-FarmMaster::FarmMaster(Transport& transport, const EmbreeScene& embree, const SceneView& view, int32_t local_threads,
-                       bool sync_guide)
+FarmMaster::FarmMaster(Transport& transport, TileBackend& backend, int32_t local_threads, bool sync_guide)
     : transport_(transport),
-      tracer_(embree.tracer()),
-      view_(view),
+      backend_(backend),
       local_threads_(local_threads),
       total_threads_(local_threads),
       sync_guide_(sync_guide) {
+  backends_.insert(backend.name());
   for (int32_t r = 1; r < transport_.size(); ++r) {
     Message m = transport_.receive(r);
     if (m.tag == kTagError) throw std::runtime_error("rank " + std::to_string(r) + ": " + decode<FarmError>(m.bytes).message);
     if (m.tag != kTagHello) throw std::runtime_error("rank " + std::to_string(r) + ": unexpected message");
-    total_threads_ += decode<FarmHello>(m.bytes).threads;
+    const FarmHello hello = decode<FarmHello>(m.bytes);
+    total_threads_ += hello.threads;
+    backends_.insert(hello.backend);
   }
 }
+
+std::string FarmMaster::backends() const {
+  std::string all;
+  for (const std::string& b : backends_) all += (all.empty() ? "" : "+") + b;
+  return all;
+}
+
+namespace {
+
+// The master's share of a pass: tiles from the one queue the workers also
+// draw from, and the workers answered between tiles.
+class MasterQueue : public TileQueue {
+ public:
+  MasterQueue(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film, std::atomic<size_t>& next,
+              OrderedSplats& splats, const std::function<void(uint64_t)>& on_tile_done, std::function<void()> serve)
+      : settings_(settings), jobs_(jobs), film_(film), next_(next), splats_(splats), on_tile_done_(on_tile_done),
+        serve_(std::move(serve)) {}
+  bool take(TileTask* task) override {
+    const size_t i = next_.fetch_add(1);  // one tile at a time, so the workers find the rest
+    if (i >= jobs_.size()) return false;
+    *task = TileTask{jobs_[i], film_tile(film_, jobs_[i]), i};
+    return true;
+  }
+  void done(const TileTask& task, uint64_t samples, std::vector<Splat>&& splats) override {
+    if (settings_.path.light_traced_caustics)
+      splats_.add(task.job.index, std::move(splats), job_light_paths(settings_, task.job));
+    if (on_tile_done_) on_tile_done_(samples);
+  }
+  void between_tiles() override { serve_(); }
+
+ private:
+  const TileSettings& settings_;
+  const std::vector<TileJob>& jobs_;
+  Film& film_;
+  std::atomic<size_t>& next_;
+  OrderedSplats& splats_;
+  const std::function<void(uint64_t)>& on_tile_done_;
+  std::function<void()> serve_;
+};
+
+}  // namespace
 
 void FarmMaster::render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film,
                              TileCounters* counters, const std::function<void(uint64_t)>& on_tile_done) {
@@ -54,15 +94,13 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
   const FarmPassStart start{settings.specialisation, settings.path.guided_roulette};
   for (int32_t r = 1; r <= workers; ++r) transport_.send(r, kTagPassStart, encode(start));
 
-  // One queue of tiles for the workers and the master's own threads. There
+  // One queue of tiles for the workers and the master's own backend. There
   // is no communication thread: between tiles, whichever rendering thread
   // gets the lock answers the workers (one thread in MPI at a time), so no
   // extra thread competes with rendering for the master's cores. Once the
-  // queue is empty, they keep answering until every worker is done.
+  // queue is empty, this thread keeps answering until every worker is done.
   std::atomic<size_t> next{0};
   std::atomic<uint32_t> empty_replies{0};
-  ThreadGuideAccumulators guide_acc(settings);
-  std::atomic<bool> failed{false};
   const bool light_paths = settings.path.light_traced_caustics;
   OrderedSplats splats(film, jobs.size());
   const uint32_t all_done = kRequestsInFlight * static_cast<uint32_t>(workers);
@@ -107,41 +145,19 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
     while (transport_.try_receive(&m, -1)) handle(m);
   };
 
-  tbb::task_arena arena(local_threads_);
-  try {
-    arena.execute([&] {
-      tbb::parallel_for(0, local_threads_, [&](int32_t) {
-        try {
-          while (!failed) {
-            serve();
-            const size_t i = next.fetch_add(1);  // one tile at a time, so the workers find the rest
-            if (i >= jobs.size()) break;
-            std::vector<Splat> tile_splats;
-            TileCounters tc = render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]),
-                                          light_paths ? &tile_splats : nullptr);
-            if (light_paths) splats.add(jobs[i].index, std::move(tile_splats), job_light_paths(settings, jobs[i]));
-            {
-              std::lock_guard<std::mutex> lock(counters_mutex);
-              counters->add(tc);
-            }
-            if (on_tile_done) on_tile_done(tc.samples);
-          }
-          while (!failed && empty_replies < all_done) {
-            serve();
-            std::this_thread::sleep_for(std::chrono::microseconds(50));
-          }
-        } catch (...) {
-          failed = true;
-          throw;
-        }
-      });
-    });
-  } catch (...) {
-    failed = true;
-    throw;
+  MasterQueue queue(settings, jobs, film, next, splats, on_tile_done, serve);
+  backend_.begin_pass(settings);
+  const TileCounters mine = backend_.render_tiles(queue, local_threads_);
+  {
+    std::lock_guard<std::mutex> lock(counters_mutex);
+    counters->add(mine);
+  }
+  while (empty_replies < all_done) {
+    serve();
+    std::this_thread::sleep_for(std::chrono::microseconds(50));
   }
   if (light_paths) splats.finish();
-  guide_acc.gather();
+  backend_.end_pass();
 }
 
 void FarmMaster::reduce_guide(GuideField& guide) {

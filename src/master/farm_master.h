@@ -1,10 +1,12 @@
 // Rank 0 of the farm as a PassExecutor: hands a pass's tiles out to workers
 // on request (dynamic: fast ranks take more), renders tiles itself with its
-// own threads meanwhile, and puts returned tiles into the film. Between
+// own backend meanwhile, and puts returned tiles into the film. Between
 // passes it takes part in the guide's all-reduction like every rank.
 #pragma once
 
 #include <memory>
+#include <set>
+#include <string>
 
 #include "comm/transport.h"
 #include "master/renderer.h"
@@ -13,16 +15,17 @@ namespace tessera {
 
 class FarmMaster : public PassExecutor {
  public:
-  // Waits for every worker's Hello. local_threads (>= 1): the master's own
-  // rendering threads; they also answer the workers, between tiles.
-  FarmMaster(Transport& transport, const EmbreeScene& embree, const SceneView& view, int32_t local_threads,
-             bool sync_guide);
+  // Waits for every worker's Hello. `backend` (outliving the farm) renders
+  // the master's own share with local_threads (>= 1) host threads; they also
+  // answer the workers, between tiles.
+  FarmMaster(Transport& transport, TileBackend& backend, int32_t local_threads, bool sync_guide);
   void render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film, TileCounters* counters,
                    const std::function<void(uint64_t)>& on_tile_done) override;
   void reduce_guide(GuideField& guide) override;
   int32_t ranks() const override { return transport_.size(); }
   int32_t machines() const override { return transport_.machines(); }
   int32_t total_threads() const override { return total_threads_; }
+  std::string backends() const override;
   // Tells the workers the render is over.
   void stop();
 
@@ -32,8 +35,8 @@ class FarmMaster : public PassExecutor {
 
  private:
   Transport& transport_;
-  EmbreeTracer tracer_;
-  const SceneView& view_;
+  TileBackend& backend_;
+  std::set<std::string> backends_;  // of every rank
   int32_t local_threads_;
   int32_t total_threads_;
   bool sync_guide_;

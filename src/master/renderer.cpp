@@ -1,12 +1,8 @@
 #include "master/renderer.h"
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -15,7 +11,6 @@
 #include "master/ordered_splats.h"
 #include "master/progress.h"
 #include "worker/cpu_affinity.h"
-#include "worker/thread_guide_accumulators.h"
 
 namespace tessera {
 
@@ -52,53 +47,56 @@ uint32_t pass_spp_for(uint32_t pass, uint32_t max_pass_spp) {
   return std::min<uint32_t>(max_pass_spp, pass == 0 ? 1u : (1u << std::min(pass - 1, 20u)));
 }
 
-LocalPassExecutor::LocalPassExecutor(const EmbreeScene& embree, const SceneView& view, int32_t threads)
-    : tracer_(embree.tracer()), view_(view), threads_(std::max(1, threads)) {}
+namespace {
 
-LocalPassExecutor::LocalPassExecutor(const BvhTracer& bvh, const SceneView& view, int32_t threads)
-    : bvh_(&bvh), view_(view), threads_(std::max(1, threads)) {}
+// A local pass's tiles: in order, into the image's film.
+class FilmQueue : public TileQueue {
+ public:
+  FilmQueue(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film,
+            const std::function<void(uint64_t)>& on_tile_done)
+      : settings_(settings), jobs_(jobs), film_(film), on_tile_done_(on_tile_done), splats_(film, jobs.size()) {}
+  bool take(TileTask* task) override {
+    // In order, so that light-path splats wait for few earlier tiles (OrderedSplats).
+    const size_t i = next_.fetch_add(1);
+    if (i >= jobs_.size()) return false;
+    *task = TileTask{jobs_[i], film_tile(film_, jobs_[i]), i};
+    return true;
+  }
+  void done(const TileTask& task, uint64_t samples, std::vector<Splat>&& splats) override {
+    if (settings_.path.light_traced_caustics)
+      splats_.add(task.slot, std::move(splats), job_light_paths(settings_, task.job));
+    if (on_tile_done_) on_tile_done_(samples);
+  }
+  void finish() {
+    if (settings_.path.light_traced_caustics) splats_.finish();
+  }
+
+ private:
+  const TileSettings& settings_;
+  const std::vector<TileJob>& jobs_;
+  Film& film_;
+  const std::function<void(uint64_t)>& on_tile_done_;
+  OrderedSplats splats_;
+  std::atomic<size_t> next_{0};
+};
+
+}  // namespace
+
+LocalPassExecutor::LocalPassExecutor(TileBackend& backend, int32_t threads)
+    : backend_(backend), threads_(std::max(1, threads)) {}
 
 void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film,
                                     TileCounters* counters, const std::function<void(uint64_t)>& on_tile_done) {
-  std::mutex counters_mutex;
-  ThreadGuideAccumulators guide_acc(settings);
-  const bool light_paths = settings.path.light_traced_caustics;
-  OrderedSplats splats(film, jobs.size());
-  // Threads take tiles in order, so that light-path splats wait for few
-  // earlier tiles (OrderedSplats).
-  std::atomic<size_t> next{0};
-  std::atomic<bool> failed{false};  // a tile threw: the others stop taking tiles
-  auto render_one = [&](size_t i) {
-    std::vector<Splat> tile_splats;
-    std::vector<Splat>* sp = light_paths ? &tile_splats : nullptr;
-    TileCounters tc = bvh_ ? render_tile(view_, *bvh_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]), sp)
-                           : render_tile(view_, tracer_, guide_acc.for_this_thread(), jobs[i], film_tile(film, jobs[i]), sp);
-    if (light_paths) splats.add(i, std::move(tile_splats), job_light_paths(settings, jobs[i]));
-    {
-      std::lock_guard<std::mutex> lock(counters_mutex);
-      counters->add(tc);  // integer sums: order-independent
-    }
-    if (on_tile_done) on_tile_done(tc.samples);
-  };
-  tbb::task_arena arena(threads_);
-  arena.execute([&] {
-    tbb::parallel_for(0, threads_, [&](int32_t) {
-      try {
-        for (size_t i = next.fetch_add(1); i < jobs.size() && !failed; i = next.fetch_add(1)) render_one(i);
-      } catch (...) {
-        failed = true;
-        throw;
-      }
-    });
-  });
-  if (light_paths) splats.finish();
-  guide_acc.gather();
+  FilmQueue queue(settings, jobs, film, on_tile_done);
+  backend_.begin_pass(settings);
+  counters->add(backend_.render_tiles(queue, threads_));
+  queue.finish();
+  backend_.end_pass();
 }
 
-RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& opt, GuideField* guide,
-                    PassExecutor* executor, const RenderResult* resume, const PassEndHook& on_pass_end) {
-  if (executor) return render(scene, *executor, opt, guide, resume, on_pass_end);
-  LocalPassExecutor local(embree, scene.view(), render_threads(opt));
+RenderResult render(const SceneData& scene, TileBackend& backend, const RenderOptions& opt, GuideField* guide,
+                    const RenderResult* resume, const PassEndHook& on_pass_end) {
+  LocalPassExecutor local(backend, render_threads(opt));
   return render(scene, local, opt, guide, resume, on_pass_end);
 }
 
@@ -119,6 +117,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
   stats.spectral = scene.desc().spectral;
   stats.specialisation = effective_specialisation(scene, opt, guide != nullptr);
 
+  stats.backend = executor->backends();
   stats.threads = executor->total_threads();
   stats.ranks = executor->ranks();
   stats.machines = executor->machines();

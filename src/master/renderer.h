@@ -12,8 +12,8 @@
 #include "guidecache/guide_field.h"
 #include "master/film.h"
 #include "master/guide_trial.h"
-#include "worker/embree_backend.h"
 #include "worker/render_tile.h"
+#include "worker/tile_backend.h"
 #include "worker/scene_data.h"
 
 namespace tessera {
@@ -56,7 +56,7 @@ struct PassStats {
 };
 
 struct RenderStats {
-  std::string backend = "embree";  // the ray queries' backend (embree, bvh)
+  std::string backend = "embree";  // what rendered the tiles (embree, bvh, cuda; a farm's distinct ones joined by "+")
   uint32_t spp = 0;
   uint32_t passes = 0;
   double seconds = 0.0;
@@ -122,24 +122,24 @@ class PassExecutor {
   virtual void reduce_guide(GuideField& guide) {}
   // How many processes render (1 locally).
   virtual int32_t ranks() const { return 1; }
+  // The backends that render (a farm's ranks may differ).
+  virtual std::string backends() const = 0;
   virtual int32_t machines() const { return 1; }
   virtual int32_t total_threads() const = 0;
 };
 
-// This process's threads (oneTBB), tiles handed out dynamically.
+// This process's backend: tiles handed out in order, as its threads ask.
 class LocalPassExecutor : public PassExecutor {
  public:
-  LocalPassExecutor(const EmbreeScene& embree, const SceneView& view, int32_t threads);
-  // Over the portable BVH instead (`bvh` outlives the executor).
-  LocalPassExecutor(const BvhTracer& bvh, const SceneView& view, int32_t threads);
+  // `backend` outlives the executor; threads: the host threads it renders with.
+  LocalPassExecutor(TileBackend& backend, int32_t threads);
   void render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film, TileCounters* counters,
                    const std::function<void(uint64_t)>& on_tile_done) override;
   int32_t total_threads() const override { return threads_; }
+  std::string backends() const override { return backend_.name(); }
 
  private:
-  EmbreeTracer tracer_;
-  const BvhTracer* bvh_ = nullptr;  // set: tiles trace the BVH
-  const SceneView& view_;
+  TileBackend& backend_;
   int32_t threads_;
 };
 
@@ -147,16 +147,15 @@ class LocalPassExecutor : public PassExecutor {
 using PassEndHook = std::function<void(const RenderResult& so_far, const GuideField* guide)>;
 
 // Renders passes until options.spp, the time budget or the target error is
-// reached, whichever comes first. With a
-// guide, every pass samples from the field as it stood when the pass began
-// and the pass's learning is folded in before the next one. `resume`
-// continues a render from a checkpoint (its film, passes and counters; the
-// guide is the caller's); `executor` defaults to this process's threads.
-RenderResult render(const SceneData& scene, const EmbreeScene& embree, const RenderOptions& options,
-                    GuideField* guide = nullptr, PassExecutor* executor = nullptr,
-                    const RenderResult* resume = nullptr, const PassEndHook& on_pass_end = {});
-// The same over any executor (this process's threads on any backend, a farm): no Embree scene needed.
+// reached, whichever comes first. With a guide, every pass samples from the
+// field as it stood when the pass began and the pass's learning is folded
+// in before the next one. `resume` continues a render from a checkpoint
+// (its film, passes and counters; the guide is the caller's).
 RenderResult render(const SceneData& scene, PassExecutor& executor, const RenderOptions& options,
+                    GuideField* guide = nullptr, const RenderResult* resume = nullptr,
+                    const PassEndHook& on_pass_end = {});
+// The same on this process's backend, with render_threads(options) threads.
+RenderResult render(const SceneData& scene, TileBackend& backend, const RenderOptions& options,
                     GuideField* guide = nullptr, const RenderResult* resume = nullptr,
                     const PassEndHook& on_pass_end = {});
 

@@ -1,7 +1,9 @@
 #include "worker/embree_backend.h"
 
 #include "kernels/hit_filter.h"
+#include "worker/render_tile_impl.h"
 
+#include <array>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -99,5 +101,27 @@ void EmbreeScene::build(const SceneData& data) {
 }
 
 EmbreeScene::~EmbreeScene() { release(); }
+
+namespace {
+
+using TileFn = TileCounters (*)(const SceneView&, const EmbreeTracer&, const TileSettings&, const TileJob&, TilePixels,
+                                std::vector<Splat>*);
+
+template <size_t... I>
+constexpr std::array<TileFn, sizeof...(I)> make_table(std::index_sequence<I...>) {
+  return {&render_tile_spec<instantiated_spec(static_cast<uint32_t>(I)), EmbreeTracer>...};
+}
+
+// One instantiation per specialisation; chosen once per tile.
+constexpr auto kTileFns = make_table(std::make_index_sequence<kSpecAll + 1>{});
+
+}  // namespace
+
+TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, const TileSettings& settings,
+                         const TileJob& job, TilePixels pixels, std::vector<Splat>* splats) {
+  if (settings.path.light_traced_caustics && !splats)
+    throw std::logic_error("render_tile: light-traced caustics need a splat list");
+  return kTileFns[settings.specialisation & kSpecAll](scene, tracer, settings, job, pixels, splats);
+}
 
 }  // namespace tessera

@@ -1,5 +1,7 @@
-// The CPU ray-query backend: one Embree scene holding every triangle.
-// Integrators only see EmbreeTracer's intersect/occluded (see kernels/integrator.h).
+// The Embree backend: one Embree scene holding every triangle, traced by
+// this process's threads. Integrators only see EmbreeTracer's
+// intersect/occluded (see kernels/integrator.h); the pass loop only sees
+// EmbreeBackend as a TileBackend (worker/tile_backend.h).
 #pragma once
 
 #include <embree3/rtcore.h>
@@ -7,6 +9,7 @@
 #include <string>
 
 #include "kernels/integrator.h"
+#include "worker/cpu_tile_backend.h"
 #include "worker/scene_data.h"
 
 namespace tessera {
@@ -72,6 +75,36 @@ class EmbreeScene {
   std::string error_;  // first error Embree reported
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+};
+
+// Adds samples [sample_begin, sample_end) of every pixel of the job to its
+// accumulators, in sample order, with the integrator specialisation
+// settings.specialisation names. Random streams depend on (seed, pixel
+// index in the whole image, sample index) only, so a tile renders the same
+// wherever it runs. With light-traced caustics
+// (settings.path.light_traced_caustics) each sample also traces one light
+// path, whose contributions to any pixel of the image are appended to
+// *splats in order (film_add_splats adds them, tile by tile in job order).
+TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, const TileSettings& settings,
+                         const TileJob& job, TilePixels pixels, std::vector<Splat>* splats = nullptr);
+
+class EmbreeBackend : public CpuTileBackend {
+ public:
+  // `data` must outlive the backend.
+  explicit EmbreeBackend(const SceneData& data) : view_(data.view()), scene_(data) {}
+  std::string name() const override { return "embree"; }
+  // Ray queries for tools that trace rays of their own (guide-viz, bench-rays).
+  EmbreeTracer tracer() const { return scene_.tracer(); }
+
+ protected:
+  TileCounters render_one(const TileSettings& settings, const TileJob& job, TilePixels pixels,
+                          std::vector<Splat>* splats) const override {
+    return render_tile(view_, scene_.tracer(), settings, job, pixels, splats);
+  }
+
+ private:
+  const SceneView& view_;
+  EmbreeScene scene_;
 };
 
 }  // namespace tessera

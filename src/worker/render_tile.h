@@ -1,5 +1,7 @@
-// The worker's core: render a rectangle of pixels for a range of sample
-// indices into the film, a pure function of (scene, job, seed).
+// What a tile is: a rectangle of pixels and a range of sample indices, the
+// settings every tile of a render shares, and the counters a tile returns.
+// Rendering one is a pure function of (scene, job, seed); each backend
+// (worker/tile_backend.h) does it with its own ray queries.
 #pragma once
 
 #include <algorithm>
@@ -7,9 +9,7 @@
 #include <vector>
 
 #include "kernels/integrator.h"
-#include "kernels/bvh.h"
 #include "master/film.h"
-#include "worker/embree_backend.h"
 
 namespace tessera {
 
@@ -38,14 +38,14 @@ struct GuideLearnSchedule {
   uint32_t every = 8;
   bool taper = true;
   // Gap between learning sample indices around sample_index (past all_spp).
-  uint64_t period(uint32_t sample_index) const {
+  TESSERA_HOST_DEVICE uint64_t period(uint32_t sample_index) const {
     const uint64_t start = std::max<uint64_t>(uint64_t{2 * kTaperLearnPerDoubling} * every, all_spp);
     if (!taper || sample_index < start) return every;
     uint32_t doublings = 1;
     while ((start << doublings) <= sample_index) ++doublings;
     return uint64_t{every} << doublings;
   }
-  bool learns(uint32_t sample_index) const {
+  TESSERA_HOST_DEVICE bool learns(uint32_t sample_index) const {
     return sample_index < all_spp || (every > 0 && sample_index % period(sample_index) == 0);
   }
 };
@@ -100,21 +100,6 @@ struct TilePixels {
 
 // A tile of the image's film.
 inline TilePixels film_tile(Film& film, const TileJob& job) { return {&film.at(job.x0, job.y0), film.width}; }
-
-// Adds samples [sample_begin, sample_end) of every pixel of the job to its
-// accumulators, in sample order. Random streams depend on (seed, pixel index
-// in the whole image, sample index) only, so a tile renders the same
-// wherever it runs. With light-traced caustics
-// (settings.path.light_traced_caustics) each sample also traces one light
-// path, whose contributions to any pixel of the image are appended to
-// *splats in order (film_add_splats adds them, tile by tile in job order).
-TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, const TileSettings& settings,
-                         const TileJob& job, TilePixels pixels, std::vector<Splat>* splats = nullptr);
-// The same over the portable BVH (kernels/bvh.h), with the full integrator
-// (surface, or media for scenes with media) whatever settings.specialisation
-// narrows: statistically the same image, not bit for bit.
-TileCounters render_tile(const SceneView& scene, const BvhTracer& tracer, const TileSettings& settings,
-                         const TileJob& job, TilePixels pixels, std::vector<Splat>* splats = nullptr);
 
 // Light paths a job traces: one per camera sample when caustics are light-traced.
 inline uint64_t job_light_paths(const TileSettings& settings, const TileJob& job) {

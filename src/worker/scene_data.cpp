@@ -364,6 +364,9 @@ void SceneData::build_view() {
     v.normals_end = normals_end_.data();
   }
   v.uvs = uvs_.data();
+  v.num_vertices = static_cast<uint32_t>(positions_.size());
+  v.num_normals = static_cast<uint32_t>(normals_.size());
+  v.num_uvs = static_cast<uint32_t>(uvs_.size());
   v.indices = indices_.data();
   v.triangles = triangles_.data();
   v.face_normals = face_normals_.data();
@@ -373,7 +376,9 @@ void SceneData::build_view() {
   v.materials = desc_.materials.data();
   v.num_materials = static_cast<uint32_t>(desc_.materials.size());
   v.textures = desc_.textures.data();
+  v.num_textures = static_cast<uint32_t>(desc_.textures.size());
   v.images = image_views_.data();
+  v.num_images = static_cast<uint32_t>(image_views_.size());
   v.lights = lights_.data();
   v.num_lights = static_cast<uint32_t>(lights_.size());
   v.light_select = light_select_.view();
@@ -383,6 +388,7 @@ void SceneData::build_view() {
   v.camera = camera_;
   if (desc_.spectral) v.spectral = srgb_spectral_tables().view();
   v.spectra = desc_.spectra.empty() ? nullptr : desc_.spectra.data();
+  v.num_spectra = static_cast<uint32_t>(desc_.spectra.size() / kSpectralSamples);
   for (const Material& m : desc_.materials) v.has_interfaces |= m.type == MaterialType::Interface;
   if (has_media_) {
     v.media = desc_.media.data();

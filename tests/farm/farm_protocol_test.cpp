@@ -5,11 +5,14 @@
 
 #include <thread>
 
+#include "../render/guided_helpers.h"
 #include "../render/render_helpers.h"
 #include "comm/farm_protocol.h"
 #include "comm/inproc_transport.h"
 #include "comm/scene_wire.h"
 #include "master/farm_master.h"
+#include "worker/backends.h"
+#include "worker/embree_backend.h"
 #include "worker/farm_worker.h"
 
 namespace tessera {
@@ -19,7 +22,7 @@ using testing::films_identical;
 
 struct FarmScene {
   SceneData scene;
-  EmbreeScene embree;
+  mutable EmbreeBackend embree;  // local renders (its per-pass state changes while it renders)
   RenderOptions opt;
   explicit FarmScene(SceneDesc d) : scene(std::move(d)), embree(scene) {
     opt.progress = false;
@@ -46,8 +49,10 @@ struct FarmRun {
   std::vector<std::unique_ptr<GuideField>> guides;  // every rank's field at the end
 };
 
-// Rank 0 runs the master (1 rendering thread), ranks 1.. run workers.
-FarmRun render_farm(const FarmScene& fs, int32_t ranks, bool guided, bool sync) {
+// Rank 0 runs the master (1 rendering thread), ranks 1.. run workers, each
+// with its own backend: backends[r], or Embree where none is named.
+FarmRun render_farm(const FarmScene& fs, int32_t ranks, bool guided, bool sync,
+                    const std::vector<std::string>& backends = {}) {
   InProcessHub hub(ranks);
   std::vector<std::unique_ptr<Transport>> ends;
   FarmRun run;
@@ -55,16 +60,18 @@ FarmRun render_farm(const FarmScene& fs, int32_t ranks, bool guided, bool sync) 
     ends.push_back(hub.endpoint(r));
     run.guides.push_back(guided ? fs.make_guide() : nullptr);
   }
+  std::vector<std::unique_ptr<TileBackend>> rank_backends;
+  for (int32_t r = 0; r < ranks; ++r)
+    rank_backends.push_back(make_tile_backend(r < static_cast<int32_t>(backends.size()) ? backends[r] : "embree", fs.scene));
   const uint32_t spec = effective_specialisation(fs.scene, fs.opt, guided);
   std::vector<std::thread> workers;
   for (int32_t r = 1; r < ranks; ++r) {
     workers.emplace_back([&, r] {
-      run_farm_worker(*ends[r], fs.scene.view(), fs.embree, make_tile_settings(fs.opt, spec, guided),
-                      run.guides[r].get(), sync, 1);
+      run_farm_worker(*ends[r], *rank_backends[r], make_tile_settings(fs.opt, spec, guided), run.guides[r].get(), sync, 1);
     });
   }
-  FarmMaster master(*ends[0], fs.embree, fs.scene.view(), 1, sync);
-  run.result = render(fs.scene, fs.embree, fs.opt, run.guides[0].get(), &master);
+  FarmMaster master(*ends[0], *rank_backends[0], 1, sync);
+  run.result = render(fs.scene, master, fs.opt, run.guides[0].get());
   master.stop();
   for (auto& w : workers) w.join();
   return run;
@@ -136,6 +143,25 @@ TEST(FarmProtocol, GuideTrialGivesTheLocalImageAndDecisionForAnyRankCount) {
     EXPECT_EQ(farm.result.stats.guide_trial.state, local.stats.guide_trial.state);
     for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(*farm.guides[r] == *local_guide) << "rank " << r;
   }
+}
+
+// Each rank renders with its own backend: a farm of the portable BVH and
+// Embree ranks gives the local image statistically (not bit for bit: the
+// two find hits a few ulps apart), every rank ends with the same field, and
+// the stats name both backends.
+TEST(FarmProtocol, MixedBackendsAgreeWithTheLocalImage) {
+  FarmScene fs(door_ajar());
+  fs.opt.spp = 32;
+  auto local_guide = fs.make_guide();
+  RenderResult local = render(fs.scene, fs.embree, fs.opt, local_guide.get());
+  FarmRun farm = render_farm(fs, 3, true, true, {"bvh", "embree", "bvh"});
+  EXPECT_EQ(farm.result.stats.backend, "bvh+embree");
+  EXPECT_EQ(local.stats.backend, "embree");
+  EXPECT_EQ(farm.result.stats.counters.samples, local.stats.counters.samples);
+  for (const PixelAccum& p : farm.result.film.pixels)
+    for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(p.sum[c]));
+  testing::expect_agree(testing::channel_stats(local.film), testing::channel_stats(farm.result.film), "mixed farm");
+  for (int32_t r = 1; r < 3; ++r) EXPECT_TRUE(*farm.guides[r] == *farm.guides[0]) << "rank " << r;
 }
 
 TEST(FarmProtocol, GuideSyncOffLetsEachRankLearnAlone) {
@@ -211,15 +237,15 @@ TEST(FarmProtocol, WorkerFailureReachesTheMaster) {
   auto master_end = hub.endpoint(0), worker_end = hub.endpoint(1);
   std::thread worker([&] {
     // A worker that says hello and then fails on its first pass.
-    worker_end->send(0, kTagHello, encode(FarmHello{1}));
+    worker_end->send(0, kTagHello, encode(FarmHello{1, "embree"}));
     worker_end->receive(0);
     worker_end->send(0, kTagError, encode(FarmError{"out of device memory"}));
     while (worker_end->receive(0).tag != kTagStop) {
     }
   });
-  FarmMaster master(*master_end, fs.embree, fs.scene.view(), 1, true);
+  FarmMaster master(*master_end, fs.embree, 1, true);
   try {
-    render(fs.scene, fs.embree, fs.opt, nullptr, &master);
+    render(fs.scene, master, fs.opt);
     ADD_FAILURE() << "the render should fail";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("rank 1: out of device memory"), std::string::npos) << e.what();

@@ -16,7 +16,9 @@
 #include "furnace_scene.h"
 #include "guided_helpers.h"
 #include "render_helpers.h"
+#include "worker/backends.h"
 #include "worker/bvh_build.h"
+#include "worker/embree_backend.h"
 
 namespace tessera {
 namespace {
@@ -153,13 +155,12 @@ RenderResult render_with(SceneDesc desc, bool bvh, int threads, uint64_t seed = 
   opt.sampler = sampler_setup(desc);
   opt.seed = seed;
   opt.threads = threads;
+  opt.force_full_specialisation = bvh;  // as --backend bvh sets it
   SceneData scene(std::move(desc));
-  EmbreeScene embree(scene);
-  if (!bvh) return render(scene, embree, opt);
-  const BvhBuild build = build_bvh(scene.view());
-  const BvhTracer tracer{build.view(), &scene.view()};
-  LocalPassExecutor executor(tracer, scene.view(), threads);
-  return render(scene, embree, opt, nullptr, &executor);
+  std::unique_ptr<TileBackend> backend = make_tile_backend(bvh ? "bvh" : "embree", scene);
+  RenderResult r = render(scene, *backend, opt);
+  EXPECT_EQ(r.stats.backend, bvh ? "bvh" : "embree");
+  return r;
 }
 
 TEST(Bvh, RendersAgreeWithEmbree) {

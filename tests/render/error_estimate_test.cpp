@@ -206,8 +206,8 @@ TEST(ErrorEstimate, MatchesMeasuredRelMseOnFurnace) {
     // error; with stratified (Sobol) samples it is an upper bound.
     opt.sampler.kind = SamplerKind::Independent;
     SceneData scene(std::move(desc));
-    EmbreeScene embree(scene);
-    RenderResult r = render(scene, embree, opt, nullptr, nullptr, nullptr,
+    EmbreeBackend embree(scene);
+    RenderResult r = render(scene, embree, opt, nullptr, nullptr,
                             [&](const RenderResult& so_far, const GuideField*) {
                               const uint32_t spp = so_far.stats.spp;
                               if (spp != 16 && spp != 64 && spp != 256) return;
@@ -244,7 +244,7 @@ TEST(ErrorEstimate, PerPassEstimatesFallAsOneOverSpp) {
   opt.max_depth = desc.max_depth;
   opt.seed = 3;
   SceneData scene(std::move(desc));
-  EmbreeScene embree(scene);
+  EmbreeBackend embree(scene);
   RenderResult r = render(scene, embree, opt);
   std::map<uint32_t, double> by_spp;
   uint32_t spp = 0;

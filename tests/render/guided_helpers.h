@@ -14,7 +14,7 @@ namespace tessera::testing {
 // One scene + its BVH, rendered with or without a guide.
 struct GuidedScene {
   SceneData scene;
-  EmbreeScene embree;
+  mutable EmbreeBackend embree;  // its per-pass state changes while it renders
   explicit GuidedScene(SceneDesc d) : scene(std::move(d)), embree(scene) {}
 
   GuideField make_guide(const GuideConfig& cfg = {}) const {

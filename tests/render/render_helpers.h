@@ -22,7 +22,7 @@ inline RenderResult render_desc(SceneDesc desc, RenderOptions opt) {
   opt.max_depth = desc.max_depth;
   opt.sampler = sampler_setup(desc);
   SceneData scene(std::move(desc));
-  EmbreeScene embree(scene);
+  EmbreeBackend embree(scene);
   return render(scene, embree, opt);
 }
 

@@ -34,10 +34,10 @@ class TargetError : public ::testing::Test {
     return opt;
   }
   RenderResult render_with(const RenderOptions& opt, const RenderResult* resume = nullptr) {
-    return render(scene_, embree_, opt, nullptr, nullptr, resume);
+    return render(scene_, embree_, opt, nullptr, resume);
   }
   SceneData scene_;
-  EmbreeScene embree_;
+  EmbreeBackend embree_;
 };
 
 // Every pass before the last was above the target (or not yet estimable),

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Prepares, on a machine with the full build and nvcc, what a bare GPU
+# machine needs to check the CUDA backend: the device check program (linked
+# without the renderer's libraries; CUDA's runtime is static) and the
+# fixtures it reads (packed scenes and their host-emulated images).
+# Usage: scripts/gpu_bundle.sh [BUNDLE_DIR] (default .gpu/bundle); then, on
+# the GPU machine, scripts/gpu_check.sh [OUT_DIR] with GPU_BUNDLE=BUNDLE_DIR.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bundle=${1:-.gpu/bundle}
+cmake --build build -j "$(nproc)" --target device_backend_on_device make_gpu_fixtures
+mkdir -p "$bundle/fixtures"
+cp build/device_backend_on_device "$bundle/"
+build/make_gpu_fixtures "$bundle/fixtures" "${SPP:-64}"
+du -sh "$bundle"

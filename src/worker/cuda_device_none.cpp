@@ -1,0 +1,13 @@
+// open_cuda_device for builds without nvcc (the CUDA one is in cuda_device.cu).
+#include "worker/device_api.h"
+
+#if !TESSERA_HAVE_CUDA
+namespace tessera {
+
+std::unique_ptr<DeviceApi> open_cuda_device(std::string* why) {
+  if (why) *why = "this build has no CUDA backend (nvcc was not found when it was built)";
+  return nullptr;
+}
+
+}  // namespace tessera
+#endif

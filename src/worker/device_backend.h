@@ -1,0 +1,73 @@
+// The GPU backend behind the seam (worker/tile_backend.h), over a DeviceApi
+// (worker/device_api.h): the scene and its BVH live in device memory (one
+// PackedScene upload); every pass uploads the guide as it stands after the
+// last fold and a zeroed copy of its accumulator block; each batch of tiles
+// is one launch (one thread per pixel, samples in order, no float atomics),
+// whose pixel accumulators and counters come back to the host; end_pass
+// adds the device's integer accumulators into the pass's block, for the
+// fold and the farm's all-reduction.
+//
+// Served by the full integrator (served_specialisation, as --backend bvh).
+// device_backend_obstacle says which scenes cannot go there yet; --backend
+// auto then picks Embree.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "worker/bvh_build.h"
+#include "worker/device_api.h"
+#include "worker/scene_pack.h"
+#include "worker/scene_data.h"
+#include "worker/tile_backend.h"
+
+namespace tessera {
+
+// What keeps a scene off the device backend, "" if nothing: grid media
+// (not packed yet), caustics traced from the lights (light_paths), and any
+// medium where the device has no media kernels (CUDA: they would double the
+// build).
+std::string device_backend_obstacle(const SceneData& scene, bool light_paths, bool media_kernels);
+
+class DeviceBackend : public TileBackend {
+ public:
+  // Copies `scene` to the device (it is not read afterwards). Throws
+  // std::runtime_error when the scene cannot go to the device or the
+  // device's memory is short.
+  DeviceBackend(const SceneView& scene, std::unique_ptr<DeviceApi> device);
+  // From a scene already packed (with its BVH).
+  DeviceBackend(const PackedScene& packed, std::unique_ptr<DeviceApi> device);
+  ~DeviceBackend() override;
+  DeviceBackend(const DeviceBackend&) = delete;
+  DeviceBackend& operator=(const DeviceBackend&) = delete;
+
+  std::string name() const override { return device_->backend_name(); }
+  bool serves_full_integrator() const override { return true; }
+  uint32_t tiles_per_request(int32_t threads) const override { return kBatchTiles; }
+  void begin_pass(const TileSettings& settings) override;
+  TileCounters render_tiles(TileQueue& queue, int32_t threads) override;
+  void end_pass() override;
+
+  // Tiles per launch: enough pixels to fill a large GPU (16x16 tiles:
+  // 262,144 threads), few enough that a farm's other ranks find tiles.
+  static constexpr uint32_t kBatchTiles = 1024;
+
+ private:
+  // A device allocation that grows (never shrinks) as batches need.
+  struct Buffer {
+    void* ptr = nullptr;
+    size_t bytes = 0;
+  };
+  void* reserve(Buffer& b, size_t bytes);
+  void upload_guide(const GuideView& host);
+
+  std::unique_ptr<DeviceApi> device_;
+  Buffer scene_bytes_, scene_view_, guide_bytes_, guide_acc_, tiles_, pixels_, counters_;
+  BvhView bvh_;
+  TileSettings settings_;      // the pass's, as the host gave them
+  TileSettings device_settings_;  // the same with the guide view in device memory
+  bool in_pass_ = false;
+};
+
+}  // namespace tessera

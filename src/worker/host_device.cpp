@@ -1,0 +1,60 @@
+// The device API emulated on the host (worker/device_api.h): "device"
+// memory is this process's, and a launch runs the CUDA kernel's body
+// (render_device_pixel) for every pixel on a oneTBB arena. It exists so that
+// the device backend's batching, scene packing, guide upload and
+// accumulator return are tested wherever the suite runs.
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+
+#include "worker/device_api.h"
+
+namespace tessera {
+namespace {
+
+template <uint32_t Spec>
+void run_launch(const DeviceLaunch& launch, tbb::task_arena& arena) {
+  arena.execute([&] {
+    tbb::parallel_for(uint32_t{0}, launch.num_tiles, [&](uint32_t tile) {
+      for (uint32_t p = 0; p < launch.max_tile_pixels; ++p) render_device_pixel<Spec>(launch, tile, p);
+    });
+  });
+}
+
+class EmulatedDevice : public DeviceApi {
+ public:
+  explicit EmulatedDevice(int32_t threads) : arena_(std::max(1, threads)) {}
+  std::string backend_name() const override { return "emulated-device"; }
+  std::string description() const override { return "the device kernel on host threads"; }
+  bool has_media_kernels() const override { return true; }
+  void* alloc(size_t bytes) override {
+    void* p = std::aligned_alloc(64, (bytes + 63) & ~size_t{63});
+    if (!p) throw std::bad_alloc();
+    return p;
+  }
+  void release(void* p) noexcept override { std::free(p); }
+  void upload(void* dst, const void* src, size_t bytes) override { std::memcpy(dst, src, bytes); }
+  void download(void* dst, const void* src, size_t bytes) override { std::memcpy(dst, src, bytes); }
+  void zero(void* dst, size_t bytes) override { std::memset(dst, 0, bytes); }
+  void launch(const DeviceLaunch& launch, uint32_t spec) override {
+    switch (served_specialisation(spec)) {
+      case kServedMedia | kSpecGuiding: return run_launch<kServedMedia | kSpecGuiding>(launch, arena_);
+      case kServedMedia: return run_launch<kServedMedia>(launch, arena_);
+      case kServedSurface | kSpecGuiding: return run_launch<kServedSurface | kSpecGuiding>(launch, arena_);
+      default: return run_launch<kServedSurface>(launch, arena_);
+    }
+  }
+
+ private:
+  tbb::task_arena arena_;
+};
+
+}  // namespace
+
+std::unique_ptr<DeviceApi> open_emulated_device(int32_t threads) { return std::make_unique<EmulatedDevice>(threads); }
+
+}  // namespace tessera

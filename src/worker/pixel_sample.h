@@ -1,0 +1,48 @@
+// One camera sample of one pixel, added to the pixel's accumulators: the
+// body every backend runs, a CPU thread tile by tile or a GPU thread per
+// pixel. Host and device code; the random streams depend on (seed, image
+// pixel, sample index) only, so a sample is the same wherever it runs.
+#pragma once
+
+#include "kernels/integrator.h"
+#include "master/film.h"
+#include "worker/render_tile.h"
+
+namespace tessera {
+
+// Image pixel (ix, iy) of the full image (a crop's film pixel plus its
+// offset), sample `si`. `path` is the tile's copy of settings.path (learn is
+// set here, per sample); counters go to *tc.
+template <uint32_t Spec, class Tracer>
+TESSERA_HOST_DEVICE inline void add_camera_sample(const SceneView& s, const Tracer& tracer, const TileSettings& settings,
+                                                  PathSettings& path, int32_t ix, int32_t iy, uint32_t si,
+                                                  PixelAccum& acc, TileCounters& tc) {
+  const uint64_t pixel_index = static_cast<uint64_t>(iy) * static_cast<uint64_t>(s.camera.width) + ix;
+  PixelSampler rng = PixelSampler::start(settings.sampler, static_cast<uint32_t>(ix), static_cast<uint32_t>(iy), pixel_index, si);
+  const CameraSample cs = sample_camera_ray(s, ix, iy, rng);
+  path.learn = settings.learn.learns(si);
+  // Spectral transport: the path's three wavelengths (spectral.h).
+  Wavelengths wl;
+  if (s.spectral.enabled) wl = sample_wavelengths(rng.uniform());
+  Rgb L = trace_path<Spec>(s, tracer, cs.ray, rng, path, tc.path, s.spectral.enabled ? &wl : nullptr);
+  if (!is_finite(L)) {
+    ++tc.rejected_nonfinite;
+    L = Rgb(0.f);
+  } else if (L.x < 0.f || L.y < 0.f || L.z < 0.f) {
+    ++tc.rejected_negative;
+    L = glm::max(L, Rgb(0.f));
+  }
+  if (is_black(L)) ++tc.zero_radiance;
+  // Radiance at three wavelengths to linear sRGB. A single sample's RGB
+  // may be negative (a spectral line outside the sRGB gamut): the mean is not.
+  if (s.spectral.enabled) L = spectral_to_rgb(s.spectral, wl, L);
+  L = film_pixel_value(s.camera, L) * cs.filter_weight;
+  for (int c = 0; c < 3; ++c) {
+    acc.sum[c] += L[c];
+    acc.sum_sq[c] += static_cast<double>(L[c]) * L[c];
+  }
+  ++acc.n;
+  ++tc.samples;
+}
+
+}  // namespace tessera

@@ -1,0 +1,69 @@
+// render_tile's body for any ray-query type, instantiated by each CPU
+// backend (worker/embree_backend.cpp, worker/bvh_backend.cpp) for its tracer.
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include "kernels/light_paths.h"
+#include "worker/pixel_sample.h"
+#include "worker/render_tile.h"
+
+namespace tessera {
+
+// Light paths draw independent numbers of their own (seed, pixel, sample).
+SamplerSetup light_path_sampler(const TileSettings& settings);
+// Merges the splats from `first` on that reach the same pixel (one per path and pixel).
+void merge_splats_by_pixel(std::vector<Splat>& splats, size_t first);
+
+// Media scenes run the full surface integrator (see kSpecMedia): every
+// index with the media bit maps to one of two instantiations.
+constexpr uint32_t instantiated_spec(uint32_t s) {
+  if (!(s & kSpecMedia)) return s;
+  return kSpecMedia | (kSpecSurfaceAll & ~kSpecGuiding) | (s & kSpecGuiding);
+}
+
+// Adds samples [sample_begin, sample_end) of every pixel of the job, in
+// sample order, and with light-traced caustics one light path per sample
+// whose splats are appended to *splats.
+template <uint32_t Spec, class Tracer>
+TileCounters render_tile_spec(const SceneView& s, const Tracer& tracer, const TileSettings& settings,
+                              const TileJob& job, TilePixels pixels, std::vector<Splat>* splats) {
+  TileCounters tc;
+  PathSettings path = settings.path;
+  const bool light_paths = path.light_traced_caustics && splats != nullptr;
+  const SamplerSetup light_sampler = light_path_sampler(settings);
+  auto add_splat = [&](uint64_t pixel, const Rgb& v) {
+    Splat sp;
+    sp.pixel = pixel;
+    sp.value[0] = v.x;
+    sp.value[1] = v.y;
+    sp.value[2] = v.z;
+    splats->push_back(sp);
+  };
+  for (int32_t y = job.y0; y < job.y1; ++y) {
+    for (int32_t x = job.x0; x < job.x1; ++x) {
+      // Tiles are in film pixels; samples belong to the image's pixel, so a
+      // crop renders what the whole image has there.
+      const int32_t ix = s.camera.film_x0 + x, iy = s.camera.film_y0 + y;
+      const uint64_t pixel_index = static_cast<uint64_t>(iy) * static_cast<uint64_t>(s.camera.width) + ix;
+      PixelAccum& acc = pixels.at(job, x, y);
+      for (uint32_t si = job.sample_begin; si < job.sample_end; ++si) {
+        add_camera_sample<Spec>(s, tracer, settings, path, ix, iy, si, acc, tc);
+        if (light_paths) {
+          PixelSampler light_rng = PixelSampler::start(light_sampler, static_cast<uint32_t>(ix),
+                                                       static_cast<uint32_t>(iy), pixel_index, si);
+          Wavelengths light_wl;
+          if (s.spectral.enabled) light_wl = sample_wavelengths(light_rng.uniform());
+          const size_t first = splats->size();
+          trace_caustic_light_path<Spec>(s, tracer, light_rng, path, s.spectral.enabled ? &light_wl : nullptr, tc.path,
+                                         add_splat);
+          merge_splats_by_pixel(*splats, first);
+        }
+      }
+    }
+  }
+  return tc;
+}
+
+}  // namespace tessera

@@ -1,0 +1,71 @@
+// A pass over a whole film with any TileBackend, with no renderer around
+// it: what the GPU check (device_backend_on_device.cpp) and the fixtures it
+// compares with (make_gpu_fixtures.cpp) both run, so their tiles and
+// sample ranges are the same.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <vector>
+
+#include "master/film.h"
+#include "worker/tile_backend.h"
+
+namespace tessera::cuda_check {
+
+class FilmTiles : public TileQueue {
+ public:
+  FilmTiles(Film& film, uint32_t sample_begin, uint32_t sample_end) : film_(film) {
+    for (int32_t y = 0; y < film.height; y += 16)
+      for (int32_t x = 0; x < film.width; x += 16)
+        jobs_.push_back(TileJob{x, y, std::min(x + 16, film.width), std::min(y + 16, film.height), sample_begin,
+                                sample_end, static_cast<uint32_t>(jobs_.size())});
+  }
+  bool take(TileTask* task) override {
+    const size_t i = next_++;
+    if (i >= jobs_.size()) return false;
+    *task = TileTask{jobs_[i], film_tile(film_, jobs_[i]), i};
+    return true;
+  }
+  void done(const TileTask&, uint64_t, std::vector<Splat>&&) override {}
+
+ private:
+  Film& film_;
+  std::vector<TileJob> jobs_;
+  std::atomic<size_t> next_{0};
+};
+
+// Samples [sample_begin, sample_end) of every pixel, added to the film.
+inline TileCounters render_film_pass(TileBackend& backend, const TileSettings& settings, Film& film,
+                                     uint32_t sample_begin, uint32_t sample_end) {
+  FilmTiles tiles(film, sample_begin, sample_end);
+  backend.begin_pass(settings);
+  const TileCounters c = backend.render_tiles(tiles, 1);
+  backend.end_pass();
+  return c;
+}
+
+// Image mean per channel and its standard error (from every pixel's own
+// sample variance: the noise, not the picture's variation).
+struct FilmMean {
+  double mean[3] = {0, 0, 0}, se[3] = {0, 0, 0};
+};
+inline FilmMean film_mean_of(const Film& f) {
+  FilmMean m;
+  const double n = static_cast<double>(f.pixels.size());
+  for (int c = 0; c < 3; ++c) {
+    double s = 0, var = 0;
+    for (const PixelAccum& p : f.pixels) {
+      if (p.n < 2) continue;
+      const double k = static_cast<double>(p.n), mean = p.sum[c] / k;
+      s += mean;
+      var += std::max(0.0, p.sum_sq[c] / k - mean * mean) / (k - 1);
+    }
+    m.mean[c] = s / n;
+    m.se[c] = std::sqrt(var) / n;
+  }
+  return m;
+}
+
+}  // namespace tessera::cuda_check

@@ -1,0 +1,94 @@
+// A scene made ready for the GPU check on a machine that has only a GPU and
+// nvcc's runtime: the packed scene (worker/scene_pack.h), the settings its
+// tiles render with, what a guide over it needs, and the image the host
+// emulation of the device kernel gave for it. Written by
+// make_gpu_fixtures.cpp, read by device_backend_on_device.cpp.
+#pragma once
+
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "master/film.h"
+#include "worker/render_tile.h"
+#include "worker/scene_pack.h"
+
+namespace tessera::cuda_check {
+
+struct GpuFixture {
+  std::string name;
+  TileSettings settings;  // unguided; no guide view
+  int32_t width = 0, height = 0;
+  uint32_t spp = 0;
+  Vec3 lo{0.f}, hi{0.f};  // the scene's bounds, for a guide
+  uint32_t lights = 0;
+  Float max_emitted = 0.f;
+  double host_seconds = 0.0;  // the emulated device's render on the machine that wrote it
+  int32_t host_threads = 0;
+  std::vector<PixelAccum> reference;  // that render: samples [0, spp), one pass
+};
+
+constexpr char kFixtureMagic[8] = {'T', 'S', 'F', 'I', 'X', '0', '0', '1'};
+
+template <class T>
+void put(std::ostream& o, const T& v) {
+  o.write(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+template <class T>
+void get(std::istream& i, T* v) {
+  if (!i.read(reinterpret_cast<char*>(v), sizeof(T))) throw std::runtime_error("fixture: truncated");
+}
+
+inline void save_fixture(const std::string& path, const GpuFixture& f, const PackedScene& scene) {
+  std::ofstream o(path, std::ios::binary);
+  o.write(kFixtureMagic, sizeof(kFixtureMagic));
+  const uint64_t name_size = f.name.size();
+  put(o, name_size);
+  o.write(f.name.data(), static_cast<std::streamsize>(name_size));
+  put(o, f.settings);
+  put(o, f.width);
+  put(o, f.height);
+  put(o, f.spp);
+  put(o, f.lo);
+  put(o, f.hi);
+  put(o, f.lights);
+  put(o, f.max_emitted);
+  put(o, f.host_seconds);
+  put(o, f.host_threads);
+  o.write(reinterpret_cast<const char*>(f.reference.data()),
+          static_cast<std::streamsize>(f.reference.size() * sizeof(PixelAccum)));
+  scene.save(o);
+  if (!o) throw std::runtime_error("fixture: cannot write " + path);
+}
+
+inline PackedScene load_fixture(const std::string& path, GpuFixture* f) {
+  std::ifstream i(path, std::ios::binary);
+  char magic[sizeof(kFixtureMagic)];
+  if (!i.read(magic, sizeof(magic)) || std::memcmp(magic, kFixtureMagic, sizeof(magic)) != 0)
+    throw std::runtime_error("fixture: " + path + " is not a fixture of this version");
+  uint64_t name_size = 0;
+  get(i, &name_size);
+  if (name_size > 4096) throw std::runtime_error("fixture: bad name");
+  f->name.resize(name_size);
+  i.read(f->name.data(), static_cast<std::streamsize>(name_size));
+  get(i, &f->settings);
+  get(i, &f->width);
+  get(i, &f->height);
+  get(i, &f->spp);
+  get(i, &f->lo);
+  get(i, &f->hi);
+  get(i, &f->lights);
+  get(i, &f->max_emitted);
+  get(i, &f->host_seconds);
+  get(i, &f->host_threads);
+  if (f->width <= 0 || f->height <= 0 || f->width > 16384 || f->height > 16384) throw std::runtime_error("fixture: bad size");
+  f->reference.resize(static_cast<size_t>(f->width) * f->height);
+  if (!i.read(reinterpret_cast<char*>(f->reference.data()),
+              static_cast<std::streamsize>(f->reference.size() * sizeof(PixelAccum))))
+    throw std::runtime_error("fixture: truncated");
+  return PackedScene::load(i);
+}
+
+}  // namespace tessera::cuda_check

@@ -1,0 +1,67 @@
+// Writes the GPU check's fixtures (gpu_fixture.h) for the shipped Cornell
+// box and door-ajar: run on a machine with the full build, read on one with
+// a GPU (scripts/gpu_check.sh). Usage: make_gpu_fixtures OUT_DIR [SPP]
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "gpu_fixture.h"
+#include "device_pass.h"
+#include "master/renderer.h"
+#include "scene/pbrt_loader.h"
+#include "scene/sampler_setup.h"
+#include "worker/bvh_build.h"
+#include "worker/device_backend.h"
+
+int main(int argc, char** argv) {
+  using namespace tessera;
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: make_gpu_fixtures OUT_DIR [SPP]\n");
+    return 2;
+  }
+  const std::string out = argv[1];
+  const uint32_t spp = argc > 2 ? static_cast<uint32_t>(std::stoul(argv[2])) : 64;
+  std::filesystem::create_directories(out);
+  try {
+    for (const char* name : {"cornell-box", "door-ajar"}) {
+      SceneDesc desc = load_pbrt_file(std::string(TESSERA_SOURCE_DIR) + "/scenes/" + name + ".pbrt");
+      desc.film.xres = 128;
+      desc.film.yres = 96;
+      const SceneData scene(std::move(desc));
+      RenderOptions opt;
+      opt.seed = 5;
+      opt.max_depth = scene.desc().max_depth;
+      opt.sampler = sampler_setup(scene.desc());
+      opt.force_full_specialisation = true;
+      cuda_check::GpuFixture f;
+      f.name = name;
+      f.settings = make_tile_settings(opt, effective_specialisation(scene, opt, false), false);
+      f.width = scene.view().camera.film_width;
+      f.height = scene.view().camera.film_height;
+      f.spp = spp;
+      f.lo = scene.bounds().lo;
+      f.hi = scene.bounds().hi;
+      f.lights = scene.view().num_lights;
+      f.max_emitted = scene.max_emitted_radiance();
+      f.host_threads = render_threads(opt);
+      const BvhBuild bvh = build_bvh(scene.view());
+      const PackedScene packed(scene.view(), bvh.view());
+      DeviceBackend device(packed, open_emulated_device(f.host_threads));
+      Film film(f.width, f.height);
+      const auto t0 = std::chrono::steady_clock::now();
+      cuda_check::render_film_pass(device, f.settings, film, 0, spp);
+      f.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      f.reference = film.pixels;
+      const std::string path = out + "/" + name + ".fixture";
+      cuda_check::save_fixture(path, f, packed);
+      std::printf("%s: %dx%d, %u spp, emulated device on %d threads: %.2f s (%.3f Msamples/s)\n", path.c_str(),
+                  f.width, f.height, spp, f.host_threads, f.host_seconds,
+                  double(f.width) * f.height * spp / f.host_seconds * 1e-6);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "make_gpu_fixtures: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
