@@ -65,7 +65,14 @@ std::unique_ptr<DeviceApi> open_cuda_device(std::string* why) {
   int count = 0;
   const cudaError_t e = cudaGetDeviceCount(&count);
   if (e != cudaSuccess || count == 0) {
-    if (why) *why = e != cudaSuccess ? std::string("no CUDA device (") + cudaGetErrorString(e) + ")" : "no CUDA device";
+    if (why) {
+      if (e == cudaErrorInsufficientDriver)
+        *why = "no CUDA device (no NVIDIA driver, or one older than this build's CUDA runtime)";
+      else if (e == cudaSuccess || e == cudaErrorNoDevice)
+        *why = "no CUDA device";
+      else
+        *why = std::string("no CUDA device (") + cudaGetErrorString(e) + ")";
+    }
     return nullptr;
   }
   try {

@@ -65,6 +65,22 @@ TEST_F(FarmCliTest, MpirunWritesTheSameExrAsTheLocalRun) {
   }
 }
 
+// Each rank picks its own backend (mpirun's colon syntax gives ranks their
+// own arguments): a BVH rank and an emulated-device rank write the local
+// BVH render's image bit for bit, and the stats name both.
+TEST_F(FarmCliTest, RanksWithDifferentBackendsWriteTheLocalImage) {
+  const std::string args = kDoor + " -q --no-preview --res 64x48 --spp 10 --seed 3";
+  RunResult local = run("render " + args + " --backend bvh -o " + path("local.exr"));
+  ASSERT_EQ(local.exit_code, 0) << local.output;
+  const std::string exr = path("mixed.exr"), js = path("mixed.json");
+  const std::string rank = std::string(TESSERA_BINARY) + " render " + args + " -o " + exr + " --stats " + js;
+  RunResult farm = run_shell("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe -np 1 " +
+                             rank + " --backend bvh : -np 1 " + rank + " --backend emulated-device 2>&1");
+  ASSERT_EQ(farm.exit_code, 0) << farm.output;
+  EXPECT_TRUE(exr_channels(exr) == exr_channels(path("local.exr"))) << "the mixed farm's image differs from the local one";
+  EXPECT_NE(read_text(js).find("\"backend\": \"bvh+emulated-device\""), std::string::npos) << read_text(js);
+}
+
 TEST_F(FarmCliTest, KilledRenderResumesBitIdenticallyOnOtherRankCounts) {
   const std::string args = kDoor + " -q --no-preview --res 128x96 --spp 160 --seed 4";
   RunResult whole = run("render " + args + " -o " + path("whole.exr"));

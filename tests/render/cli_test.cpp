@@ -18,6 +18,7 @@
 #include "../cli_run.h"
 #include "../json_read.h"
 #include "render_helpers.h"
+#include "worker/device_api.h"
 
 namespace tessera {
 namespace {
@@ -434,14 +435,29 @@ TEST_F(CliTest, SceneTooLargeForMemoryFailsBeforeBuilding) {
 
 }  // namespace
 TEST_F(CliTest, BackendsRenderOrRefuseInOneLine) {
-  // The portable BVH renders and says so; CUDA is refused in a build without it.
-  const std::string out = (dir_ / "bvh.exr").string(), stats = (dir_ / "bvh.json").string();
-  const RunResult bvh = run("render -q --backend bvh --spp 4 --res 16x12 --no-preview -o " + out + " --stats " + stats);
-  EXPECT_EQ(bvh.exit_code, 0) << bvh.output;
-  std::ifstream in(stats);
-  const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(json.find("\"backend\": \"bvh\""), std::string::npos);
-  expect_one_line_error(run("render -q --backend cuda --spp 4 --res 16x12 --no-preview -o " + out), "--backend cuda");
+  // The portable BVH and the emulated device render and say so in the
+  // stats; auto says why it chose; CUDA renders where there is a device and
+  // is refused in one line where there is none.
+  auto stats_backend = [&](const std::string& backend) {
+    const std::string out = (dir_ / (backend + ".exr")).string(), stats = (dir_ / (backend + ".json")).string();
+    const RunResult r = run("render --backend " + backend + " --spp 4 --res 16x12 --no-preview -o " + out + " --stats " + stats);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("backend: "), std::string::npos) << r.output;
+    std::ifstream in(stats);
+    const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return json;
+  };
+  EXPECT_NE(stats_backend("bvh").find("\"backend\": \"bvh\""), std::string::npos);
+  EXPECT_NE(stats_backend("emulated-device").find("\"backend\": \"emulated-device\""), std::string::npos);
+  std::string why;
+  const bool device = open_cuda_device(&why) != nullptr;
+  EXPECT_NE(stats_backend("auto").find(device ? "\"backend\": \"cuda\"" : "\"backend\": \"embree\""), std::string::npos);
+  const std::string out = (dir_ / "cuda.exr").string();
+  if (device) {
+    EXPECT_EQ(run("render -q --backend cuda --spp 4 --res 16x12 --no-preview -o " + out).exit_code, 0);
+  } else {
+    expect_one_line_error(run("render -q --backend cuda --spp 4 --res 16x12 --no-preview -o " + out), "--backend cuda");
+  }
 }
 
 }  // namespace tessera
