@@ -407,7 +407,7 @@ std::unique_ptr<TileBackend> backend_for(const RenderArgs& a, const MasterSetup&
   std::string why;
   const std::string name = resolve_backend(a.backend, m.scene.get(), m.opt.light_paths, &why);
   if (log) std::fprintf(stderr, "tessera: backend: %s%s%s\n", name.c_str(), why.empty() ? "" : " (", why.empty() ? "" : (why + ")").c_str());
-  return make_tile_backend(name, *m.scene, render_threads(m.opt));
+  return make_tile_backend(name, *m.scene, render_threads(m.opt), m.opt.light_paths);
 }
 
 int run_render_local(const RenderArgs& a) {
@@ -477,6 +477,11 @@ int run_render_farm(const RenderArgs& a) {
       return 0;
     }
     FarmMaster farm(*t, *backend, std::max(1, threads), sync);
+    if (!farm.backends_agree_bitwise())
+      std::fprintf(stderr,
+                   "tessera: farm: ranks render with %s: which rank renders a tile depends on timing, so the image is "
+                   "reproducible statistically, not bit for bit (docs/farm.md)\n",
+                   farm.backends().c_str());
     render_and_write(a, m, farm, [&](RenderStats& s) {
       s.guide_sync = a.guide_sync;
       s.guide_sync_seconds = farm.sync_seconds();
@@ -509,7 +514,7 @@ CommandRunner add_render_command(CLI::App& app) {
   CLI::App* c = app.add_subcommand("render", "Render a pbrt-v4 scene (default: the built-in Cornell box) to OpenEXR + PNG; under mpirun, as a farm");
   c->add_option("scene", a->scene, "Scene file in pbrt-v4 syntax (omit for the built-in Cornell box)");
   c->add_option("--backend", a->backend,
-                "What renders the tiles: auto (cuda where there is a device and the scene can go there, else embree), "
+                "What renders the tiles: auto (embree until the CUDA backend has been checked on a GPU), "
                 "embree, bvh (the GPU's BVH on the CPU), cuda, emulated-device (the GPU's kernel on the CPU, for "
                 "testing); bvh, cuda and emulated-device run the full integrator")
       ->check(CLI::IsMember({"auto", "embree", "bvh", "cuda", "emulated-device"}));

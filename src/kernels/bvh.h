@@ -32,6 +32,7 @@ struct BvhView {
   const BvhNode* nodes = nullptr;
   const uint32_t* triangles = nullptr;  // triangle indices, leaf by leaf
   uint32_t num_nodes = 0;
+  uint32_t num_triangles = 0;  // entries of triangles (triangles with non-finite bounds are left out)
 };
 
 namespace bvh_detail {

@@ -47,6 +47,12 @@ FarmMaster::FarmMaster(Transport& transport, TileBackend& backend, int32_t local
   }
 }
 
+bool FarmMaster::backends_agree_bitwise() const {
+  std::set<std::string> families;
+  for (const std::string& b : backends_) families.insert(b == "emulated-device" ? "bvh" : b);
+  return families.size() <= 1;
+}
+
 std::string FarmMaster::backends() const {
   std::string all;
   for (const std::string& b : backends_) all += (all.empty() ? "" : "+") + b;

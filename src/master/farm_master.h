@@ -26,6 +26,10 @@ class FarmMaster : public PassExecutor {
   int32_t machines() const override { return transport_.machines(); }
   int32_t total_threads() const override { return total_threads_; }
   std::string backends() const override;
+  // Whether every rank's backend computes the same bits (embree; bvh and
+  // emulated-device; cuda): else the image depends on which rank rendered
+  // which tile, and is reproducible only statistically.
+  bool backends_agree_bitwise() const;
   // Tells the workers the render is over.
   void stop();
 

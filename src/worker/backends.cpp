@@ -9,11 +9,16 @@
 namespace tessera {
 namespace {
 
-// Whether a CUDA device is there (asked once per process).
+// Whether auto may pick CUDA: not until the CUDA backend's renders have been
+// checked on a GPU (scripts/gpu_check.sh with GPU_BUNDLE). Until then a GPU
+// renders only when asked for with --backend cuda.
+constexpr bool kAutoPicksCuda = false;
+
+// Whether a CUDA device is there (asked once per process; makes no context).
 bool cuda_present(std::string* why) {
   static const std::string reason = [] {
     std::string r;
-    if (!open_cuda_device(&r)) return r.empty() ? std::string("no CUDA device") : r;
+    if (cuda_device_count(&r) == 0) return r.empty() ? std::string("no CUDA device") : r;
     return std::string();
   }();
   if (why) *why = reason;
@@ -26,7 +31,7 @@ std::string resolve_backend(const std::string& requested, const SceneData* scene
   if (why) why->clear();
   if (requested == "embree" || requested == "bvh" || requested == "emulated-device") return requested;
   if (requested != "cuda" && requested != "auto")
-    throw std::runtime_error("--backend " + requested + ": unknown backend (auto, embree, bvh, cuda)");
+    throw std::runtime_error("--backend " + requested + ": unknown backend (auto, embree, bvh, cuda, emulated-device)");
   std::string reason;
   bool ok = cuda_present(&reason);
   if (ok && scene) {
@@ -37,23 +42,28 @@ std::string resolve_backend(const std::string& requested, const SceneData* scene
     if (!ok) throw std::runtime_error("--backend cuda: " + reason);
     return "cuda";
   }
+  if (ok && !kAutoPicksCuda) {
+    ok = false;
+    reason = "the CUDA backend has not been checked on a GPU yet; --backend cuda uses it";
+  }
   if (ok) return "cuda";
   if (why) *why = "auto: " + reason;
   return "embree";
 }
 
-std::unique_ptr<TileBackend> make_tile_backend(const std::string& name, const SceneData& scene, int32_t host_threads) {
+std::unique_ptr<TileBackend> make_tile_backend(const std::string& name, const SceneData& scene, int32_t host_threads,
+                                               bool light_paths) {
   if (name == "embree") return std::make_unique<EmbreeBackend>(scene);
   if (name == "bvh") return std::make_unique<BvhBackend>(scene);
   if (name == "emulated-device" || name == "cuda") {
     std::string why;
     std::unique_ptr<DeviceApi> device = name == "cuda" ? open_cuda_device(&why) : open_emulated_device(host_threads);
     if (!device) throw std::runtime_error("--backend " + name + ": " + why);
-    why = device_backend_obstacle(scene, false, device->has_media_kernels());
+    why = device_backend_obstacle(scene, light_paths, device->has_media_kernels());
     if (!why.empty()) throw std::runtime_error("--backend " + name + ": " + why);
     return std::make_unique<DeviceBackend>(scene.view(), std::move(device));
   }
-  throw std::runtime_error("--backend " + name + ": unknown backend (auto, embree, bvh, cuda)");
+  throw std::runtime_error("--backend " + name + ": unknown backend (auto, embree, bvh, cuda, emulated-device)");
 }
 
 }  // namespace tessera

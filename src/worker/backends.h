@@ -1,7 +1,8 @@
 // Picks and builds the backend a process renders with (--backend): the one
-// place that knows every backend. "auto" is CUDA where this binary was built
-// with it, a device is present and the scene can go there; else Embree.
-// Each rank of a farm picks its own.
+// place that knows every backend. "auto" is Embree until the CUDA backend
+// has been checked on a GPU; then it will be CUDA where this binary was
+// built with it, a device is present and the scene can go there. Each rank
+// of a farm picks its own.
 #pragma once
 
 #include <memory>
@@ -21,8 +22,10 @@ std::string resolve_backend(const std::string& requested, const SceneData* scene
                             std::string* why = nullptr);
 
 // Builds backend `name` (as resolve_backend gives it) over `scene`, which
-// must outlive it (the device backends copy it and do not). host_threads: what the emulated device runs on.
+// must outlive it (the device backends copy it and do not). host_threads:
+// what the emulated device runs on. light_paths: the render traces
+// caustics from the lights (the device backends refuse such renders).
 std::unique_ptr<TileBackend> make_tile_backend(const std::string& name, const SceneData& scene,
-                                               int32_t host_threads = 1);
+                                               int32_t host_threads = 1, bool light_paths = false);
 
 }  // namespace tessera

@@ -12,7 +12,10 @@ struct BvhBuild {
   std::vector<BvhNode> nodes;
   std::vector<uint32_t> triangles;
   int depth = 0;  // of the deepest leaf (root = 0), below kBvhStackSize
-  BvhView view() const { return BvhView{nodes.data(), triangles.data(), static_cast<uint32_t>(nodes.size())}; }
+  BvhView view() const {
+    return BvhView{nodes.data(), triangles.data(), static_cast<uint32_t>(nodes.size()),
+                   static_cast<uint32_t>(triangles.size())};
+  }
 };
 
 // Moving triangles are bounded over both time steps. Leaves hold at most

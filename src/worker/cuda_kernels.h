@@ -21,7 +21,8 @@ inline void cuda_check_error(cudaError_t e, const char* what) {
 
 constexpr uint32_t kCudaThreadsPerBlock = 128;
 
-// Launches the kernel over every tile of the batch (a block per tile) and waits; throws on a CUDA error.
+// Queues the trace of every sample of every tile of the batch (a block per
+// tile and sample) on the default stream; throws on a launch error.
 template <uint32_t Spec>
 void launch_render_tiles(const DeviceLaunch& launch);
 // The kernel's stack (local memory) per thread, as ptxas compiled it.

@@ -5,23 +5,23 @@
 
 namespace tessera {
 
+// Block (tile, sample); its threads stride over the tile's pixels.
 template <uint32_t Spec>
-__global__ void __launch_bounds__(kCudaThreadsPerBlock) render_tiles_kernel(DeviceLaunch launch) {
+__global__ void __launch_bounds__(kCudaThreadsPerBlock) trace_samples_kernel(DeviceLaunch launch) {
   for (uint32_t p = threadIdx.x; p < launch.max_tile_pixels; p += blockDim.x)
-    render_device_pixel<Spec>(launch, blockIdx.x, p);
+    trace_device_sample<Spec>(launch, blockIdx.x, p, blockIdx.y);
 }
 
 template <uint32_t Spec>
 void launch_render_tiles(const DeviceLaunch& launch) {
-  render_tiles_kernel<Spec><<<launch.num_tiles, kCudaThreadsPerBlock>>>(launch);
+  trace_samples_kernel<Spec><<<dim3(launch.num_tiles, launch.max_samples), kCudaThreadsPerBlock>>>(launch);
   cuda_check_error(cudaGetLastError(), "launch");
-  cuda_check_error(cudaDeviceSynchronize(), "render_tiles_kernel");
 }
 
 template <uint32_t Spec>
 size_t render_tiles_stack_bytes() {
   cudaFuncAttributes a{};
-  cuda_check_error(cudaFuncGetAttributes(&a, render_tiles_kernel<Spec>), "cudaFuncGetAttributes");
+  cuda_check_error(cudaFuncGetAttributes(&a, trace_samples_kernel<Spec>), "cudaFuncGetAttributes");
   return a.localSizeBytes;
 }
 

@@ -30,13 +30,20 @@ class DeviceApi {
   virtual void upload(void* device_dst, const void* host_src, size_t bytes) = 0;
   virtual void download(void* host_dst, const void* device_src, size_t bytes) = 0;
   virtual void zero(void* device_dst, size_t bytes) = 0;
-  // Renders every pixel of every tile of the launch with the integrator
-  // served_specialisation(spec) names, and waits for it.
-  virtual void launch(const DeviceLaunch& launch, uint32_t spec) = 0;
+  // Starts rendering every sample of every tile of the launch (trace, then
+  // accumulate) with the integrator served_specialisation(spec) names. The
+  // caller polls finished() (the farm master answers its workers meanwhile)
+  // and then calls wait(), which reports the launch's errors.
+  virtual void start(const DeviceLaunch& launch, uint32_t spec) = 0;
+  virtual bool finished() = 0;
+  virtual void wait() = 0;
 };
 
-// The first CUDA device, or null with *why saying why not (no device, or a
-// build without nvcc).
+// How many CUDA devices there are (no context is made); 0 with *why saying
+// why not (no device or driver, or a build without nvcc).
+int cuda_device_count(std::string* why);
+// A CUDA device, or null with *why saying why not. Ranks of a farm on one
+// machine take devices in turn (their local rank, modulo the count).
 std::unique_ptr<DeviceApi> open_cuda_device(std::string* why);
 // The kernel body on `threads` host threads, memory in this process.
 std::unique_ptr<DeviceApi> open_emulated_device(int32_t threads);

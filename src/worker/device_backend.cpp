@@ -1,8 +1,10 @@
 #include "worker/device_backend.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
+#include <thread>
 
 #include "worker/scene_pack.h"
 
@@ -58,29 +60,24 @@ DeviceBackend::DeviceBackend(const SceneView& scene, std::unique_ptr<DeviceApi> 
 
 DeviceBackend::DeviceBackend(const PackedScene& packed, std::unique_ptr<DeviceApi> device)
     : device_(std::move(device)) {
-  void* base = reserve(scene_bytes_, packed.size());
+  void* base = scene_bytes_.reserve(packed.size());
   std::vector<unsigned char> staging(packed.size());
   packed.write_for(reinterpret_cast<uintptr_t>(base), staging.data());
   device_->upload(base, staging.data(), staging.size());
   const SceneView view = packed.view_at(reinterpret_cast<uintptr_t>(base));
-  device_->upload(reserve(scene_view_, sizeof(SceneView)), &view, sizeof(SceneView));
+  device_->upload(scene_view_.reserve(sizeof(SceneView)), &view, sizeof(SceneView));
   bvh_ = packed.bvh_at(reinterpret_cast<uintptr_t>(base));
 }
 
-DeviceBackend::~DeviceBackend() {
-  for (Buffer* b : {&scene_bytes_, &scene_view_, &guide_bytes_, &guide_acc_, &tiles_, &pixels_, &counters_})
-    if (b->ptr) device_->release(b->ptr);
-}
-
-void* DeviceBackend::reserve(Buffer& b, size_t bytes) {
+void* DeviceBackend::Buffer::reserve(size_t bytes) {
   bytes = std::max<size_t>(bytes, 16);
-  if (b.bytes >= bytes) return b.ptr;
-  if (b.ptr) device_->release(b.ptr);
-  b.ptr = nullptr;
-  b.bytes = 0;
-  b.ptr = device_->alloc(bytes);
-  b.bytes = bytes;
-  return b.ptr;
+  if (bytes_ >= bytes) return ptr_;
+  device_.release(ptr_);
+  ptr_ = nullptr;
+  bytes_ = 0;
+  ptr_ = device_.alloc(bytes);
+  bytes_ = bytes;
+  return ptr_;
 }
 
 // The guide as it stands (frozen for the pass) and a zeroed accumulator
@@ -100,9 +97,9 @@ void DeviceBackend::upload_guide(const GuideView& g) {
   const size_t light_prob = st.add(g.cell_light_prob, g.cell_light_prob ? cells : 0);
   const size_t nee_prob = st.add(g.nee_prob, g.nee_prob ? cells : 0);
   const size_t mix = st.add(g.cell_mix, cells);
-  void* base = reserve(guide_bytes_, st.bytes().size());
+  void* base = guide_bytes_.reserve(st.bytes().size());
   device_->upload(base, st.bytes().data(), st.bytes().size());
-  uint64_t* acc = static_cast<uint64_t*>(reserve(guide_acc_, g.acc_words * sizeof(uint64_t)));
+  uint64_t* acc = static_cast<uint64_t*>(guide_acc_.reserve(g.acc_words * sizeof(uint64_t)));
   device_->zero(acc, g.acc_words * sizeof(uint64_t));
 
   GuideView& d = device_settings_.path.guide;
@@ -146,7 +143,7 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
     tasks.clear();
     tiles.clear();
     pixels.clear();
-    uint32_t max_tile_pixels = 0;
+    uint32_t max_tile_pixels = 0, max_samples = 0;
     TileTask task;
     while (tasks.size() < kBatchTiles && queue.take(&task)) {
       const TileJob& j = task.job;
@@ -154,26 +151,36 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
       for (int32_t y = j.y0; y < j.y1; ++y)
         for (int32_t x = j.x0; x < j.x1; ++x) pixels.push_back(task.pixels.at(j, x, y));
       max_tile_pixels = std::max(max_tile_pixels, static_cast<uint32_t>(pixels.size() - t.first_pixel));
+      max_samples = std::max(max_samples, tile_samples(t));
       tiles.push_back(t);
       tasks.push_back(task);
     }
     if (tasks.empty()) break;
     DeviceLaunch launch;
-    launch.scene = static_cast<const SceneView*>(scene_view_.ptr);
+    launch.scene = static_cast<const SceneView*>(scene_view_.get());
     launch.bvh = bvh_;
     launch.settings = device_settings_;
     launch.num_tiles = static_cast<uint32_t>(tiles.size());
     launch.max_tile_pixels = max_tile_pixels;
-    auto* d_tiles = static_cast<DeviceTile*>(reserve(tiles_, tiles.size() * sizeof(DeviceTile)));
-    auto* d_pixels = static_cast<PixelAccum*>(reserve(pixels_, pixels.size() * sizeof(PixelAccum)));
-    auto* d_counters = static_cast<TileCounters*>(reserve(counters_, sizeof(TileCounters)));
+    launch.max_samples = max_samples;
+    auto* d_tiles = static_cast<DeviceTile*>(tiles_.reserve(tiles.size() * sizeof(DeviceTile)));
+    auto* d_pixels = static_cast<PixelAccum*>(pixels_.reserve(pixels.size() * sizeof(PixelAccum)));
+    auto* d_values = static_cast<Rgb*>(values_.reserve(pixels.size() * max_samples * sizeof(Rgb)));
+    auto* d_counters = static_cast<TileCounters*>(counters_.reserve(sizeof(TileCounters)));
     device_->upload(d_tiles, tiles.data(), tiles.size() * sizeof(DeviceTile));
     device_->upload(d_pixels, pixels.data(), pixels.size() * sizeof(PixelAccum));
     device_->zero(d_counters, sizeof(TileCounters));
     launch.tiles = d_tiles;
     launch.pixels = d_pixels;
+    launch.values = d_values;
     launch.counters = d_counters;
-    device_->launch(launch, served_specialisation(settings_.specialisation));
+    device_->start(launch, served_specialisation(settings_.specialisation));
+    // A farm master answers its workers while the device renders.
+    while (!device_->finished()) {
+      queue.between_tiles();
+      std::this_thread::sleep_for(std::chrono::microseconds(50));
+    }
+    device_->wait();
     device_->download(pixels.data(), d_pixels, pixels.size() * sizeof(PixelAccum));
     TileCounters batch;
     device_->download(&batch, d_counters, sizeof(TileCounters));
@@ -195,7 +202,7 @@ void DeviceBackend::end_pass() {
   const GuideView& g = settings_.path.guide;
   if (in_pass_ && g.acc != nullptr && g.acc_words > 0) {
     std::vector<uint64_t> learned(g.acc_words);
-    device_->download(learned.data(), guide_acc_.ptr, learned.size() * sizeof(uint64_t));
+    device_->download(learned.data(), guide_acc_.get(), learned.size() * sizeof(uint64_t));
     for (size_t i = 0; i < learned.size(); ++i) g.acc[i] += learned[i];  // integers: order-free
   }
   in_pass_ = false;

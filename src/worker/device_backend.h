@@ -38,7 +38,6 @@ class DeviceBackend : public TileBackend {
   DeviceBackend(const SceneView& scene, std::unique_ptr<DeviceApi> device);
   // From a scene already packed (with its BVH).
   DeviceBackend(const PackedScene& packed, std::unique_ptr<DeviceApi> device);
-  ~DeviceBackend() override;
   DeviceBackend(const DeviceBackend&) = delete;
   DeviceBackend& operator=(const DeviceBackend&) = delete;
 
@@ -49,21 +48,33 @@ class DeviceBackend : public TileBackend {
   TileCounters render_tiles(TileQueue& queue, int32_t threads) override;
   void end_pass() override;
 
-  // Tiles per launch: enough pixels to fill a large GPU (16x16 tiles:
-  // 262,144 threads), few enough that a farm's other ranks find tiles.
-  static constexpr uint32_t kBatchTiles = 1024;
+  // Tiles per launch (and per farm request): with a thread per pixel and
+  // sample, 256 16x16 tiles are 65,536 threads per sample of the pass;
+  // few enough that a farm's other ranks find tiles.
+  static constexpr uint32_t kBatchTiles = 256;
 
  private:
-  // A device allocation that grows (never shrinks) as batches need.
-  struct Buffer {
-    void* ptr = nullptr;
-    size_t bytes = 0;
+  // A device allocation that grows (never shrinks) as batches need, freed
+  // with the backend (or when its constructor fails).
+  class Buffer {
+   public:
+    explicit Buffer(DeviceApi& device) : device_(device) {}
+    ~Buffer() { device_.release(ptr_); }
+    Buffer(const Buffer&) = delete;
+    Buffer& operator=(const Buffer&) = delete;
+    void* reserve(size_t bytes);
+    void* get() const { return ptr_; }
+
+   private:
+    DeviceApi& device_;
+    void* ptr_ = nullptr;
+    size_t bytes_ = 0;
   };
-  void* reserve(Buffer& b, size_t bytes);
   void upload_guide(const GuideView& host);
 
-  std::unique_ptr<DeviceApi> device_;
-  Buffer scene_bytes_, scene_view_, guide_bytes_, guide_acc_, tiles_, pixels_, counters_;
+  std::unique_ptr<DeviceApi> device_;  // declared first: the buffers are freed before it goes
+  Buffer scene_bytes_{*device_}, scene_view_{*device_}, guide_bytes_{*device_}, guide_acc_{*device_};
+  Buffer tiles_{*device_}, pixels_{*device_}, values_{*device_}, counters_{*device_};
   BvhView bvh_;
   TileSettings settings_;      // the pass's, as the host gave them
   TileSettings device_settings_;  // the same with the guide view in device memory

@@ -1,6 +1,6 @@
 // The device API emulated on the host (worker/device_api.h): "device"
-// memory is this process's, and a launch runs the CUDA kernel's body
-// (render_device_pixel) for every pixel on a oneTBB arena. It exists so that
+// memory is this process's, and a launch runs the CUDA kernels' bodies
+// (worker/device_tiles.h) on a oneTBB arena, in the same two steps. It exists so that
 // the device backend's batching, scene packing, guide upload and
 // accumulator return are tested wherever the suite runs.
 #include <tbb/parallel_for.h>
@@ -19,8 +19,13 @@ namespace {
 template <uint32_t Spec>
 void run_launch(const DeviceLaunch& launch, tbb::task_arena& arena) {
   arena.execute([&] {
+    const uint64_t steps = uint64_t{launch.num_tiles} * launch.max_samples;
+    tbb::parallel_for(uint64_t{0}, steps, [&](uint64_t i) {
+      const uint32_t tile = static_cast<uint32_t>(i / launch.max_samples), sample = static_cast<uint32_t>(i % launch.max_samples);
+      for (uint32_t p = 0; p < launch.max_tile_pixels; ++p) trace_device_sample<Spec>(launch, tile, p, sample);
+    });
     tbb::parallel_for(uint32_t{0}, launch.num_tiles, [&](uint32_t tile) {
-      for (uint32_t p = 0; p < launch.max_tile_pixels; ++p) render_device_pixel<Spec>(launch, tile, p);
+      for (uint32_t p = 0; p < launch.max_tile_pixels; ++p) accumulate_device_pixel(launch, tile, p);
     });
   });
 }
@@ -40,7 +45,10 @@ class EmulatedDevice : public DeviceApi {
   void upload(void* dst, const void* src, size_t bytes) override { std::memcpy(dst, src, bytes); }
   void download(void* dst, const void* src, size_t bytes) override { std::memcpy(dst, src, bytes); }
   void zero(void* dst, size_t bytes) override { std::memset(dst, 0, bytes); }
-  void launch(const DeviceLaunch& launch, uint32_t spec) override {
+  bool finished() override { return true; }
+  void wait() override {}
+  // Runs the launch to its end: the emulation has nothing to overlap.
+  void start(const DeviceLaunch& launch, uint32_t spec) override {
     switch (served_specialisation(spec)) {
       case kServedMedia | kSpecGuiding: return run_launch<kServedMedia | kSpecGuiding>(launch, arena_);
       case kServedMedia: return run_launch<kServedMedia>(launch, arena_);

@@ -110,7 +110,7 @@ PackedScene::PackedScene(const SceneView& s, const BvhView& bvh) {
   point_view(v.infinite_lights, s.infinite_lights, s.num_infinite_lights);
   pack_env_distributions(s);
   point_view(v.media, s.media, s.num_media);
-  point_view(v.triangle_media, s.triangle_media, s.media ? tris : 0);
+  point_view(v.triangle_media, s.triangle_media, s.triangle_media ? tris : 0);
   v.grids = nullptr;
   point_view(v.filter.inverse_cdf_x, s.filter.inverse_cdf_x, s.filter.n);
   point_view(v.filter.inverse_cdf_y, s.filter.inverse_cdf_y, s.filter.n);
@@ -127,7 +127,7 @@ PackedScene::PackedScene(const SceneView& s, const BvhView& bvh) {
   }
   point_view(v.spectra, s.spectra, static_cast<size_t>(s.num_spectra) * kSpectralSamples);
   point_view(views_.bvh.nodes, bvh.nodes, bvh.num_nodes);
-  point_view(views_.bvh.triangles, bvh.triangles, bvh.nodes ? tris : 0);
+  point_view(views_.bvh.triangles, bvh.triangles, bvh.num_triangles);
   if (bytes_.empty()) bytes_.resize(16, 0);
 }
 

@@ -2,8 +2,8 @@
 // array a SceneView points to (and the arrays inside its images and
 // environment distributions) copied back to back, plus the list of every
 // pointer to patch for wherever the buffer lands. One allocation and one
-// copy upload the whole scene (worker/cuda_backend.cu); on the CPU a render
-// from the packed copy proves the packing complete (tests/render/scene_pack_test.cpp).
+// copy upload the whole scene (worker/device_backend.cpp); on the CPU the
+// emulated device renders from the packed copy (tests/render/device_backend_test.cpp).
 // Grid media are not packed yet: such scenes throw std::runtime_error.
 #pragma once
 

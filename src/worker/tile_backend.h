@@ -2,7 +2,8 @@
 // loop (master/renderer.cpp), the farm master and the farm worker hand tiles
 // to a TileBackend through a TileQueue and never see how they are traced:
 // Embree on this process's threads (worker/embree_backend.h), the portable
-// BVH on them (worker/bvh_backend.h), or a GPU (worker/cuda_backend.h).
+// BVH on them (worker/bvh_backend.h), or a device (worker/device_backend.h:
+// CUDA, or the GPU's kernel emulated on the host).
 // make_tile_backend (worker/backends.h) picks one.
 #pragma once
 

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <memory>
 
 #include "comm/inproc_transport.h"
@@ -19,9 +20,11 @@
 #include "render_helpers.h"
 #include "worker/backends.h"
 #include "worker/bvh_backend.h"
+#include "worker/bvh_build.h"
 #include "worker/device_api.h"
 #include "worker/device_backend.h"
 #include "worker/farm_worker.h"
+#include "worker/scene_pack.h"
 
 namespace tessera {
 namespace {
@@ -81,11 +84,14 @@ TEST(DeviceBackend, EqualsTheBvhOnTheShippedScenes) {
 }
 
 TEST(DeviceBackend, EqualsTheBvhWithTexturesSpectraImagesMediaAndMotion) {
-  {
+  for (const bool spectral : {false, true}) {
     SceneDesc d = load_pbrt_file(testing::source_dir() + "/tests/data/materials.pbrt");
     d.film.xres = 32;
     d.film.yres = 18;
-    expect_device_equals_bvh(SceneData(std::move(d)), "materials");
+    d.spectral = spectral;  // the spectral tables and measured spectra go to the device too
+    const SceneData scene(std::move(d));
+    ASSERT_EQ(scene.view().spectral.enabled, spectral);
+    expect_device_equals_bvh(scene, spectral ? "materials (spectral)" : "materials");
   }
   // An image environment (its texels and sampling distribution), a medium,
   // cut-outs, a one-way curve tube and a moving triangle.
@@ -123,6 +129,108 @@ AttributeEnd
   expect_device_equals_bvh(data, "image sky, medium, cut-outs, tube, motion", 4);
 }
 
+// Every array of the packed view lies in the buffer and holds what the
+// scene's own view points to (a pointer left behind would read host memory
+// on the GPU), nested ones (images, environment distributions) included.
+class PackedPointers {
+ public:
+  PackedPointers(const unsigned char* lo, size_t size) : lo_(lo), hi_(lo + size) {}
+  template <class T>
+  void expect(const T* original, const T* packed, size_t n, const char* what) {
+    ++checked;
+    if (original == nullptr || n == 0) {
+      EXPECT_TRUE(packed == nullptr || n == 0) << what;
+      return;
+    }
+    const auto* p = reinterpret_cast<const unsigned char*>(packed);
+    ASSERT_TRUE(p >= lo_ && p + n * sizeof(T) <= hi_) << what << " points outside the packed buffer";
+    EXPECT_EQ(std::memcmp(original, packed, n * sizeof(T)), 0) << what << " differs from the scene's";
+  }
+  int checked = 0;
+
+ private:
+  const unsigned char *lo_, *hi_;
+};
+
+void expect_packed_completely(const SceneData& scene, const std::string& what) {
+  const SceneView& o = scene.view();
+  const BvhBuild bvh = build_bvh(o);
+  const PackedScene packed(o, bvh.view());
+  std::vector<unsigned char> buffer(packed.size() + 16);
+  unsigned char* at = buffer.data() + (16 - reinterpret_cast<uintptr_t>(buffer.data()) % 16) % 16;
+  packed.write_for(reinterpret_cast<uintptr_t>(at), at);
+  const SceneView v = packed.view_at(reinterpret_cast<uintptr_t>(at));
+  const BvhView b = packed.bvh_at(reinterpret_cast<uintptr_t>(at));
+  PackedPointers c(at, packed.size());
+  SCOPED_TRACE(what);
+  const size_t tris = o.num_triangles;
+  c.expect(o.positions, v.positions, o.num_vertices, "positions");
+  c.expect(o.normals, v.normals, o.num_normals, "normals");
+  c.expect(o.positions_end, v.positions_end, o.num_vertices, "positions_end");
+  c.expect(o.normals_end, v.normals_end, o.num_normals, "normals_end");
+  c.expect(o.uvs, v.uvs, o.num_uvs, "uvs");
+  c.expect(o.indices, v.indices, 3 * tris, "indices");
+  c.expect(o.triangles, v.triangles, tris, "triangles");
+  c.expect(o.face_normals, v.face_normals, tris, "face_normals");
+  c.expect(o.triangle_alpha, v.triangle_alpha, tris, "triangle_alpha");
+  c.expect(o.materials, v.materials, o.num_materials, "materials");
+  c.expect(o.textures, v.textures, o.num_textures, "textures");
+  for (uint32_t i = 0; i < o.num_images; ++i)
+    c.expect(o.images[i].texels, v.images[i].texels, size_t(o.images[i].width) * o.images[i].height, "image texels");
+  c.expect(o.lights, v.lights, o.num_lights, "lights");
+  c.expect(o.light_select.func, v.light_select.func, o.light_select.n, "light_select.func");
+  c.expect(o.light_select.cdf, v.light_select.cdf, o.light_select.n + 1, "light_select.cdf");
+  c.expect(o.infinite_lights, v.infinite_lights, o.num_infinite_lights, "infinite_lights");
+  for (uint32_t i = 0; o.env_distributions && i < o.num_lights; ++i) {
+    const Distribution2DView &e = o.env_distributions[i], &p = v.env_distributions[i];
+    c.expect(e.func, p.func, size_t(e.width) * e.height, "env func");
+    c.expect(e.cond_cdf, p.cond_cdf, size_t(e.width + 1) * e.height, "env cond_cdf");
+    c.expect(e.cond_integral, p.cond_integral, e.height, "env cond_integral");
+    c.expect(e.marginal.func, p.marginal.func, e.marginal.n, "env marginal func");
+    c.expect(e.marginal.cdf, p.marginal.cdf, e.marginal.n + 1, "env marginal cdf");
+  }
+  c.expect(o.media, v.media, o.num_media, "media");
+  c.expect(o.triangle_media, v.triangle_media, tris, "triangle_media");
+  c.expect(o.filter.inverse_cdf_x, v.filter.inverse_cdf_x, o.filter.n, "filter x");
+  c.expect(o.filter.inverse_cdf_y, v.filter.inverse_cdf_y, o.filter.n, "filter y");
+  c.expect(o.filter.weight_x, v.filter.weight_x, o.filter.bins, "filter weight x");
+  c.expect(o.filter.weight_y, v.filter.weight_y, o.filter.bins, "filter weight y");
+  if (o.spectral.enabled) {
+    const size_t res = size_t(o.spectral.res);
+    c.expect(o.spectral.cmf, v.spectral.cmf, 3 * kSpectralSamples, "cmf");
+    c.expect(o.spectral.illuminant, v.spectral.illuminant, kSpectralSamples, "illuminant");
+    c.expect(o.spectral.table_scale, v.spectral.table_scale, res, "table_scale");
+    c.expect(o.spectral.table, v.spectral.table, 9 * res * res * res, "rgb-to-spectrum table");
+  }
+  c.expect(o.spectra, v.spectra, size_t(o.num_spectra) * kSpectralSamples, "spectra");
+  c.expect(bvh.view().nodes, b.nodes, bvh.nodes.size(), "bvh nodes");
+  c.expect(bvh.view().triangles, b.triangles, bvh.triangles.size(), "bvh triangles");
+  EXPECT_GE(c.checked, 30);
+}
+
+TEST(PackedScene, EveryArrayLandsInTheBufferWithItsContents) {
+  for (const bool spectral : {false, true}) {
+    SceneDesc d = load_pbrt_file(testing::source_dir() + "/tests/data/materials.pbrt");
+    d.spectral = spectral;
+    expect_packed_completely(SceneData(std::move(d)), spectral ? "materials (spectral)" : "materials");
+  }
+  expect_packed_completely(shipped("door-ajar"), "door-ajar");
+  // Measured spectra (a dispersive glass) are packed too.
+  SceneDesc glass = load_pbrt_string(R"(
+LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" [ 40 ]
+Film "rgb" "integer xresolution" [ 8 ] "integer yresolution" [ 8 ]
+WorldBegin
+LightSource "infinite"
+Material "dielectric" "spectrum eta" "glass-BK7"
+Shape "sphere" "float radius" 0.6
+)", "glass.pbrt", ".");
+  glass.spectral = true;
+  const SceneData dispersive(std::move(glass));
+  ASSERT_GT(dispersive.view().num_spectra, 0u);
+  expect_packed_completely(dispersive, "dispersive glass");
+}
+
 // The device holds its own copy: the scene it was built from may go.
 TEST(DeviceBackend, RendersWithTheSceneItWasBuiltFromGone) {
   SceneData scene = shipped("door-ajar");
@@ -136,10 +244,31 @@ TEST(DeviceBackend, RendersWithTheSceneItWasBuiltFromGone) {
   expect_same_render(render(scene, bvh, opt), render(scene, *device, opt), "door-ajar");
 }
 
-// Device ranks take batches of tiles: a farm of BVH and device ranks gives
-// the local BVH image and field, bit for bit, and names both backends.
+// A backend that counts the samples it rendered (so a farm test knows every rank took part).
+class CountingBackend : public TileBackend {
+ public:
+  explicit CountingBackend(std::unique_ptr<TileBackend> inner) : inner_(std::move(inner)) {}
+  std::string name() const override { return inner_->name(); }
+  bool serves_full_integrator() const override { return inner_->serves_full_integrator(); }
+  uint32_t tiles_per_request(int32_t threads) const override { return inner_->tiles_per_request(threads); }
+  void begin_pass(const TileSettings& s) override { inner_->begin_pass(s); }
+  TileCounters render_tiles(TileQueue& q, int32_t threads) override {
+    const TileCounters c = inner_->render_tiles(q, threads);
+    samples += c.samples;
+    return c;
+  }
+  void end_pass() override { inner_->end_pass(); }
+  uint64_t samples = 0;
+
+ private:
+  std::unique_ptr<TileBackend> inner_;
+};
+
+// Device ranks take batches of tiles: a farm of a BVH master (one tile at a
+// time, answering the workers between tiles) and device workers gives the
+// local BVH image and field, bit for bit, and names both backends.
 TEST(DeviceBackend, FarmOfDeviceAndBvhRanksEqualsTheLocalImage) {
-  const SceneData scene = shipped("door-ajar", 48, 36);
+  const SceneData scene = shipped("door-ajar", 96, 72);
   RenderOptions opt = small_options(scene, 8);
   opt.threads = 1;
   GuideField local_guide = make_guide(scene);
@@ -150,11 +279,11 @@ TEST(DeviceBackend, FarmOfDeviceAndBvhRanksEqualsTheLocalImage) {
   InProcessHub hub(ranks);
   std::vector<std::unique_ptr<Transport>> ends;
   std::vector<std::unique_ptr<GuideField>> guides;
-  std::vector<std::unique_ptr<TileBackend>> backends;
+  std::vector<std::unique_ptr<CountingBackend>> backends;
   for (int32_t r = 0; r < ranks; ++r) {
     ends.push_back(hub.endpoint(r));
     guides.push_back(std::make_unique<GuideField>(make_guide(scene)));
-    backends.push_back(make_tile_backend(r == 1 ? "bvh" : "emulated-device", scene, 1));
+    backends.push_back(std::make_unique<CountingBackend>(make_tile_backend(r == 0 ? "bvh" : "emulated-device", scene, 1)));
   }
   const uint32_t spec = effective_specialisation(scene, opt, true);
   std::vector<std::thread> workers;
@@ -168,7 +297,10 @@ TEST(DeviceBackend, FarmOfDeviceAndBvhRanksEqualsTheLocalImage) {
   for (auto& w : workers) w.join();
   EXPECT_EQ(farm.stats.backend, "bvh+emulated-device");
   expect_same_render(local, farm, "farm");
-  for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(*guides[r] == local_guide) << "rank " << r;
+  for (int32_t r = 0; r < ranks; ++r) {
+    EXPECT_TRUE(*guides[r] == local_guide) << "rank " << r;
+    EXPECT_GT(backends[r]->samples, 0u) << "rank " << r << " rendered nothing";
+  }
 }
 
 TEST(DeviceBackend, ScenesTheDeviceCannotHoldSayWhy) {
