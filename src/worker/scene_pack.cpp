@@ -5,6 +5,7 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "worker/pod_io.h"
 
 namespace tessera {
 namespace {
@@ -162,16 +163,6 @@ namespace {
 
 constexpr char kPackMagic[8] = {'T', 'S', 'P', 'A', 'C', 'K', '0', '1'};
 
-template <class T>
-void write_pod(std::ostream& out, const T& v) {
-  out.write(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-
-template <class T>
-void read_pod(std::istream& in, T* v) {
-  if (!in.read(reinterpret_cast<char*>(v), sizeof(T))) throw std::runtime_error("packed scene: truncated");
-}
-
 }  // namespace
 
 void PackedScene::save(std::ostream& out) const {
@@ -194,19 +185,19 @@ PackedScene PackedScene::load(std::istream& in) {
     throw std::runtime_error("packed scene: not a packed scene of this version");
   PackedScene p;
   uint64_t n = 0;
-  read_pod(in, &n);
+  read_pod(in, &n, "packed scene");
   if (n != sizeof(Views)) throw std::runtime_error("packed scene: written by a different build");
-  read_pod(in, &p.views_);
-  read_pod(in, &n);
+  read_pod(in, &p.views_, "packed scene");
+  read_pod(in, &n, "packed scene");
   if (n % 16 != 0 || n > (uint64_t{1} << 40)) throw std::runtime_error("packed scene: bad size");
   p.bytes_.resize(n);
   if (!in.read(reinterpret_cast<char*>(p.bytes_.data()), static_cast<std::streamsize>(n)))
     throw std::runtime_error("packed scene: truncated");
-  read_pod(in, &n);
+  read_pod(in, &n, "packed scene");
   for (uint64_t i = 0; i < n; ++i) {
     uint64_t in_views = 0, at = 0;
-    read_pod(in, &in_views);
-    read_pod(in, &at);
+    read_pod(in, &in_views, "packed scene");
+    read_pod(in, &at, "packed scene");
     const size_t limit = in_views ? sizeof(Views) : p.bytes_.size();
     if (at + sizeof(uintptr_t) > limit) throw std::runtime_error("packed scene: bad pointer entry");
     p.fixups_.push_back({in_views != 0, static_cast<size_t>(at)});

@@ -10,13 +10,20 @@
 //     back from the device, the image agrees with the unguided one, and a
 //     second guided render is the same bit for bit with the same field;
 //   - figures: samples/s unguided and guided, time per path vertex guided /
-//     unguided, and against the host emulation's figure in the fixture.
+//     unguided; against Embree on the machine that made the fixture (the
+//     2-core CPU) and against the same kernels on this machine's own cores.
 // Usage: device_backend_on_device FIXTURE...   (exit 0 pass, 1 fail, 77 no device;
-// --probe: 0 when a device is here)
+// --probe: 0 when a device is here; TESSERA_GPU_CHECK_DRY_RUN=1: host
+// threads stand in for the GPU, to check this program itself)
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <new>
+#include <thread>
+#include <vector>
 
 #include "cuda_check.h"
 #include "device_pass.h"
@@ -27,13 +34,60 @@
 namespace tessera::cuda_check {
 namespace {
 
+// The device kernels' bodies on this machine's own cores (std::thread): the
+// GPU against the CPU of the same machine, same code, same run.
+class HostThreadsDevice : public DeviceApi {
+ public:
+  explicit HostThreadsDevice(int threads) : threads_(std::max(1, threads)) {}
+  std::string backend_name() const override { return "host-threads"; }
+  std::string description() const override { return std::to_string(threads_) + " host threads"; }
+  bool has_media_kernels() const override { return false; }
+  void* alloc(size_t bytes) override {
+    void* p = std::aligned_alloc(64, (bytes + 63) & ~size_t{63});
+    if (!p) throw std::bad_alloc();
+    return p;
+  }
+  void release(void* p) noexcept override { std::free(p); }
+  void upload(void* dst, const void* src, size_t bytes) override { std::memcpy(dst, src, bytes); }
+  void download(void* dst, const void* src, size_t bytes) override { std::memcpy(dst, src, bytes); }
+  void zero(void* dst, size_t bytes) override { std::memset(dst, 0, bytes); }
+  bool finished() override { return true; }
+  void wait() override {}
+  void start(const DeviceLaunch& launch, uint32_t spec) override {
+    if ((served_specialisation(spec) & kSpecGuiding) != 0)
+      run<kServedSurface | kSpecGuiding>(launch);
+    else
+      run<kServedSurface>(launch);
+  }
+
+ private:
+  template <uint32_t Spec>
+  void run(const DeviceLaunch& launch) {
+    const uint64_t steps = uint64_t{launch.num_tiles} * launch.max_samples;
+    std::atomic<uint64_t> next{0};
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads_; ++t)
+      pool.emplace_back([&] {
+        for (uint64_t i = next++; i < steps; i = next++)
+          for (uint32_t p = 0; p < launch.max_tile_pixels; ++p)
+            trace_device_sample<Spec>(launch, static_cast<uint32_t>(i / launch.max_samples), p,
+                                      static_cast<uint32_t>(i % launch.max_samples));
+      });
+    for (std::thread& t : pool) t.join();
+    for (uint32_t tile = 0; tile < launch.num_tiles; ++tile)
+      for (uint32_t p = 0; p < launch.max_tile_pixels; ++p) accumulate_device_pixel(launch, tile, p);
+  }
+  int threads_;
+};
+
 struct Timed {
   Film film;
   TileCounters counters;
   double seconds = 0.0;
 };
 
-// Passes of 1, 1, 2, 4, 8, ... spp up to `spp`, the guide folded after each.
+// Passes of 1, 1, 2, 4, 8, ... spp up to `spp` (guided or not, the same
+// passes), the guide folded after each.
 Timed render(DeviceBackend& backend, const GpuFixture& f, GuideField* guide) {
   Timed t{Film(f.width, f.height), {}, 0.0};
   TileSettings s = f.settings;
@@ -41,7 +95,7 @@ Timed render(DeviceBackend& backend, const GpuFixture& f, GuideField* guide) {
   const auto t0 = std::chrono::steady_clock::now();
   uint32_t done = 0;
   for (uint32_t pass = 0; done < f.spp; ++pass) {
-    const uint32_t n = std::min(f.spp - done, guide ? (pass == 0 ? 1u : std::min(8u, 1u << (pass - 1))) : f.spp);
+    const uint32_t n = std::min(f.spp - done, pass == 0 ? 1u : std::min(8u, 1u << (pass - 1)));
     if (guide) s.path.guide = guide->view();
     t.counters.add(render_film_pass(backend, s, t.film, done, done + n));
     if (guide) guide->fold();
@@ -81,7 +135,9 @@ bool check(const std::string& path) {
   GpuFixture f;
   const PackedScene packed = load_fixture(path, &f);
   std::string why;
-  std::unique_ptr<DeviceApi> device = open_cuda_device(&why);
+  // A dry run of this program where there is no GPU: the host threads stand in for it.
+  std::unique_ptr<DeviceApi> device =
+      std::getenv("TESSERA_GPU_CHECK_DRY_RUN") ? std::make_unique<HostThreadsDevice>(2) : open_cuda_device(&why);
   if (!device) {
     std::printf("FAIL %s: %s\n", path.c_str(), why.c_str());
     return false;
@@ -118,8 +174,19 @@ bool check(const std::string& path) {
   std::printf("  guided:   %.2f s, %.2f Msamples/s, %.1f ns per path vertex (%.2fx unguided's), %llu guided samples\n",
               ga.seconds, guided_rate * 1e-6, guided_vertex * 1e9, guided_vertex / unguided_vertex,
               static_cast<unsigned long long>(ga.counters.path.guided_samples));
-  std::printf("  host emulation where the fixture was made (%d threads): %.3f Msamples/s; GPU unguided is %.1fx that\n",
-              f.host_threads, samples / f.host_seconds * 1e-6, unguided_rate / (samples / f.host_seconds));
+  std::printf("  where the fixture was made (%d threads): Embree %.3f Msamples/s, the device kernels %.3f Msamples/s; "
+              "GPU unguided is %.1fx Embree there\n",
+              f.host_threads, samples / f.embree_seconds * 1e-6, samples / f.host_seconds * 1e-6,
+              unguided_rate / (samples / f.embree_seconds));
+  // The same kernels on this machine's cores.
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  DeviceBackend host(packed, std::make_unique<HostThreadsDevice>(cores));
+  const Timed h = render(host, f, nullptr);
+  GuideField gh = make_guide();
+  const Timed hg = render(host, f, &gh);
+  std::printf("  this machine's %d cores, the same kernels: %.3f Msamples/s unguided, %.3f guided; GPU is %.1fx, %.1fx\n",
+              cores, samples / h.seconds * 1e-6, samples / hg.seconds * 1e-6, h.seconds / a.seconds, hg.seconds / ga.seconds);
+  ok &= agree(a.film, h.film, "GPU vs this machine's cores", f.name);
   return ok;
 }
 
@@ -127,7 +194,7 @@ bool check(const std::string& path) {
 }  // namespace tessera::cuda_check
 
 int main(int argc, char** argv) {
-  if (!tessera::cuda_check::device_present()) return 77;
+  if (!std::getenv("TESSERA_GPU_CHECK_DRY_RUN") && !tessera::cuda_check::device_present()) return 77;
   if (argc == 2 && std::strcmp(argv[1], "--probe") == 0) return 0;  // a device is here
   if (argc < 2) {
     std::printf("usage: device_backend_on_device FIXTURE...\n");

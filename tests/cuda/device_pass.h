@@ -38,10 +38,10 @@ class FilmTiles : public TileQueue {
 
 // Samples [sample_begin, sample_end) of every pixel, added to the film.
 inline TileCounters render_film_pass(TileBackend& backend, const TileSettings& settings, Film& film,
-                                     uint32_t sample_begin, uint32_t sample_end) {
+                                     uint32_t sample_begin, uint32_t sample_end, int32_t threads = 1) {
   FilmTiles tiles(film, sample_begin, sample_end);
   backend.begin_pass(settings);
-  const TileCounters c = backend.render_tiles(tiles, 1);
+  const TileCounters c = backend.render_tiles(tiles, threads);
   backend.end_pass();
   return c;
 }

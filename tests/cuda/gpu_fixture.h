@@ -13,6 +13,7 @@
 
 #include "master/film.h"
 #include "worker/render_tile.h"
+#include "worker/pod_io.h"
 #include "worker/scene_pack.h"
 
 namespace tessera::cuda_check {
@@ -25,38 +26,31 @@ struct GpuFixture {
   Vec3 lo{0.f}, hi{0.f};  // the scene's bounds, for a guide
   uint32_t lights = 0;
   Float max_emitted = 0.f;
-  double host_seconds = 0.0;  // the emulated device's render on the machine that wrote it
+  double host_seconds = 0.0;    // the emulated device's render on the machine that wrote it
+  double embree_seconds = 0.0;  // the same pass with Embree there (its specialised integrator)
   int32_t host_threads = 0;
   std::vector<PixelAccum> reference;  // that render: samples [0, spp), one pass
 };
 
-constexpr char kFixtureMagic[8] = {'T', 'S', 'F', 'I', 'X', '0', '0', '1'};
-
-template <class T>
-void put(std::ostream& o, const T& v) {
-  o.write(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-template <class T>
-void get(std::istream& i, T* v) {
-  if (!i.read(reinterpret_cast<char*>(v), sizeof(T))) throw std::runtime_error("fixture: truncated");
-}
+constexpr char kFixtureMagic[8] = {'T', 'S', 'F', 'I', 'X', '0', '0', '2'};
 
 inline void save_fixture(const std::string& path, const GpuFixture& f, const PackedScene& scene) {
   std::ofstream o(path, std::ios::binary);
   o.write(kFixtureMagic, sizeof(kFixtureMagic));
   const uint64_t name_size = f.name.size();
-  put(o, name_size);
+  write_pod(o, name_size);
   o.write(f.name.data(), static_cast<std::streamsize>(name_size));
-  put(o, f.settings);
-  put(o, f.width);
-  put(o, f.height);
-  put(o, f.spp);
-  put(o, f.lo);
-  put(o, f.hi);
-  put(o, f.lights);
-  put(o, f.max_emitted);
-  put(o, f.host_seconds);
-  put(o, f.host_threads);
+  write_pod(o, f.settings);
+  write_pod(o, f.width);
+  write_pod(o, f.height);
+  write_pod(o, f.spp);
+  write_pod(o, f.lo);
+  write_pod(o, f.hi);
+  write_pod(o, f.lights);
+  write_pod(o, f.max_emitted);
+  write_pod(o, f.host_seconds);
+  write_pod(o, f.embree_seconds);
+  write_pod(o, f.host_threads);
   o.write(reinterpret_cast<const char*>(f.reference.data()),
           static_cast<std::streamsize>(f.reference.size() * sizeof(PixelAccum)));
   scene.save(o);
@@ -69,20 +63,21 @@ inline PackedScene load_fixture(const std::string& path, GpuFixture* f) {
   if (!i.read(magic, sizeof(magic)) || std::memcmp(magic, kFixtureMagic, sizeof(magic)) != 0)
     throw std::runtime_error("fixture: " + path + " is not a fixture of this version");
   uint64_t name_size = 0;
-  get(i, &name_size);
+  read_pod(i, &name_size, "fixture");
   if (name_size > 4096) throw std::runtime_error("fixture: bad name");
   f->name.resize(name_size);
   i.read(f->name.data(), static_cast<std::streamsize>(name_size));
-  get(i, &f->settings);
-  get(i, &f->width);
-  get(i, &f->height);
-  get(i, &f->spp);
-  get(i, &f->lo);
-  get(i, &f->hi);
-  get(i, &f->lights);
-  get(i, &f->max_emitted);
-  get(i, &f->host_seconds);
-  get(i, &f->host_threads);
+  read_pod(i, &f->settings, "fixture");
+  read_pod(i, &f->width, "fixture");
+  read_pod(i, &f->height, "fixture");
+  read_pod(i, &f->spp, "fixture");
+  read_pod(i, &f->lo, "fixture");
+  read_pod(i, &f->hi, "fixture");
+  read_pod(i, &f->lights, "fixture");
+  read_pod(i, &f->max_emitted, "fixture");
+  read_pod(i, &f->host_seconds, "fixture");
+  read_pod(i, &f->embree_seconds, "fixture");
+  read_pod(i, &f->host_threads, "fixture");
   if (f->width <= 0 || f->height <= 0 || f->width > 16384 || f->height > 16384) throw std::runtime_error("fixture: bad size");
   f->reference.resize(static_cast<size_t>(f->width) * f->height);
   if (!i.read(reinterpret_cast<char*>(f->reference.data()),

@@ -13,6 +13,7 @@
 #include "scene/sampler_setup.h"
 #include "worker/bvh_build.h"
 #include "worker/device_backend.h"
+#include "worker/embree_backend.h"
 
 int main(int argc, char** argv) {
   using namespace tessera;
@@ -50,14 +51,26 @@ int main(int argc, char** argv) {
       DeviceBackend device(packed, open_emulated_device(f.host_threads));
       Film film(f.width, f.height);
       const auto t0 = std::chrono::steady_clock::now();
-      cuda_check::render_film_pass(device, f.settings, film, 0, spp);
+      cuda_check::render_film_pass(device, f.settings, film, 0, spp, f.host_threads);
       f.host_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       f.reference = film.pixels;
+      {
+        // Embree on the same threads, with the scene's own specialisation: the CPU figure users know.
+        RenderOptions embree_opt = opt;
+        embree_opt.force_full_specialisation = false;
+        EmbreeBackend embree(scene);
+        Film embree_film(f.width, f.height);
+        const auto e0 = std::chrono::steady_clock::now();
+        cuda_check::render_film_pass(embree, make_tile_settings(embree_opt, effective_specialisation(scene, embree_opt, false), false),
+                                     embree_film, 0, spp, f.host_threads);
+        f.embree_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - e0).count();
+      }
       const std::string path = out + "/" + name + ".fixture";
       cuda_check::save_fixture(path, f, packed);
-      std::printf("%s: %dx%d, %u spp, emulated device on %d threads: %.2f s (%.3f Msamples/s)\n", path.c_str(),
-                  f.width, f.height, spp, f.host_threads, f.host_seconds,
-                  double(f.width) * f.height * spp / f.host_seconds * 1e-6);
+      const double samples = double(f.width) * f.height * spp;
+      std::printf("%s: %dx%d, %u spp on %d threads: emulated device %.3f Msamples/s, Embree %.3f Msamples/s\n",
+                  path.c_str(), f.width, f.height, spp, f.host_threads, samples / f.host_seconds * 1e-6,
+                  samples / f.embree_seconds * 1e-6);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "make_gpu_fixtures: %s\n", e.what());

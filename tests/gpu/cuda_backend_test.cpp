@@ -22,22 +22,9 @@ bool cuda_device_here() {
   return open_cuda_device(&why) != nullptr;
 }
 
-RenderOptions options_for(const SceneData& scene, uint32_t spp) {
-  RenderOptions opt;
-  opt.progress = false;
-  opt.spp = spp;
-  opt.max_depth = scene.desc().max_depth;
-  opt.sampler = sampler_setup(scene.desc());
-  opt.seed = 5;
-  return opt;
-}
+RenderOptions options_for(const SceneData& scene, uint32_t spp) { return testing::scene_options(scene, spp, 5); }
 
-SceneData shipped(const char* name) {
-  SceneDesc d = load_pbrt_file(testing::source_dir() + "/scenes/" + name + ".pbrt");
-  d.film.xres = 64;
-  d.film.yres = 48;
-  return SceneData(std::move(d));
-}
+SceneData shipped(const char* name) { return testing::shipped_scene(name, 64, 48); }
 
 TEST(CudaBackend, AgreesWithEmbreeAndRepeatsBitForBit) {
   if (!cuda_device_here()) GTEST_SKIP() << "no CUDA device";

@@ -30,12 +30,7 @@ namespace tessera {
 namespace {
 
 RenderOptions small_options(const SceneData& scene, uint32_t spp) {
-  RenderOptions opt;
-  opt.progress = false;
-  opt.spp = spp;
-  opt.max_depth = scene.desc().max_depth;
-  opt.sampler = sampler_setup(scene.desc());
-  opt.seed = 11;
+  RenderOptions opt = testing::scene_options(scene, spp, 11);
   opt.threads = 2;
   opt.force_full_specialisation = true;  // both backends run the full integrator
   return opt;
@@ -72,12 +67,7 @@ void expect_device_equals_bvh(const SceneData& scene, const std::string& what, u
   EXPECT_TRUE(gb == gd) << what << ": the device's learning came back different";
 }
 
-SceneData shipped(const char* name, int w = 32, int h = 24) {
-  SceneDesc d = load_pbrt_file(testing::source_dir() + "/scenes/" + name + ".pbrt");
-  d.film.xres = w;
-  d.film.yres = h;
-  return SceneData(std::move(d));
-}
+SceneData shipped(const char* name, int w = 32, int h = 24) { return testing::shipped_scene(name, w, h); }
 
 TEST(DeviceBackend, EqualsTheBvhOnTheShippedScenes) {
   for (const char* name : {"cornell-box", "door-ajar", "glossy"}) expect_device_equals_bvh(shipped(name), name);

@@ -26,6 +26,28 @@ inline RenderResult render_desc(SceneDesc desc, RenderOptions opt) {
   return render(scene, embree, opt);
 }
 
+inline std::string source_dir() { return TESSERA_SOURCE_DIR; }
+
+// Options that render `scene` as its file says (depth, sampler), quietly,
+// with the given spp and seed.
+inline RenderOptions scene_options(const SceneData& scene, uint32_t spp, uint64_t seed) {
+  RenderOptions opt;
+  opt.progress = false;
+  opt.spp = spp;
+  opt.max_depth = scene.desc().max_depth;
+  opt.sampler = sampler_setup(scene.desc());
+  opt.seed = seed;
+  return opt;
+}
+
+// A shipped scene (scenes/NAME.pbrt) at w x h.
+inline SceneData shipped_scene(const std::string& name, int w, int h) {
+  SceneDesc d = load_pbrt_file(source_dir() + "/scenes/" + name + ".pbrt");
+  d.film.xres = w;
+  d.film.yres = h;
+  return SceneData(std::move(d));
+}
+
 inline RenderResult render_text(const std::string& pbrt, RenderOptions opt = {}) {
   return render_desc(load_pbrt_string(pbrt, "<test>", "."), opt);
 }
@@ -47,8 +69,6 @@ inline bool films_identical(const Film& a, const Film& b) {
     if (std::memcmp(&a.splats[i], &b.splats[i], sizeof(SplatAccum)) != 0) return false;
   return true;
 }
-
-inline std::string source_dir() { return TESSERA_SOURCE_DIR; }
 
 // A file name in the temporary folder, unique to this process and `tag`,
 // removed when the test ends (images the scenes of a test read).
