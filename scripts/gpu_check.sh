@@ -19,8 +19,7 @@ nvcc=${NVCC:-/usr/local/cuda/bin/nvcc}
 flags=(-std=c++17 -O3 "-arch=${CUDA_ARCH:-sm_90}" --expt-relaxed-constexpr -diag-suppress=20012 -Isrc
        "-I${GLM_INCLUDE:-/usr/include}")
 command -v nvidia-smi >/dev/null && nvidia-smi -L | tee "$out/device.txt"
-"$nvcc" "${flags[@]}" tests/cuda/kernels_on_device.cu -o "$out/kernels_on_device" || exit 1
-"$nvcc" "${flags[@]}" tests/cuda/bvh_on_device.cu src/worker/bvh_build.cpp -o "$out/bvh_on_device" || exit 1
+# The CUDA backend first (prebuilt: it needs nothing built here).
 status=0
 if [ -n "${GPU_BUNDLE:-}" ]; then
   "$GPU_BUNDLE/device_backend_on_device" "$GPU_BUNDLE"/fixtures/*.fixture 2>&1 | tee "$out/device_backend_on_device.txt"
@@ -28,6 +27,8 @@ if [ -n "${GPU_BUNDLE:-}" ]; then
   echo "device_backend_on_device: exit $rc"
   if [ "$rc" -eq 77 ]; then status=77; elif [ "$rc" -ne 0 ]; then status=1; fi
 fi
+"$nvcc" "${flags[@]}" tests/cuda/kernels_on_device.cu -o "$out/kernels_on_device" || exit 1
+"$nvcc" "${flags[@]}" tests/cuda/bvh_on_device.cu src/worker/bvh_build.cpp -o "$out/bvh_on_device" || exit 1
 for check in kernels_on_device bvh_on_device; do
   "$out/$check" 2>&1 | tee "$out/$check.txt"
   rc=${PIPESTATUS[0]}

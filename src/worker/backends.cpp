@@ -32,6 +32,10 @@ std::string resolve_backend(const std::string& requested, const SceneData* scene
   if (requested == "embree" || requested == "bvh" || requested == "emulated-device") return requested;
   if (requested != "cuda" && requested != "auto")
     throw std::runtime_error("--backend " + requested + ": unknown backend (auto, embree, bvh, cuda, emulated-device)");
+  if (requested == "auto" && !kAutoPicksCuda) {
+    if (why) *why = "auto: the CUDA backend has not been checked on a GPU yet; --backend cuda uses one";
+    return "embree";
+  }
   std::string reason;
   bool ok = cuda_present(&reason);
   if (ok && scene) {
@@ -41,10 +45,6 @@ std::string resolve_backend(const std::string& requested, const SceneData* scene
   if (requested == "cuda") {
     if (!ok) throw std::runtime_error("--backend cuda: " + reason);
     return "cuda";
-  }
-  if (ok && !kAutoPicksCuda) {
-    ok = false;
-    reason = "the CUDA backend has not been checked on a GPU yet; --backend cuda uses it";
   }
   if (ok) return "cuda";
   if (why) *why = "auto: " + reason;

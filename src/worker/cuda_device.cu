@@ -71,7 +71,11 @@ class CudaDevice : public DeviceApi {
     cuda_check_error(cudaGetLastError(), "launch");
     cuda_check_error(cudaEventRecord(done_), "cudaEventRecord");
   }
-  bool finished() override { return cudaEventQuery(done_) != cudaErrorNotReady; }
+  bool finished() override {
+    if (cudaEventQuery(done_) != cudaErrorNotReady) return true;
+    (void)cudaGetLastError();  // "not ready" is recorded as the thread's last error: not one of ours
+    return false;
+  }
   void wait() override {
     cuda_check_error(cudaEventSynchronize(done_), "render");
     cuda_check_error(cudaGetLastError(), "render");

@@ -1,21 +1,27 @@
 // Definitions behind cuda_kernels.h; each cuda_kernel_*.cu instantiates one.
 #pragma once
 
+#include <algorithm>
+
 #include "worker/cuda_kernels.h"
 
 namespace tessera {
 
-// Block (tile, sample); its threads stride over the tile's pixels.
+// Block (tile, first_sample + sample); its threads stride over the tile's pixels.
 template <uint32_t Spec>
-__global__ void __launch_bounds__(kCudaThreadsPerBlock) trace_samples_kernel(DeviceLaunch launch) {
+__global__ void __launch_bounds__(kCudaThreadsPerBlock) trace_samples_kernel(DeviceLaunch launch, uint32_t first_sample) {
   for (uint32_t p = threadIdx.x; p < launch.max_tile_pixels; p += blockDim.x)
-    trace_device_sample<Spec>(launch, blockIdx.x, p, blockIdx.y);
+    trace_device_sample<Spec>(launch, blockIdx.x, p, first_sample + blockIdx.y);
 }
 
 template <uint32_t Spec>
 void launch_render_tiles(const DeviceLaunch& launch) {
-  trace_samples_kernel<Spec><<<dim3(launch.num_tiles, launch.max_samples), kCudaThreadsPerBlock>>>(launch);
-  cuda_check_error(cudaGetLastError(), "launch");
+  constexpr uint32_t kMaxGridY = 65535;  // CUDA's limit on gridDim.y: longer passes launch in parts
+  for (uint32_t first = 0; first < launch.max_samples; first += kMaxGridY) {
+    const uint32_t n = std::min(kMaxGridY, launch.max_samples - first);
+    trace_samples_kernel<Spec><<<dim3(launch.num_tiles, n), kCudaThreadsPerBlock>>>(launch, first);
+    cuda_check_error(cudaGetLastError(), "launch");
+  }
 }
 
 template <uint32_t Spec>

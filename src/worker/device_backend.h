@@ -2,8 +2,9 @@
 // (worker/device_api.h): the scene and its BVH live in device memory (one
 // PackedScene upload); every pass uploads the guide as it stands after the
 // last fold and a zeroed copy of its accumulator block; each batch of tiles
-// is one launch (one thread per pixel, samples in order, no float atomics),
-// whose pixel accumulators and counters come back to the host; end_pass
+// is a trace (a thread per pixel and sample) and an accumulation (a thread
+// per pixel, adding in sample order; no float atomics), whose pixel
+// accumulators and counters come back to the host; end_pass
 // adds the device's integer accumulators into the pass's block, for the
 // fold and the farm's all-reduction.
 //

@@ -1,6 +1,6 @@
-// One camera sample of one pixel, added to the pixel's accumulators: the
-// body every backend runs, a CPU thread tile by tile or a GPU thread per
-// pixel. Host and device code; the random streams depend on (seed, image
+// One camera sample of one pixel and how it is added to the pixel's
+// accumulators: the body every backend runs, a CPU thread tile by tile or a
+// GPU thread per sample. Host and device code; the random streams depend on (seed, image
 // pixel, sample index) only, so a sample is the same wherever it runs.
 #pragma once
 

@@ -127,7 +127,8 @@ int main() {
   SceneView* dscene = nullptr;
   cudaMalloc(&dscene, sizeof(SceneView));
   cudaMemcpy(dscene, &dview, sizeof(SceneView), cudaMemcpyHostToDevice);
-  BvhView dbvh{to_device(build.nodes), to_device(build.triangles), static_cast<uint32_t>(build.nodes.size())};
+  BvhView dbvh{to_device(build.nodes), to_device(build.triangles), static_cast<uint32_t>(build.nodes.size()),
+               static_cast<uint32_t>(build.triangles.size())};
   Vec3* d_o = to_device(o);
   Vec3* d_d = to_device(d);
   TraceHit* d_hits = nullptr;

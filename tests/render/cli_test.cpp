@@ -450,7 +450,7 @@ TEST_F(CliTest, BackendsRenderOrRefuseInOneLine) {
   EXPECT_NE(stats_backend("bvh").find("\"backend\": \"bvh\""), std::string::npos);
   EXPECT_NE(stats_backend("emulated-device").find("\"backend\": \"emulated-device\""), std::string::npos);
   std::string why;
-  const bool device = open_cuda_device(&why) != nullptr;
+  const bool device = cuda_device_count(&why) > 0;
   // auto stays on Embree until the CUDA backend has been checked on a GPU (worker/backends.cpp).
   EXPECT_NE(stats_backend("auto").find("\"backend\": \"embree\""), std::string::npos);
   const std::string out = (dir_ / "cuda.exr").string();
