@@ -4,7 +4,8 @@
 # without the renderer's libraries; CUDA's runtime is static) and the
 # fixtures it reads (packed scenes and their host-emulated images).
 # Usage: scripts/gpu_bundle.sh [BUNDLE_DIR] (default .gpu/bundle); then, on
-# the GPU machine, scripts/gpu_check.sh [OUT_DIR] with GPU_BUNDLE=BUNDLE_DIR.
+# the GPU machine (with .gpu carried there):
+#   GLM_INCLUDE=.gpu/include GPU_BUNDLE=.gpu/bundle scripts/gpu_check.sh OUT_DIR
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bundle=${1:-.gpu/bundle}
@@ -12,4 +13,6 @@ cmake --build build -j "$(nproc)" --target device_backend_on_device make_gpu_fix
 mkdir -p "$bundle/fixtures"
 cp build/device_backend_on_device "$bundle/"
 build/make_gpu_fixtures "$bundle/fixtures" "${SPP:-64}"
-du -sh "$bundle"
+# GLM for the checks gpu_check.sh builds there with nvcc (a bare GPU machine has none).
+mkdir -p .gpu/include && cp -r /usr/include/glm .gpu/include/
+du -sh "$bundle" .gpu/include

@@ -7,11 +7,8 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <cstdlib>
-#include <cstring>
-#include <new>
 
-#include "worker/device_api.h"
+#include "worker/host_memory_device.h"
 
 namespace tessera {
 namespace {
@@ -30,23 +27,12 @@ void run_launch(const DeviceLaunch& launch, tbb::task_arena& arena) {
   });
 }
 
-class EmulatedDevice : public DeviceApi {
+class EmulatedDevice : public HostMemoryDevice {
  public:
   explicit EmulatedDevice(int32_t threads) : arena_(std::max(1, threads)) {}
   std::string backend_name() const override { return "emulated-device"; }
   std::string description() const override { return "the device kernel on host threads"; }
   bool has_media_kernels() const override { return true; }
-  void* alloc(size_t bytes) override {
-    void* p = std::aligned_alloc(64, (bytes + 63) & ~size_t{63});
-    if (!p) throw std::bad_alloc();
-    return p;
-  }
-  void release(void* p) noexcept override { std::free(p); }
-  void upload(void* dst, const void* src, size_t bytes) override { std::memcpy(dst, src, bytes); }
-  void download(void* dst, const void* src, size_t bytes) override { std::memcpy(dst, src, bytes); }
-  void zero(void* dst, size_t bytes) override { std::memset(dst, 0, bytes); }
-  bool finished() override { return true; }
-  void wait() override {}
   // Runs the launch to its end: the emulation has nothing to overlap.
   void start(const DeviceLaunch& launch, uint32_t spec) override {
     switch (served_specialisation(spec)) {

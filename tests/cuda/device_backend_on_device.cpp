@@ -31,29 +31,19 @@
 #include "gpu_fixture.h"
 #include "guidecache/guide_field.h"
 #include "worker/device_backend.h"
+#include "worker/host_memory_device.h"
 
 namespace tessera::cuda_check {
 namespace {
 
 // The device kernels' bodies on this machine's own cores (std::thread): the
 // GPU against the CPU of the same machine, same code, same run.
-class HostThreadsDevice : public DeviceApi {
+class HostThreadsDevice : public HostMemoryDevice {
  public:
   explicit HostThreadsDevice(int threads) : threads_(std::max(1, threads)) {}
   std::string backend_name() const override { return "host-threads"; }
   std::string description() const override { return std::to_string(threads_) + " host threads"; }
   bool has_media_kernels() const override { return false; }
-  void* alloc(size_t bytes) override {
-    void* p = std::aligned_alloc(64, (bytes + 63) & ~size_t{63});
-    if (!p) throw std::bad_alloc();
-    return p;
-  }
-  void release(void* p) noexcept override { std::free(p); }
-  void upload(void* dst, const void* src, size_t bytes) override { std::memcpy(dst, src, bytes); }
-  void download(void* dst, const void* src, size_t bytes) override { std::memcpy(dst, src, bytes); }
-  void zero(void* dst, size_t bytes) override { std::memset(dst, 0, bytes); }
-  bool finished() override { return true; }
-  void wait() override {}
   void start(const DeviceLaunch& launch, uint32_t spec) override {
     switch (served_specialisation(spec)) {
       case kServedSurface | kSpecGuiding: return run<kServedSurface | kSpecGuiding>(launch);
