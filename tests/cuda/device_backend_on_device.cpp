@@ -111,7 +111,7 @@ bool finite(const Film& f) {
 
 // Means within 4 standard errors of their difference, per channel.
 bool agree(const Film& a, const Film& b, const char* what, const std::string& name) {
-  const FilmMean ma = film_mean_of(a), mb = film_mean_of(b);
+  const testing::ChannelStats ma = testing::channel_stats(a), mb = testing::channel_stats(b);
   bool ok = true;
   for (int c = 0; c < 3; ++c) {
     const double tol = 4.0 * std::sqrt(ma.se[c] * ma.se[c] + mb.se[c] * mb.se[c]);

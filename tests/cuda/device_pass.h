@@ -6,9 +6,9 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <vector>
 
+#include "../film_stats.h"
 #include "master/film.h"
 #include "worker/tile_backend.h"
 
@@ -44,28 +44,6 @@ inline TileCounters render_film_pass(TileBackend& backend, const TileSettings& s
   const TileCounters c = backend.render_tiles(tiles, threads);
   backend.end_pass();
   return c;
-}
-
-// Image mean per channel and its standard error (from every pixel's own
-// sample variance: the noise, not the picture's variation).
-struct FilmMean {
-  double mean[3] = {0, 0, 0}, se[3] = {0, 0, 0};
-};
-inline FilmMean film_mean_of(const Film& f) {
-  FilmMean m;
-  const double n = static_cast<double>(f.pixels.size());
-  for (int c = 0; c < 3; ++c) {
-    double s = 0, var = 0;
-    for (const PixelAccum& p : f.pixels) {
-      if (p.n < 2) continue;
-      const double k = static_cast<double>(p.n), mean = p.sum[c] / k;
-      s += mean;
-      var += std::max(0.0, p.sum_sq[c] / k - mean * mean) / (k - 1);
-    }
-    m.mean[c] = s / n;
-    m.se[c] = std::sqrt(var) / n;
-  }
-  return m;
 }
 
 }  // namespace tessera::cuda_check

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "../film_stats.h"
 #include "render_helpers.h"
 
 namespace tessera::testing {
@@ -35,35 +36,6 @@ inline GuideConfig config_with(GuideTarget target, Float guide_prob = 0.5f) {
   cfg.target = target;
   cfg.guide_prob = guide_prob;
   return cfg;
-}
-
-// Per-channel image means and their standard errors. Pixels are independent
-// given the guide, and each pass's samples are unbiased given the field they
-// were drawn with, so the variance of a channel's mean over N pixels is
-// sum_i var_i / N^2 with var_i the variance of pixel i's mean. Channels are
-// compared separately: the three channels of one path are strongly
-// correlated, and pooling them as if independent would understate the error.
-struct ChannelStats {
-  double mean[3] = {0, 0, 0};
-  double se[3] = {0, 0, 0};
-};
-
-// In double from the film's sums: the float images saturate variances
-// beyond float's range (radiance ~1e20 and up), which would understate them.
-inline ChannelStats channel_stats(const Film& film) {
-  const double n = static_cast<double>(film.pixels.size());
-  ChannelStats s;
-  for (int c = 0; c < 3; ++c) {
-    double sum = 0, var = 0;
-    for (size_t i = 0; i < film.pixels.size(); ++i) {
-      const PixelEstimate e = pixel_estimate(film, i, c);
-      sum += e.mean;
-      var += e.var_of_mean;
-    }
-    s.mean[c] = sum / n;
-    s.se[c] = std::sqrt(var) / n;
-  }
-  return s;
 }
 
 // Two independent estimates of the same image agree when every channel's
