@@ -142,7 +142,9 @@ TEST_F(FarmCliTest, SignalledWorkerStopsTheWholeFarm) {
       "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe -np 2 " +
       std::string(TESSERA_BINARY) + " render " + kDoor + " -q --no-preview --res 64x48 --seed 5 --time 60 --threads 1 -o " +
       path("worker-signalled.exr") + " --stats " + out + " & P=$!; sleep 3; " +
-      "for p in $(pgrep -f 'tessera render'); do tr '\\0' '\\n' < /proc/$p/environ 2>/dev/null | " +
+      // Only this test's ranks (their command line names its output): ctest
+      // runs other farms beside it.
+      "for p in $(pgrep -f 'tessera render.*" + out + "'); do tr '\\0' '\\n' < /proc/$p/environ 2>/dev/null | " +
       "grep -qx OMPI_COMM_WORLD_RANK=1 && kill -TERM $p; done; " +
       "for i in $(seq 1 50); do test -f " + out + " && break; sleep 0.2; done; test -f " + out +
       " && echo written-within-10s; wait $P; echo done=$?");
