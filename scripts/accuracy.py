@@ -39,9 +39,10 @@ import reference as ref_cache  # noqa: E402
 
 ROOT = ref_cache.ROOT
 SCENES = ["cornell-box", "door-ajar", "shelter", "pillars", "glossy"]
-METHODS = ["none", "qtable", "qlearning"]
+METHODS = ["none", "qtable", "qlearning", "neural"]
 GUIDED_DEFAULT = "qtable"  # what `tessera render` uses on scenes where guiding helps
-LABELS = {"none": "plain path tracing", "qtable": "qtable (expected SARSA)", "qlearning": "qlearning (max)"}
+LABELS = {"none": "plain path tracing", "qtable": "qtable (expected SARSA)", "qlearning": "qlearning (max)",
+          "neural": "neural (MLP, expected SARSA)"}
 
 
 def run(cmd):
@@ -137,7 +138,7 @@ def plot(a, results, docs_dir):
         print("matplotlib missing (scripts/install-deps.sh installs python3-matplotlib): no plots", file=sys.stderr)
         return []
     scenes = list(results["scenes"])
-    colors = {"none": "black", "qtable": "tab:blue", "qlearning": "tab:orange"}
+    colors = {"none": "black", "qtable": "tab:blue", "qlearning": "tab:orange", "neural": "tab:green"}
     files = []
 
     def save(fig, name):

@@ -28,7 +28,26 @@ struct VizArgs {
   GuideArgs guide;
 };
 
-void write_distribution(const VizArgs& a, const GuideField& field, const glm::dvec3& render_origin) {
+// The learned radiance per bin at a point: a table cell's values, or the network's answer there.
+std::vector<Float> guide_values_at(Guide& guide, const Vec3& p, const Vec3& n, std::string* where, uint32_t* grid) {
+  if (auto* field = dynamic_cast<GuideField*>(&guide)) {
+    const int32_t cell = field->find_cell(p, n);
+    *grid = field->config().grid;
+    *where = "cell " + std::to_string(cell);
+    const Float* q = field->cell_values(cell);
+    return std::vector<Float>(q, q + *grid * *grid);
+  }
+  auto* neural = dynamic_cast<NeuralGuide*>(&guide);
+  if (!neural) throw std::runtime_error("guide-viz: unknown guide");
+  const NeuralGuideView view = neural->view();  // the path guide keeps a reference
+  NeuralPathGuide pg(view);
+  const int32_t s = pg.locate(p, n);
+  *grid = kNeuralGrid;
+  *where = "network";
+  return std::vector<Float>(pg.site[s].q, pg.site[s].q + kNeuralBins);
+}
+
+void write_distribution(const VizArgs& a, Guide& guide, const glm::dvec3& render_origin) {
   if (a.point.size() != 3 || a.normal.size() != 3)
     throw std::runtime_error("guide-viz: --distribution needs --point X Y Z and --normal X Y Z");
   // The point is in the scene file's world; the guide lives in render space (camera at the origin).
@@ -36,9 +55,11 @@ void write_distribution(const VizArgs& a, const GuideField& field, const glm::dv
   Vec3 n(a.normal[0], a.normal[1], a.normal[2]);
   if (!(glm::length(n) > 0.f)) throw std::runtime_error("guide-viz: --normal must not be zero");
   n = glm::normalize(n);
-  const int32_t cell = field.find_cell(p, n);
-  const uint32_t grid = field.config().grid, bins = grid * grid;
-  const Float* q = field.cell_values(cell);
+  std::string where;
+  uint32_t grid = 0;
+  const std::vector<Float> values = guide_values_at(guide, p, n, &where, &grid);
+  const uint32_t bins = grid * grid;
+  const Float* q = values.data();
   // Each bin becomes a block of pixels; the image is the equal-area square
   // (the centre is +z, the corners -z).
   const int32_t scale = std::max<int32_t>(1, 256 / static_cast<int32_t>(grid));
@@ -53,12 +74,12 @@ void write_distribution(const VizArgs& a, const GuideField& field, const glm::dv
     }
   ExrMetadata meta;
   meta.strings["content"] = "learned incident radiance Q per direction bin (equal-area octahedral square)";
-  meta.numbers["cell"] = cell;
+  meta.strings["guide"] = guide.mode() + " (" + where + ")";
   write_exr(a.distribution, img, nullptr, meta);
   std::vector<uint32_t> order(bins);
   std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(), [&](uint32_t i, uint32_t j) { return q[i] > q[j] || (q[i] == q[j] && i < j); });
-  std::printf("cell %d at (%g, %g, %g), normal (%g, %g, %g); brightest bins:\n", cell, p.x, p.y, p.z, n.x, n.y, n.z);
+  std::printf("%s at (%g, %g, %g), normal (%g, %g, %g); brightest bins:\n", where.c_str(), p.x, p.y, p.z, n.x, n.y, n.z);
   for (uint32_t k = 0; k < std::min<uint32_t>(5, bins); ++k) {
     const uint32_t b = order[k];
     Vec3 d = equal_area_square_to_sphere(Vec2((b % grid + 0.5f) / grid, (b / grid + 0.5f) / grid));
@@ -67,9 +88,12 @@ void write_distribution(const VizArgs& a, const GuideField& field, const glm::dv
   std::printf("wrote %s\n", a.distribution.c_str());
 }
 
-void write_diagnostic(const VizArgs& a, const SceneData& scene, const EmbreeBackend& embree, GuideField& field) {
+void write_diagnostic(const VizArgs& a, const SceneData& scene, const EmbreeBackend& embree, Guide& guide) {
   const SceneView& s = scene.view();
-  const GuideView g = field.view();
+  GuideView g;
+  NeuralGuideView nv;
+  guide.views(&g, &nv);
+  const bool neural = guide.mode() == "neural";
   const EmbreeTracer tracer = embree.tracer();
   ImageRgb img;
   img.width = s.camera.width;
@@ -78,7 +102,14 @@ void write_diagnostic(const VizArgs& a, const SceneData& scene, const EmbreeBack
   tbb::parallel_for(0, img.height, [&](int32_t y) {
     for (int32_t x = 0; x < img.width; ++x) {
       Ray ray = generate_camera_ray(s.camera, Vec2(x + 0.5f, y + 0.5f));
-      Rgb L = trace_greedy_path(s, g, tracer, ray, static_cast<int32_t>(a.max_depth));
+      Rgb L;
+      if (neural) {
+        NeuralPathGuide pg(nv);
+        L = trace_greedy_path(s, pg, tracer, ray, static_cast<int32_t>(a.max_depth));
+      } else {
+        TablePathGuide pg{g};
+        L = trace_greedy_path(s, pg, tracer, ray, static_cast<int32_t>(a.max_depth));
+      }
       for (int c = 0; c < 3; ++c) img.rgb[(size_t(y) * img.width + x) * 3 + c] = L[c];
     }
   });
@@ -96,7 +127,7 @@ int run_guide_viz(VizArgs a) {
   EmbreeBackend embree(scene);
   if (a.guide.mode == "auto" || a.guide.mode == "none") a.guide.mode = "qtable";
   std::string why;
-  std::unique_ptr<GuideField> field = make_guide(a.guide, scene, &why);
+  std::unique_ptr<Guide> field = make_guide(a.guide, scene, &why);
   if (a.guide.in.empty()) {
     // No saved cache: learn one now with a short guided render.
     RenderOptions opt;
@@ -107,7 +138,7 @@ int run_guide_viz(VizArgs a) {
     opt.progress = false;
     apply_guide_render_options(a.guide, &opt);
     render(scene, embree, opt, field.get());
-    std::printf("trained the guide with %lld spp (%u cells)\n", static_cast<long long>(a.train_spp), field->num_cells());
+    std::printf("trained the %s guide with %lld spp\n", field->mode().c_str(), static_cast<long long>(a.train_spp));
   }
   if (!a.distribution.empty()) write_distribution(a, *field, scene.desc().render_origin);
   if (!a.diagnostic.empty()) write_diagnostic(a, scene, embree, *field);

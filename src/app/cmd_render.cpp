@@ -140,16 +140,16 @@ void check_writable(const std::string& path, const char* option) {
   unlink(probe.c_str());
 }
 
-Bytes guide_bytes(const GuideField& guide, const SceneData& scene) {
+Bytes guide_bytes(const Guide& guide, const SceneData& scene) {
   std::ostringstream s(std::ios::binary);
   guide.save(s, scene.fingerprint());
   const std::string str = s.str();
   return Bytes(str.begin(), str.end());
 }
 
-std::unique_ptr<GuideField> guide_from_bytes(const Bytes& bytes, const SceneData& scene) {
+std::unique_ptr<Guide> guide_from_bytes(const Bytes& bytes, const SceneData& scene) {
   std::istringstream s(std::string(bytes.begin(), bytes.end()), std::ios::binary);
-  return std::make_unique<GuideField>(GuideField::load(s, scene.fingerprint()));
+  return load_guide(s, scene.fingerprint());
 }
 
 // An exception's message for the one-line error ("std::bad_alloc" says little).
@@ -162,7 +162,7 @@ struct MasterSetup {
   std::unique_ptr<SceneData> scene;
   RenderOptions opt;
   OutputPaths out;
-  std::unique_ptr<GuideField> guide;
+  std::unique_ptr<Guide> guide;
   std::string guide_why;
   std::optional<Checkpoint> resume;
   uint64_t options_fingerprint = 0;
@@ -198,7 +198,7 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   // The default must not cost: a trial decides whether the guide pays.
   m.opt.guide_trial = m.guide && a.guide.mode == "auto";
   m.options_fingerprint = render_options_fingerprint(m.opt, m.scene->view().camera.width, m.scene->view().camera.height,
-                                                     m.guide ? (m.guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable") : "none") ^
+                                                     m.guide ? m.guide->mode() : "none") ^
                           m.scene->film_fingerprint();
   if (!a.resume.empty()) {
     if (!a.guide.in.empty()) throw std::runtime_error("--resume and --guide-in contradict each other (the checkpoint holds the guide)");
@@ -236,12 +236,8 @@ void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks, int32_t machi
                  scene.desc().integrator.c_str(), obstacle.empty() ? "--light-paths off" : obstacle.c_str());
   }
   if (m.guide) {
-    std::fprintf(stderr,
-                 "tessera: guiding: %s (%s), %u direction bins, %s light selection, %s next-event estimation, budget "
-                 "%.0f MB\n",
-                 m.guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable", m.guide_why.c_str(),
-                 m.guide->config().grid * m.guide->config().grid, m.guide->learned_lights() ? "learned" : "power-based",
-                 m.guide->config().nee_gain > 0.f ? "learned" : "every-vertex", m.guide->config().budget_bytes / 1048576.0);
+    std::fprintf(stderr, "tessera: guiding: %s (%s), %s\n", m.guide->mode().c_str(), m.guide_why.c_str(),
+                 describe_guide(*m.guide).c_str());
   } else {
     std::fprintf(stderr, "tessera: guiding: none (%s)\n", m.guide_why.c_str());
   }
@@ -339,7 +335,15 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
     std::fprintf(stderr, "; rejected %llu NaN/Inf and %llu negative samples",
                  static_cast<unsigned long long>(c.rejected_nonfinite), static_cast<unsigned long long>(c.rejected_negative));
   std::fputc('\n', stderr);
-  if (m.guide) {
+  if (m.guide && m.guide->mode() == "neural") {
+    const NeuralGuideStats& n = r.stats.neural_guide;
+    std::fprintf(stderr,
+                 "tessera: guide: %llu parameters, %.2f MB with Adam's moments, %llu steps on %llu targets, loss %.4g, "
+                 "%.3fs training, %.2f us per inference, %llu targets rejected\n",
+                 static_cast<unsigned long long>(n.params), n.bytes / 1048576.0, static_cast<unsigned long long>(n.steps),
+                 static_cast<unsigned long long>(n.targets), n.loss, n.train_seconds, n.inference_seconds * 1e6,
+                 static_cast<unsigned long long>(n.rejected_nonfinite + n.rejected_large));
+  } else if (m.guide) {
     const GuideFieldStats& g = r.stats.guide;
     std::fprintf(stderr, "tessera: guide: %llu cells, %.1f MB, %llu updates, %llu targets rejected%s\n",
                  static_cast<unsigned long long>(g.cells), g.bytes / 1048576.0, static_cast<unsigned long long>(g.updates),
@@ -370,7 +374,7 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
 // the outputs; checkpoints after passes when asked.
 RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, PassExecutor& executor,
                               const std::function<void(RenderStats&)>& add_stats = {}) {
-  const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide != nullptr);
+  const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide.get());
   log_setup(m, spec, executor.ranks(), executor.machines());
   double last_checkpoint = m.resume ? m.resume->so_far.stats.seconds : 0.0;
   uint32_t checkpointed_spp = ~0u;  // spp of the last checkpoint this run wrote (none yet)
@@ -378,7 +382,7 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, PassExecutor&
   if (m.snapshots.enabled()) snapshots.emplace(m.snapshots, m.out.exr, base_metadata(m, spec), m.resume.has_value());
   PassEndHook hook;
   if (!a.checkpoint.empty() || snapshots) {
-    hook = [&](const RenderResult& so_far, const GuideField* guide) {
+    hook = [&](const RenderResult& so_far, const Guide* guide) {
       if (snapshots) snapshots->on_pass_end(so_far);
       if (a.checkpoint.empty() || so_far.stats.seconds - last_checkpoint < a.checkpoint_every) return;
       write_checkpoint(a.checkpoint, so_far, guide, m.scene->fingerprint(), m.options_fingerprint);
@@ -471,7 +475,7 @@ int run_render_farm(const RenderArgs& a) {
     std::unique_ptr<TileBackend> backend = backend_for(a, m, master);
     const int32_t threads = render_threads(m.opt, t->ranks_on_this_machine());
     if (!master) {
-      const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide != nullptr);
+      const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide.get());
       run_farm_worker(*t, *backend, make_tile_settings(m.opt, spec, m.guide != nullptr), m.guide.get(), sync,
                       std::max(1, threads));
       return 0;

@@ -1,6 +1,7 @@
 #include "app/guide_setup.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -13,8 +14,9 @@ namespace tessera {
 
 void add_guide_options(CLI::App* cmd, GuideArgs& a) {
   cmd->add_option("--guide", a.mode,
-                  "Learned guiding: qtable (expected SARSA), qlearning (max rule), none; auto = the scene's effects decide")
-      ->check(CLI::IsMember({"auto", "none", "qtable", "qlearning"}));
+                  "Learned guiding: qtable (expected SARSA), qlearning (max rule), neural (an MLP over a hash-grid "
+                  "encoding, trained with expected SARSA), none; auto = the scene's effects decide")
+      ->check(CLI::IsMember({"auto", "none", "qtable", "qlearning", "neural"}));
   cmd->add_option("--guide-budget", a.budget_mb, "Guide cache memory budget in MB (cells stop refining there)")
       ->check(finite_range(0.1, 1048576.0));
   cmd->add_option("--guide-mix", a.mix,
@@ -55,6 +57,12 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
       ->check(CLI::IsMember({"learned", "always"}));
   cmd->add_option("--guide-in", a.in, "Start from a guide cache saved by --guide-out (same scene only)");
   cmd->add_option("--guide-out", a.out, "Save the learned guide cache after rendering");
+  cmd->add_option("--neural-width", a.neural_width, "--guide neural: neurons per hidden layer (two layers)")
+      ->check(CLI::Range(int64_t{1}, int64_t{kNeuralMaxWidth}));
+  cmd->add_option("--neural-steps", a.neural_steps,
+                  "--guide neural: Adam steps after each learning pass (each all-reduces the gradients in a farm)")
+      ->check(CLI::Range(int64_t{1}, int64_t{1024}));
+  cmd->add_option("--neural-lr", a.neural_lr, "--guide neural: Adam's learning rate")->check(finite_range(1e-6, 1.0));
 }
 
 void apply_guide_render_options(const GuideArgs& a, RenderOptions* opt) {
@@ -70,7 +78,7 @@ bool guiding_helps(uint32_t effects) {
   return scatters && lit;
 }
 
-std::unique_ptr<GuideField> make_guide(const GuideArgs& a, const SceneData& scene, std::string* why) {
+std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, std::string* why) {
   std::string mode = a.mode;
   if (mode == "auto") {
     mode = guiding_helps(scene.effects()) ? "qtable" : "none";
@@ -87,14 +95,26 @@ std::unique_ptr<GuideField> make_guide(const GuideArgs& a, const SceneData& scen
     std::ifstream f(a.in, std::ios::binary);
     if (!f) throw std::runtime_error("--guide-in: cannot open " + a.in);
     try {
-      auto g = std::make_unique<GuideField>(GuideField::load(f, scene.fingerprint()));
+      std::unique_ptr<Guide> g = load_guide(f, scene.fingerprint());
+      // A table file serves qtable and qlearning (its rule comes from the file); auto takes either kind.
+      if (a.mode != "auto" && (g->mode() == "neural") != (mode == "neural"))
+        throw std::runtime_error("holds a " + g->mode() + " guide, not --guide " + mode);
       if (a.mix) g->set_guide_prob(static_cast<Float>(*a.mix));
-      g->set_nee_gain(a.nee == "always" ? 0.f : GuideConfig{}.nee_gain);
+      if (auto* field = dynamic_cast<GuideField*>(g.get())) field->set_nee_gain(a.nee == "always" ? 0.f : GuideConfig{}.nee_gain);
       *why = "loaded from " + a.in;
       return g;
     } catch (const std::exception& e) {
       throw std::runtime_error("--guide-in " + a.in + ": " + e.what());
     }
+  }
+  const Bounds& b = scene.bounds();
+  if (mode == "neural") {
+    NeuralGuideConfig nc;
+    nc.width = static_cast<uint32_t>(a.neural_width);
+    nc.steps_per_pass = static_cast<uint32_t>(a.neural_steps);
+    nc.learning_rate = static_cast<Float>(a.neural_lr);
+    if (a.mix) nc.guide_prob = static_cast<Float>(*a.mix);
+    return std::make_unique<NeuralGuide>(nc, b.lo, b.hi, scene.max_emitted_radiance());
   }
   GuideConfig cfg;
   cfg.budget_bytes = static_cast<uint64_t>(std::llround(a.budget_mb * 1048576.0));
@@ -106,11 +126,10 @@ std::unique_ptr<GuideField> make_guide(const GuideArgs& a, const SceneData& scen
   cfg.grid = static_cast<uint32_t>(a.grid);
   if (a.nee == "always") cfg.nee_gain = 0.f;
   cfg.target = mode == "qlearning" ? GuideTarget::QLearning : GuideTarget::ExpectedSarsa;
-  const Bounds& b = scene.bounds();
   return std::make_unique<GuideField>(cfg, b.lo, b.hi, scene.view().num_lights, scene.max_emitted_radiance());
 }
 
-void save_guide(const GuideArgs& a, const GuideField& guide, const SceneData& scene) {
+void save_guide(const GuideArgs& a, const Guide& guide, const SceneData& scene) {
   if (a.out.empty()) return;
   const std::string tmp = a.out + ".tmp";
   {
@@ -121,6 +140,26 @@ void save_guide(const GuideArgs& a, const GuideField& guide, const SceneData& sc
     if (!f) throw std::runtime_error("--guide-out: cannot write " + tmp);
   }
   std::filesystem::rename(tmp, a.out);
+}
+
+std::string describe_guide(const Guide& guide) {
+  char b[256];
+  if (const auto* f = dynamic_cast<const GuideField*>(&guide)) {
+    const GuideConfig& c = f->config();
+    std::snprintf(b, sizeof b, "%u direction bins, %s light selection, %s next-event estimation, budget %.0f MB",
+                  c.grid * c.grid, f->learned_lights() ? "learned" : "power-based",
+                  c.nee_gain > 0.f ? "learned" : "every-vertex", c.budget_bytes / 1048576.0);
+  } else if (const auto* n = dynamic_cast<const NeuralGuide*>(&guide)) {
+    const NeuralGuideConfig& c = n->config();
+    std::snprintf(b, sizeof b,
+                  "hash grid %u levels x %u entries x %u features + normal, MLP 2 x %u, %u direction bins, "
+                  "%u Adam steps per pass (learning rate %g), %.2f MB",
+                  kNeuralLevels, kNeuralTableSize, kNeuralFeatures, c.width, kNeuralBins, c.steps_per_pass,
+                  static_cast<double>(c.learning_rate), n->stats().bytes / 1048576.0);
+  } else {
+    return guide.mode();
+  }
+  return b;
 }
 
 }  // namespace tessera

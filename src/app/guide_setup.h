@@ -8,13 +8,14 @@
 #include <string>
 
 #include "guidecache/guide_field.h"
+#include "guidecache/neural_guide.h"
 #include "master/renderer.h"
 #include "worker/scene_data.h"
 
 namespace tessera {
 
 struct GuideArgs {
-  std::string mode = "auto";  // auto | none | qtable | qlearning
+  std::string mode = "auto";  // auto | none | qtable | qlearning | neural
   double budget_mb = 4.0;
   std::optional<double> mix;  // probability of sampling a direction from the guide (default 0.5)
   int64_t split = 0;
@@ -30,6 +31,10 @@ struct GuideArgs {
   double max_ratio = kMaxGuideRatio;
   std::string nee = "learned";      // learned | always: next-event estimation's probability per cell
   std::string in, out;
+  // --guide neural
+  int64_t neural_width = NeuralGuideConfig{}.width;
+  int64_t neural_steps = NeuralGuideConfig{}.steps_per_pass;
+  double neural_lr = NeuralGuideConfig{}.learning_rate;
 };
 
 void add_guide_options(CLI::App* cmd, GuideArgs& args);
@@ -44,9 +49,12 @@ bool guiding_helps(uint32_t effects);
 
 // nullptr when guiding is off. Loads --guide-in when given (its learning rule
 // and budget then come from the file). *why explains the choice for the log.
-std::unique_ptr<GuideField> make_guide(const GuideArgs& args, const SceneData& scene, std::string* why);
+std::unique_ptr<Guide> make_guide(const GuideArgs& args, const SceneData& scene, std::string* why);
 
 // Writes the cache to --guide-out when given (temp file + rename: never a torn file).
-void save_guide(const GuideArgs& args, const GuideField& guide, const SceneData& scene);
+void save_guide(const GuideArgs& args, const Guide& guide, const SceneData& scene);
+
+// One line for the log: which guide, why, and its main settings.
+std::string describe_guide(const Guide& guide);
 
 }  // namespace tessera

@@ -39,7 +39,7 @@ constexpr uint32_t kRequestsInFlight = 2;
 struct FarmSetup {
   std::string error;  // non-empty: the master could not start; workers exit
   Bytes scene;        // encode_scene
-  Bytes guide;        // GuideField::save bytes, empty without guiding
+  Bytes guide;        // Guide::save bytes (either kind), empty without guiding
   template <class Archive>
   void serialize(Archive& ar) {
     ar(error, scene, guide);

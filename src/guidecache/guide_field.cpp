@@ -1,5 +1,8 @@
 #include "guidecache/guide_field.h"
 
+#include "guidecache/neural_guide.h"
+#include "kernels/effects.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -75,6 +78,23 @@ void GuideField::build_bin_dirs() {
             (static_cast<Float>(b / config_.grid) + 0.5f) / config_.grid);
     bin_dirs_[b] = glm::normalize(equal_area_square_to_sphere(sq));
   }
+}
+
+uint32_t GuideField::spec_bits() const { return kSpecGuiding; }
+
+void GuideField::views(GuideView* table, NeuralGuideView* neural) {
+  *table = view();
+  *neural = NeuralGuideView{};
+}
+
+void GuideField::fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const {
+  *table = stats();
+  *neural = NeuralGuideStats{};
+}
+
+bool GuideField::same_as(const Guide& other) const {
+  const GuideField* o = dynamic_cast<const GuideField*>(&other);
+  return o && *this == *o;
 }
 
 GuideView GuideField::view() {

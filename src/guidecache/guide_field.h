@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "guidecache/guide.h"
 #include "guidecache/guide_view.h"
 
 namespace tessera {
@@ -68,7 +69,7 @@ struct GuideFieldStats {
   double mean_mix = 0.0;             // mean mixture weight over cells that guide
 };
 
-class GuideField {
+class GuideField final : public Guide {
  public:
   GuideField() = default;
   // bounds_lo/hi: the scene's bounds; num_lights: learned light selection is
@@ -91,9 +92,20 @@ class GuideField {
   std::vector<uint64_t>& accumulators() { return acc_; }
 
   const GuideConfig& config() const { return config_; }
+
+  // The Guide seam: one round, the accumulators, then fold().
+  std::string mode() const override { return config_.target == GuideTarget::QLearning ? "qlearning" : "qtable"; }
+  uint32_t spec_bits() const override;
+  void views(GuideView* table, NeuralGuideView* neural) override;
+  uint32_t rounds() const override { return 1; }
+  std::vector<uint64_t>& round_accumulators(uint32_t) override { return acc_; }
+  void fold_round(uint32_t) override { fold(); }
+  void fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const override;
+  bool same_as(const Guide& other) const override;
+
   // Sampling settings that do not change what was learned.
   // A fixed mixture weight everywhere (learning the weight stops).
-  void set_guide_prob(Float p);
+  void set_guide_prob(Float p) override;
   void set_nee_gain(Float gain);  // 0: every vertex traces its next-event shadow ray
   GuideFieldStats stats() const;
   uint32_t num_cells() const { return static_cast<uint32_t>(cell_updates_.size()); }
@@ -105,7 +117,7 @@ class GuideField {
   // Versioned binary serialisation (cereal). scene_fingerprint ties a cache to
   // the scene it was learned on; load() throws std::runtime_error when the
   // stream is not a guide cache, has another version, or another fingerprint.
-  void save(std::ostream& out, uint64_t scene_fingerprint) const;
+  void save(std::ostream& out, uint64_t scene_fingerprint) const override;
   static GuideField load(std::istream& in, uint64_t scene_fingerprint);
 
   bool operator==(const GuideField& o) const;

@@ -39,6 +39,10 @@ enum Specialisation : uint32_t {
   // specialisation per combination: two more instantiations, not 32.
   kSpecMedia = 1u << 5,
   kSpecAll = (1u << 6) - 1,
+  // The neural guide instead of the Q-table (with kSpecGuiding). Like media,
+  // it runs the full surface integrator: one instantiation (two with media).
+  kSpecNeural = 1u << 6,
+  kSpecIndexCount = 1u << 7,  // every combination of the bits above
 };
 
 TESSERA_HOST_DEVICE inline uint32_t specialisation_for(uint32_t effects) {

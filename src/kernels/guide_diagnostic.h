@@ -11,8 +11,9 @@
 
 namespace tessera {
 
-template <class Tracer>
-TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g, const Tracer& tracer, Ray ray,
+// PathGuide: TablePathGuide or NeuralPathGuide (path_guide.h).
+template <class PathGuide, class Tracer>
+TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, PathGuide& g, const Tracer& tracer, Ray ray,
                                           int32_t max_depth) {
   constexpr uint32_t kSpec = kSpecSurfaceAll & ~kSpecGuiding;
   Rgb beta(1.f);
@@ -42,11 +43,11 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g
       continue;
     }
     Vec3 n_side = glm::dot(h.ng, wo) >= 0.f ? h.ng : -h.ng;
-    int32_t cell = guide_find_cell(g, h.p, n_side);
+    int32_t cell = g.locate(h.p, n_side);
     Float best = 0.f;
     uint32_t best_bin = 0;
-    for (uint32_t j = 0; j < g.bins; ++j) {
-      Float v = guide_value(g, cell, j) * glm::max(0.f, glm::dot(g.bin_dirs[j], n_side));
+    for (uint32_t j = 0; j < g.bins(); ++j) {
+      Float v = g.value(cell, j) * glm::max(0.f, glm::dot(g.bin_dir(j), n_side));
       if (v > best) {
         best = v;
         best_bin = j;
@@ -54,8 +55,8 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, const GuideView& g
     }
     // Shade with the albedo-like reflectance so materials stay recognisable.
     beta *= bsdf.type == BsdfType::Diffuse || bsdf.type == BsdfType::CoatedDiffuse ? bsdf.reflectance : Rgb(1.f);
-    if (!(best > 0.f) || depth >= max_depth) return beta * (kInvPi * g.irradiance[cell]);
-    ray.d = g.bin_dirs[best_bin];
+    if (!(best > 0.f) || depth >= max_depth) return beta * (kInvPi * g.irradiance(cell));
+    ray.d = g.bin_dir(best_bin);
     ray.o = offset_ray_origin(h, ray.d);
   }
 }

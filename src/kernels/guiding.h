@@ -61,14 +61,17 @@ TESSERA_HOST_DEVICE inline uint32_t select_light(const SceneView& s, const Guide
 // (measured: ~3x the variance behind a rough glass slab). Nor is hair, which
 // scatters over the whole sphere about its fibre, nor the lobe a
 // subsurface walk leaves by (its side is the one the guide never learned).
-TESSERA_HOST_DEVICE inline Float guide_probability(const GuideView& g, int32_t cell, const BsdfParams& b,
-                                                   bool lambertian_only) {
-  const Float p = g.cell_guide_prob(cell);
+// The fading by BSDF of a full weight p (both guides).
+TESSERA_HOST_DEVICE inline Float guide_probability_for_bsdf(Float p, const BsdfParams& b, bool lambertian_only) {
   if (lambertian_only || b.type == BsdfType::Diffuse) return p;
   if (b.type == BsdfType::Dielectric || b.type == BsdfType::Hair || b.type == BsdfType::SubsurfaceExit) return 0.f;
   Float alpha = glm::sqrt(b.alpha_x * b.alpha_y);
   if (b.type == BsdfType::CoatedDiffuse) alpha = glm::max(alpha, 0.3f);  // a rough coat over a diffuse base
   return p * glm::clamp((alpha - 0.05f) / 0.25f, 0.f, 1.f);
+}
+TESSERA_HOST_DEVICE inline Float guide_probability(const GuideView& g, int32_t cell, const BsdfParams& b,
+                                                   bool lambertian_only) {
+  return guide_probability_for_bsdf(g.cell_guide_prob(cell), b, lambertian_only);
 }
 
 // What a guided vertex remembers of its sampled direction until the learning

@@ -10,6 +10,7 @@
 #include "camera.h"
 #include "effects.h"
 #include "guiding.h"
+#include "path_guide.h"
 #include "light_sampling.h"
 #include "material_eval.h"
 #include "rng.h"
@@ -41,6 +42,7 @@ struct PathSettings {
   int32_t max_depth = 5;
   bool nee = true;  // false: emitters are found by BSDF sampling only (for tests and comparisons)
   GuideView guide;  // read and updated by the kSpecGuiding specialisation only
+  NeuralGuideView neural;  // instead of guide with kSpecNeural
   // Whether this path's targets train the guide (kSpecGuiding only). A path
   // that does not learn still samples from the guide; it skips the learning
   // work, which costs as much as guided sampling itself.
@@ -164,6 +166,7 @@ template <uint32_t Spec, class Tracer>
 TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray ray, PixelSampler& rng,
                                    const PathSettings& settings, PathCounters& c, Wavelengths* wl = nullptr) {
   constexpr bool kGuide = (Spec & kSpecGuiding) != 0;
+  constexpr bool kNeural = kGuide && (Spec & kSpecNeural) != 0;
   constexpr bool kMedia = (Spec & kSpecMedia) != 0;
   int32_t medium = kMedia ? s.camera_medium : -1;  // the medium the ray travels in (-1: vacuum)
   HeroChannels heroes;  // the channel media sample distances with, and the MIS over it (medium.h)
@@ -172,8 +175,12 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   // are the radiance arriving at x, after the medium between.
   Float segment_tr = 1.f;
   const bool learn = kGuide && settings.learn;
-  const GuideView& g = settings.guide;
-  const GuideView* guide = kGuide ? &g : nullptr;
+  // The guide, per vertex (path_guide.h); light selection reads the table's cells only.
+  auto pg = [&]() {
+    if constexpr (kNeural) return NeuralPathGuide(settings.neural);
+    else return TablePathGuide{settings.guide};
+  }();
+  const GuideView* guide = kGuide ? pg.light_guide() : nullptr;
   Rgb L(0.f), beta(1.f);
   // Russian roulette decides on the throughput BSDF sampling alone would have
   // (pbrt-v4's rule). Guided directions carry small weights exactly where the
@@ -259,11 +266,11 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   };
   auto finish_target = [&](Float target) {
     target *= segment_tr;
-    if (guide_record(g, pend_cell, pend_bin, target)) {
+    if (pg.record(pend_cell, pend_bin, target)) {
       ++c.guide_updates;
       if (pend_mix.mix_pdf > 0.f) {
         pend_mix.emitted *= segment_tr;
-        guide_record_mix(g, pend_cell, pend_mix, target);
+        pg.record_mix(pend_cell, pend_mix, target);
       }
     }
   };
@@ -437,9 +444,9 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     if constexpr (kGuide) {
       // The side the path is on: the two faces of a wall never share a cell.
       Vec3 n_side = glm::dot(h.ng, wo) >= 0.f ? h.ng : -h.ng;
-      cell = guide_find_cell(g, h.p, n_side);
+      cell = pg.locate(h.p, n_side);
       if (learn) {
-        guide_record_normal(g, cell, n_side);
+        pg.note_normal(cell, n_side);
         // Emission the integrator weights by MIS is NEE's to deliver.
         pend_le = (specular_bounce || !settings.nee) ? luminance(Le_hit) : 0.f;
         pend_at_delta = delta_lobe;
@@ -451,7 +458,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     if (wo_l.z == 0.f) break;
     // Probability of drawing this vertex's direction from the guide (0: BSDF only).
     // Not once guiding has raised the path's weight max_guide_ratio-fold (see guide_ratio).
-    Float guide_p = kGuide && !delta_lobe ? guide_probability(g, cell, bsdf, (Spec & kSpecNonDiffuse) == 0) : 0.f;
+    Float guide_p = kGuide && !delta_lobe ? pg.probability(cell, bsdf, (Spec & kSpecNonDiffuse) == 0) : 0.f;
     if (guide_p > 0.f && !(guide_ratio <= settings.max_guide_ratio)) {
       guide_p = 0.f;
       ++c.guide_withheld_vertices;
@@ -462,7 +469,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     // that the guide's alias entry can be fetched while the shadow ray is traced.
     const Float uc = rng.uniform();
     const Vec2 u = rng.uniform2();
-    if (guided_vertex) TESSERA_PREFETCH(g.alias_entry(cell, uc));
+    if (guided_vertex) pg.prefetch_sample(cell, uc);
 
     // Next-event estimation at non-specular vertices (pbrt-v4's SampleLd).
     Float direct_estimate = 0.f;  // its unweighted estimate of light reflected here (guide targets)
@@ -497,12 +504,10 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           if (!ls.infinite) tmax = glm::length(ls.p_light - o) * 0.9999f;
           Float light_pdf = pmf * ls.pdf;
           // The guide's density of the light direction, for the MIS weight: its
-          // alias entry is fetched while the shadow ray is traced.
-          const GuideAlias* light_dir_entry = nullptr;
-          if (guided_vertex && !ls.delta) {
-            light_dir_entry = g.bin_entry(cell, guide_bin_of(g, ls.wi));
-            TESSERA_PREFETCH(light_dir_entry);
-          }
+          // memory is fetched while the shadow ray is traced.
+          typename decltype(pg)::DirLookup light_dir{};
+          const bool guided_light_dir = guided_vertex && !ls.delta;
+          if (guided_light_dir) light_dir = pg.lookup(cell, ls.wi);
           const Rgb tr = light_pdf > 0.f ? light_visibility<kMedia>(s, tracer, o, ls.wi, tmax,
                                                                     kMedia ? medium_after(s, hit.triangle, h.ng, ls.wi, medium) : -1,
                                                                     ray.time, c, wl)
@@ -512,8 +517,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             if (!ls.delta) {
               const Float scatter_pdf = eval_pdf<Spec>(bsdf, wo_l, wi_l);
               Float mis_pdf = eval_mis_pdf<Spec>(bsdf, wo_l, wi_l, scatter_pdf);
-              if (light_dir_entry) {
-                const Float guide_pdf_l = g.entry_pdf(*light_dir_entry);
+              if (guided_light_dir) {
+                const Float guide_pdf_l = pg.lookup_pdf(light_dir);
                 if (learn) {
                   nee_mix.nee_value = luminance(f * tr * ls.L);
                   nee_mix.nee_light_pdf = light_pdf;
@@ -529,24 +534,23 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           }
         }
       }
-      if (learn && g.lights > 0 && pmf > 0.f) guide_record(g, cell, g.bins + li, learned);
+      if (learn && pmf > 0.f) pg.record_light(cell, li, learned);
       direct_estimate = pmf > 0.f ? learned / pmf : 0.f;
     }
     // Radiance the guide expects y to reflect towards x: NEE's unweighted
     // estimate plus the learned integral. It completes the pending target, and
     // gives guide-driven roulette the path's expected radiance.
     const bool completes_target = learn && pend_cell >= 0 && !pend_at_delta;
-    const bool sets_expectation = guide_roulette && !(path_expected > 0.f) && !delta_lobe && g.learned(cell);
+    const bool sets_expectation = guide_roulette && !(path_expected > 0.f) && !delta_lobe && pg.learned(cell);
     const bool records_nee = learn && nee_vertex;
     if (completes_target || sets_expectation || records_nee) {
       const bool lambertian = (Spec & kSpecNonDiffuse) == 0 || bsdf.type == BsdfType::Diffuse;
-      const Float indirect = guide_bins_integral(g, cell, bsdf, lambertian, wo_l,
-                                                 [&](const Vec3& v) { return frame.to_local(v); }, rng);
+      const Float indirect = pg.bins_integral(cell, bsdf, lambertian, wo_l,
+                                              [&](const Vec3& v) { return frame.to_local(v); }, rng);
       const Float reflected = direct_estimate + indirect;
       if (records_nee) {
         // The two shares of the light reflected here, for nee_prob.
-        guide_record(g, cell, g.nee_entry, direct_estimate);
-        guide_record(g, cell, g.nee_entry + 1, indirect);
+        pg.record_nee(cell, direct_estimate, indirect);
       }
       if (completes_target) {
         finish_target(pend_le + reflected);
@@ -567,7 +571,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       const Float p = guide_p;
       if (rng.uniform() < p) {
         ++c.guided_samples;
-        if (!guide_sample(g, cell, uc, u, &wi, &guide_density, &wi_bin)) break;
+        if (!pg.sample(cell, uc, u, &wi, &guide_density, &wi_bin)) break;
         bs.wi = frame.to_local(wi);
         bs.f = eval_f<Spec>(bsdf, wo_l, bs.wi);
         const bool transmit = !same_hemisphere(wo_l, bs.wi);
@@ -579,28 +583,28 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         if (!sample_f<Spec>(bsdf, wo_l, uc, u, &bs) || !(bs.pdf > 0.f)) break;
         wi = frame.to_world(bs.wi);
         bsdf_pdf = bs.pdf;
-        wi_bin = guide_bin_of(g, wi);
-        guide_density = guide_bin_pdf(g, cell, wi_bin);
+        wi_bin = pg.bin_of(wi);
+        guide_density = pg.bin_pdf(cell, wi_bin);
         scatter_pdf = p * guide_density + (1.f - p) * bs.pdf;
       }
     } else {
       if (!sample_f<Spec>(bsdf, wo_l, uc, u, &bs) || !(bs.pdf > 0.f)) break;
       wi = frame.to_world(bs.wi);
       scatter_pdf = bsdf_pdf = bs.pdf;
-      if (learn || (path_expected > 0.f && g.learned(cell))) wi_bin = guide_bin_of(g, wi);
+      if (learn || (path_expected > 0.f && pg.learned(cell))) wi_bin = pg.bin_of(wi);
     }
     if (!(scatter_pdf > 0.f)) break;
     const Rgb weight = bs.f * (abs_cos_theta(bs.wi) / scatter_pdf);
     if (learn) {
       // A delta vertex's integral is the direction it actually took.
-      if (pend_at_delta && pend_cell >= 0) finish_target(pend_le + guide_value(g, cell, wi_bin) * luminance(weight));
+      if (pend_at_delta && pend_cell >= 0) finish_target(pend_le + pg.value(cell, wi_bin) * luminance(weight));
       pend_cell = cell;
       pend_bin = wi_bin;
       pend_at_delta = false;
       // Only vertices that sample with the cell's own weight (not faded by a
       // glossy lobe) inform it.
       pend_mix = nee_mix;
-      if (g.learn_mix && guided_vertex && guide_p == g.cell_guide_prob(cell)) {
+      if (guided_vertex && pg.learns_mix(cell, guide_p)) {
         pend_mix.fcos = luminance(bs.f) * abs_cos_theta(bs.wi);
         pend_mix.bsdf_pdf = bsdf_pdf;
         pend_mix.guide_pdf = guide_density;
@@ -641,9 +645,9 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     // bring light survives more often.
     if (depth > 1) {
       Float survive = glm::min(1.f, max_component(rr_beta * eta_scale));
-      if (kGuide && path_expected > 0.f && g.learned(cell)) {
-        survive = glm::max(survive, guided_survival(g, cell, wi_bin, luminance(beta), path_expected,
-                                                         settings.guided_roulette_window));
+      if (kGuide && path_expected > 0.f && pg.learned(cell)) {
+        survive = glm::max(survive, pg.survival(cell, wi_bin, luminance(beta), path_expected,
+                                                settings.guided_roulette_window));
         ++c.guided_roulette;
       }
       if (survive < 1.f) {

@@ -13,8 +13,8 @@ constexpr char kMagic[] = "tessera-checkpoint";
 // 2: per-pass error estimates; 3: next-event skip counter, guide cache v2; 4: medium
 // vertex counter, --guide auto's trial; 5: guide cache v4; 6: light-path splats;
 // 7: splats summed per light path, lights in their own medium; 8: counter of
-// vertices the guide ratio left to the BSDF
-constexpr uint32_t kVersion = 8;
+// vertices the guide ratio left to the BSDF; 9: the neural guide's loss per pass
+constexpr uint32_t kVersion = 9;
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.
 uint64_t fnv1a(const std::string& s) {
@@ -59,7 +59,7 @@ uint64_t render_options_fingerprint(const RenderOptions& o, int32_t width, int32
   return fnv1a(s.str());
 }
 
-void write_checkpoint(const std::string& path, const RenderResult& so_far, const GuideField* guide,
+void write_checkpoint(const std::string& path, const RenderResult& so_far, const Guide* guide,
                       uint64_t scene_fingerprint, uint64_t options_fingerprint) {
   Checkpoint c{so_far, {}};
   if (guide) {

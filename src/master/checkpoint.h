@@ -22,12 +22,12 @@ uint64_t render_options_fingerprint(const RenderOptions& options, int32_t width,
 
 struct Checkpoint {
   RenderResult so_far;
-  Bytes guide;  // GuideField::save bytes; empty when the render is unguided
+  Bytes guide;  // Guide::save bytes (either kind: load_guide); empty when the render is unguided
 };
 
 // Throws std::runtime_error naming the path on failure; never leaves a
 // partial file at `path`.
-void write_checkpoint(const std::string& path, const RenderResult& so_far, const GuideField* guide,
+void write_checkpoint(const std::string& path, const RenderResult& so_far, const Guide* guide,
                       uint64_t scene_fingerprint, uint64_t options_fingerprint);
 
 // Throws std::runtime_error ("<path>: <problem>") for a missing, corrupt,

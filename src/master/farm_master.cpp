@@ -166,12 +166,12 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
   backend_.end_pass();
 }
 
-void FarmMaster::reduce_guide(GuideField& guide) {
+void FarmMaster::reduce_guide(std::vector<uint64_t>& accumulators) {
   if (!sync_guide_ || transport_.size() == 1) return;
   const auto t0 = std::chrono::steady_clock::now();
-  transport_.allreduce_sum(guide.accumulators());
+  transport_.allreduce_sum(accumulators);
   sync_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  sync_bytes_ = guide.accumulators().size() * sizeof(uint64_t);
+  sync_bytes_ = std::max<uint64_t>(sync_bytes_, accumulators.size() * sizeof(uint64_t));
   ++syncs_;
 }
 

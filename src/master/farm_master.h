@@ -21,7 +21,7 @@ class FarmMaster : public PassExecutor {
   FarmMaster(Transport& transport, TileBackend& backend, int32_t local_threads, bool sync_guide);
   void render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film, TileCounters* counters,
                    const std::function<void(uint64_t)>& on_tile_done) override;
-  void reduce_guide(GuideField& guide) override;
+  void reduce_guide(std::vector<uint64_t>& accumulators) override;
   int32_t ranks() const override { return transport_.size(); }
   int32_t machines() const override { return transport_.machines(); }
   int32_t total_threads() const override { return total_threads_; }

@@ -11,13 +11,22 @@
 #include "master/ordered_splats.h"
 #include "master/progress.h"
 #include "worker/cpu_affinity.h"
+#include "worker/guide_binding.h"
 
 namespace tessera {
 
-uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options, bool guiding) {
+uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options, const Guide* guide) {
   uint32_t spec = specialisation_for(scene.effects());
   if (options.force_full_specialisation) spec = (kSpecSurfaceAll & ~kSpecGuiding) | (spec & kSpecMedia);
-  return guiding ? spec | kSpecGuiding : spec;
+  return guide ? spec | guide->spec_bits() : spec;
+}
+
+void combine_guide_learning(PassExecutor& executor, Guide& guide) {
+  // rounds() may shrink after round 0 (a pass without targets has nothing to train on).
+  for (uint32_t r = 0; r < guide.rounds(); ++r) {
+    executor.reduce_guide(guide.round_accumulators(r));
+    guide.fold_round(r);
+  }
 }
 
 TileSettings make_tile_settings(const RenderOptions& opt, uint32_t specialisation, bool guiding) {
@@ -94,13 +103,13 @@ void LocalPassExecutor::render_pass(const TileSettings& settings, const std::vec
   backend_.end_pass();
 }
 
-RenderResult render(const SceneData& scene, TileBackend& backend, const RenderOptions& opt, GuideField* guide,
+RenderResult render(const SceneData& scene, TileBackend& backend, const RenderOptions& opt, Guide* guide,
                     const RenderResult* resume, const PassEndHook& on_pass_end) {
   LocalPassExecutor local(backend, render_threads(opt));
   return render(scene, local, opt, guide, resume, on_pass_end);
 }
 
-RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const RenderOptions& opt, GuideField* guide,
+RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const RenderOptions& opt, Guide* guide,
                     const RenderResult* resume, const PassEndHook& on_pass_end) {
   PassExecutor* executor = &executor_ref;
   const SceneView& view = scene.view();
@@ -115,7 +124,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
   RenderStats& stats = result.stats;
   stats.effects = scene.effects();
   stats.spectral = scene.desc().spectral;
-  stats.specialisation = effective_specialisation(scene, opt, guide != nullptr);
+  stats.specialisation = effective_specialisation(scene, opt, guide);
 
   stats.backend = executor->backends();
   stats.threads = executor->total_threads();
@@ -144,7 +153,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
   };
 
   stats.target_error = opt.target_error;
-  if (guide) stats.guide_mode = guide->config().target == GuideTarget::QLearning ? "qlearning" : "qtable";
+  if (guide) stats.guide_mode = guide->mode();
   if (guide && opt.guide_trial && stats.guide_trial.state == GuideTrialState::Off)
     stats.guide_trial.state = GuideTrialState::Pending;
   if (!stats.pass_stats.empty()) progress.set_error(stats.estimated_rel_mse, opt.target_error);
@@ -172,15 +181,16 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     if (opt.spp > 0) pass_spp = std::min(pass_spp, opt.spp - spp_done);
     const double pass_start = elapsed();
     const TileCounters before = stats.counters;
+    double pass_loss = -1.0;
     // Guided unless this is an unguided trial pass or the trial switched guiding off.
     const TrialPass trial_pass = guide_trial_next_pass(stats.guide_trial, spp_done);
     const bool guided = guide && trial_pass != TrialPass::Unguided &&
                         stats.guide_trial.state != GuideTrialState::SwitchedOff;
     TileSettings pass_settings = settings;
     if (guided) {
-      pass_settings.path.guide = guide->view();
+      bind_guide(*guide, &pass_settings);
     } else {
-      pass_settings.specialisation &= ~kSpecGuiding;
+      pass_settings.specialisation &= ~(kSpecGuiding | kSpecNeural);
       pass_settings.path.guided_roulette = false;
     }
     std::vector<PixelAccum> film_before;
@@ -201,9 +211,12 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     }
     if (guided) {
       const double fold_start = elapsed();
-      executor->reduce_guide(*guide);
-      guide->fold();
+      const size_t losses = stats.neural_guide.pass_loss.size();
+      combine_guide_learning(*executor, *guide);
       stats.guide_fold_seconds += elapsed() - fold_start;
+      GuideFieldStats table_stats;
+      guide->fill_stats(&table_stats, &stats.neural_guide);
+      if (stats.neural_guide.pass_loss.size() > losses) pass_loss = stats.neural_guide.pass_loss.back();
     }
     spp_done += pass_spp;
     ++stats.passes;
@@ -216,6 +229,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     ps.vertices = stats.counters.path.vertices - before.path.vertices;
     ps.guided_samples = stats.counters.path.guided_samples - before.path.guided_samples;
     ps.guidable_vertices = stats.counters.path.guidable_vertices - before.path.guidable_vertices;
+    ps.guide_loss = pass_loss;
     const ErrorEstimate err = estimate_rel_mse(result.film);
     ps.estimated_rel_mse = err.valid ? err.rel_mse : -1.0;
     stats.estimated_rel_mse = ps.estimated_rel_mse;
@@ -231,7 +245,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
   }
   stats.spp = spp_done;
   stats.seconds = elapsed();
-  if (guide) stats.guide = guide->stats();
+  if (guide) guide->fill_stats(&stats.guide, &stats.neural_guide);
   progress.finish(samples_done.load(), spp_done);
   return result;
 }

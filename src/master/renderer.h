@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "guidecache/guide_field.h"
+#include "guidecache/neural_guide.h"
 #include "master/film.h"
 #include "master/guide_trial.h"
 #include "worker/render_tile.h"
@@ -53,6 +54,7 @@ struct PassStats {
   uint64_t guided_samples = 0;
   uint64_t guidable_vertices = 0;
   double estimated_rel_mse = -1.0;  // of the image after this pass; < 0 = not yet estimable
+  double guide_loss = -1.0;   // neural guide: mean training loss after this pass (< 0: none)
 };
 
 struct RenderStats {
@@ -73,8 +75,9 @@ struct RenderStats {
   double estimated_rel_mse = -1.0; // of the final image, from its per-pixel variances (< 0 = too few samples)
   double pass_end_seconds = 0.0;   // of `seconds`, spent in the pass-end hook (checkpoints, snapshots)
   std::vector<PassStats> pass_stats;
-  std::string guide_mode = "none";  // none | qtable | qlearning
-  GuideFieldStats guide;            // as the field stood at the end (when guided)
+  std::string guide_mode = "none";  // none | qtable | qlearning | neural
+  GuideFieldStats guide;            // as the guide stood at the end (when guided; the network fills bytes, updates, rejections)
+  NeuralGuideStats neural_guide;    // the network's own (--guide neural)
   double guide_fold_seconds = 0.0;
   double guide_sync_seconds = 0.0;  // farm: time in guide all-reductions (rank 0's view)
   uint64_t guide_sync_bytes = 0;    // farm: bytes all-reduced per sync
@@ -93,7 +96,7 @@ struct RenderResult {
 };
 
 // The integrator specialisation a render with these options runs.
-uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options, bool guiding);
+uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options, const Guide* guide);
 
 // What every tile of a render is rendered with (the same on every rank).
 TileSettings make_tile_settings(const RenderOptions& options, uint32_t specialisation, bool guiding);
@@ -119,7 +122,7 @@ class PassExecutor {
                            TileCounters* counters, const std::function<void(uint64_t)>& on_tile_done) = 0;
   // Before a fold: makes the pass's guide accumulators the sum over
   // everything that rendered it (a farm all-reduces them; locally they are).
-  virtual void reduce_guide(GuideField& guide) {}
+  virtual void reduce_guide(std::vector<uint64_t>& accumulators) {}
   // How many processes render (1 locally).
   virtual int32_t ranks() const { return 1; }
   // The backends that render (a farm's ranks may differ).
@@ -127,6 +130,10 @@ class PassExecutor {
   virtual int32_t machines() const { return 1; }
   virtual int32_t total_threads() const = 0;
 };
+
+// After a guided pass: every round of the guide's learning, reduced by the
+// executor (a farm sums it across ranks) and folded in.
+void combine_guide_learning(PassExecutor& executor, Guide& guide);
 
 // This process's backend: tiles handed out in order, as its threads ask.
 class LocalPassExecutor : public PassExecutor {
@@ -144,7 +151,7 @@ class LocalPassExecutor : public PassExecutor {
 };
 
 // Called after every pass (guide folded): where checkpoints are written.
-using PassEndHook = std::function<void(const RenderResult& so_far, const GuideField* guide)>;
+using PassEndHook = std::function<void(const RenderResult& so_far, const Guide* guide)>;
 
 // Renders passes until options.spp, the time budget or the target error is
 // reached, whichever comes first. With a guide, every pass samples from the
@@ -152,11 +159,11 @@ using PassEndHook = std::function<void(const RenderResult& so_far, const GuideFi
 // in before the next one. `resume` continues a render from a checkpoint
 // (its film, passes and counters; the guide is the caller's).
 RenderResult render(const SceneData& scene, PassExecutor& executor, const RenderOptions& options,
-                    GuideField* guide = nullptr, const RenderResult* resume = nullptr,
+                    Guide* guide = nullptr, const RenderResult* resume = nullptr,
                     const PassEndHook& on_pass_end = {});
 // The same on this process's backend, with render_threads(options) threads.
 RenderResult render(const SceneData& scene, TileBackend& backend, const RenderOptions& options,
-                    GuideField* guide = nullptr, const RenderResult* resume = nullptr,
+                    Guide* guide = nullptr, const RenderResult* resume = nullptr,
                     const PassEndHook& on_pass_end = {});
 
 }  // namespace tessera

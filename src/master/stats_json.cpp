@@ -1,5 +1,6 @@
 #include "master/stats_json.h"
 
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -66,6 +67,25 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
     j["guide_targets_rejected_nonfinite"] = (s.guide.rejected_nonfinite);
     j["guide_targets_rejected_large"] = (s.guide.rejected_large);
     j["guide_fold_seconds"] = (s.guide_fold_seconds);
+    if (s.guide_mode == "neural") {
+      const NeuralGuideStats& n = s.neural_guide;
+      j["guide_neural_params"] = n.params;
+      j["guide_neural_steps"] = n.steps;
+      j["guide_neural_targets"] = n.targets;
+      j["guide_neural_targets_dropped"] = n.dropped;
+      j["guide_neural_gradient_words_clamped"] = n.gradient_clamped;
+      j["guide_neural_nonfinite_gradients"] = n.nonfinite_gradients;
+      j["guide_neural_loss"] = n.loss;
+      j["guide_neural_train_seconds"] = n.train_seconds;
+      j["guide_neural_inference_us"] = n.inference_seconds * 1e6;
+      // Shares of the render's wall time: training (rank 0's, between passes),
+      // and inference estimated as one per path vertex at the measured cost,
+      // spread over the threads.
+      const double wall = std::max(s.seconds, 1e-9);
+      j["guide_neural_train_fraction"] = n.train_seconds / wall;
+      j["guide_neural_inference_fraction"] =
+          double(c.path.vertices) * n.inference_seconds / (std::max(1, s.threads) * wall);
+    }
     if (s.ranks > 1) {
       j["guide_sync"] = (s.guide_sync);
       j["guide_syncs"] = (uint64_t(s.guide_syncs));
@@ -109,7 +129,8 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
                       {"mean_path_length", p.vertices / n},
                       {"guided_sample_fraction",
                        p.guidable_vertices ? double(p.guided_samples) / double(p.guidable_vertices) : 0.0},
-                      {"estimated_relmse", p.estimated_rel_mse}});
+                      {"estimated_relmse", p.estimated_rel_mse},
+                      {"guide_loss", p.guide_loss}});
   }
   j["per_pass"] = passes;
   if (!snapshots.empty()) {

@@ -106,10 +106,11 @@ std::string describe_effects(uint32_t e) {
 }
 
 std::string describe_specialisation(uint32_t s) {
-  if (s == kSpecAll) return "full";
-  static const char* names[] = {"non-diffuse-bsdfs", "textures", "area-lights", "environment", "guiding", "media"};
+  if ((s & kSpecAll) == kSpecAll) return (s & kSpecNeural) ? "full+neural" : "full";
+  static const char* names[] = {"non-diffuse-bsdfs", "textures", "area-lights", "environment", "guiding", "media",
+                                "neural"};
   std::string out;
-  for (uint32_t i = 0; i < 6; ++i) {
+  for (uint32_t i = 0; i < 7; ++i) {
     if (s & (1u << i)) {
       if (!out.empty()) out += "+";
       out += names[i];

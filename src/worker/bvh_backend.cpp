@@ -16,6 +16,12 @@ TileCounters render_tile(const SceneView& scene, const BvhTracer& tracer, const 
       return render_tile_spec<kServedMedia | kSpecGuiding, BvhTracer>(scene, tracer, settings, job, pixels, splats);
     case kServedMedia:
       return render_tile_spec<kServedMedia, BvhTracer>(scene, tracer, settings, job, pixels, splats);
+    case kServedMedia | kSpecGuiding | kSpecNeural:
+      return render_tile_spec<kServedMedia | kSpecGuiding | kSpecNeural, BvhTracer>(scene, tracer, settings, job, pixels,
+                                                                                 splats);
+    case kServedSurface | kSpecGuiding | kSpecNeural:
+      return render_tile_spec<kServedSurface | kSpecGuiding | kSpecNeural, BvhTracer>(scene, tracer, settings, job,
+                                                                                   pixels, splats);
     case kServedSurface | kSpecGuiding:
       return render_tile_spec<kServedSurface | kSpecGuiding, BvhTracer>(scene, tracer, settings, job, pixels, splats);
     default:

@@ -30,7 +30,9 @@ TileCounters CpuTileBackend::render_tiles(TileQueue& queue, int32_t threads) {
           queue.between_tiles();
           if (!queue.take(&task)) break;
           std::vector<Splat> splats;
+          guide_acc_->begin_tile(settings, task.job);
           const TileCounters tc = render_one(settings, task.job, task.pixels, light_paths ? &splats : nullptr);
+          guide_acc_->end_tile(settings);
           counters[static_cast<size_t>(slot)].add(tc);
           queue.done(task, tc.samples, std::move(splats));
         }

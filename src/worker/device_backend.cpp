@@ -125,6 +125,8 @@ void DeviceBackend::upload_guide(const GuideView& g) {
 void DeviceBackend::begin_pass(const TileSettings& settings) {
   if (settings.path.light_traced_caustics)
     throw std::runtime_error("the " + name() + " backend does not trace caustics from the lights yet");
+  if (settings.specialisation & kSpecNeural)
+    throw std::runtime_error("the " + name() + " backend has no neural guide yet (--backend embree or bvh has)");
   settings_ = settings;
   device_settings_ = settings;
   const GuideView& g = settings.path.guide;

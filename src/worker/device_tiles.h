@@ -45,8 +45,11 @@ struct DeviceLaunch {
 // Four instantiations instead of one per effects set keep the build short.
 constexpr uint32_t kServedSurface = kSpecSurfaceAll & ~kSpecGuiding;
 constexpr uint32_t kServedMedia = kSpecMedia | kServedSurface;
+// (The neural guide's bit passes through: the BVH backend serves it on the
+// CPU; the device backend refuses it in begin_pass.)
 TESSERA_HOST_DEVICE constexpr uint32_t served_specialisation(uint32_t spec) {
-  return ((spec & kSpecMedia) ? kServedMedia : kServedSurface) | (spec & kSpecGuiding);
+  const uint32_t guide = (spec & kSpecGuiding) ? spec & (kSpecGuiding | kSpecNeural) : 0u;
+  return ((spec & kSpecMedia) ? kServedMedia : kServedSurface) | guide;
 }
 
 static_assert(sizeof(TileCounters) % sizeof(uint64_t) == 0, "TileCounters is added word by word");

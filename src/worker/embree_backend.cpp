@@ -113,7 +113,7 @@ constexpr std::array<TileFn, sizeof...(I)> make_table(std::index_sequence<I...>)
 }
 
 // One instantiation per specialisation; chosen once per tile.
-constexpr auto kTileFns = make_table(std::make_index_sequence<kSpecAll + 1>{});
+constexpr auto kTileFns = make_table(std::make_index_sequence<kSpecIndexCount>{});
 
 }  // namespace
 
@@ -121,7 +121,7 @@ TileCounters render_tile(const SceneView& scene, const EmbreeTracer& tracer, con
                          const TileJob& job, TilePixels pixels, std::vector<Splat>* splats) {
   if (settings.path.light_traced_caustics && !splats)
     throw std::logic_error("render_tile: light-traced caustics need a splat list");
-  return kTileFns[settings.specialisation & kSpecAll](scene, tracer, settings, job, pixels, splats);
+  return kTileFns[settings.specialisation & (kSpecIndexCount - 1)](scene, tracer, settings, job, pixels, splats);
 }
 
 }  // namespace tessera

@@ -6,6 +6,7 @@
 
 #include "comm/farm_protocol.h"
 #include "master/interrupt.h"
+#include "worker/guide_binding.h"
 
 namespace tessera {
 namespace {
@@ -57,7 +58,7 @@ void render_pass_tiles(Transport& t, TileBackend& backend, int32_t threads, uint
 
 }  // namespace
 
-void run_farm_worker(Transport& t, TileBackend& backend, const TileSettings& base, GuideField* guide, bool sync_guide,
+void run_farm_worker(Transport& t, TileBackend& backend, const TileSettings& base, Guide* guide, bool sync_guide,
                      int32_t threads) {
   t.send(0, kTagHello, encode(FarmHello{threads, backend.name()}));
   TileSettings settings = base;
@@ -76,13 +77,21 @@ void run_farm_worker(Transport& t, TileBackend& backend, const TileSettings& bas
       // An unguided pass (the --guide auto trial's, or after it switched
       // guiding off) gets no view at all: the last guided pass's view points
       // into accumulators that folding may have reallocated since.
-      settings.path.guide = guided ? guide->view() : GuideView{};
+      settings.path.guide = GuideView{};
+      settings.path.neural = NeuralGuideView{};
+      settings.neural_log = nullptr;
+      if (guided) bind_guide(*guide, &settings);
       backend.begin_pass(settings);
       render_pass_tiles(t, backend, threads, capacity);
       backend.end_pass();
       if (guided) {
-        if (sync_guide) t.allreduce_sum(guide->accumulators());
-        guide->fold();
+        // The same rounds as the master's combine_guide_learning (rounds()
+        // is the same on every rank: it follows the summed round 0).
+        for (uint32_t r = 0; r < guide->rounds(); ++r) {
+          std::vector<uint64_t>& acc = guide->round_accumulators(r);
+          if (sync_guide) t.allreduce_sum(acc);
+          guide->fold_round(r);
+        }
       }
     }
   } catch (const std::exception& e) {

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "comm/transport.h"
-#include "guidecache/guide_field.h"
+#include "guidecache/guide.h"
 #include "worker/render_tile.h"
 #include "worker/tile_backend.h"
 
@@ -12,7 +12,7 @@ namespace tessera {
 
 // settings: as make_tile_settings gives the master (the guide view is set
 // here, per pass). guide: this rank's copy of the cache (nullptr: none).
-void run_farm_worker(Transport& transport, TileBackend& backend, const TileSettings& settings, GuideField* guide,
+void run_farm_worker(Transport& transport, TileBackend& backend, const TileSettings& settings, Guide* guide,
                      bool sync_guide, int32_t threads);
 
 }  // namespace tessera

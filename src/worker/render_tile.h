@@ -50,12 +50,17 @@ struct GuideLearnSchedule {
   }
 };
 
+class NeuralTrainingLog;
+
 struct TileSettings {
   uint64_t seed = 0;
   SamplerSetup sampler;  // its seed is `seed`
   PathSettings path;
   GuideLearnSchedule learn;
   uint32_t specialisation = kSpecAll;
+  // The neural guide's learning targets go here (via each thread's sink in
+  // path.neural; worker/thread_guide_accumulators.h). Null: not recorded.
+  NeuralTrainingLog* neural_log = nullptr;
 };
 
 struct TileCounters {

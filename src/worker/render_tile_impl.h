@@ -16,9 +16,12 @@ SamplerSetup light_path_sampler(const TileSettings& settings);
 // Merges the splats from `first` on that reach the same pixel (one per path and pixel).
 void merge_splats_by_pixel(std::vector<Splat>& splats, size_t first);
 
-// Media scenes run the full surface integrator (see kSpecMedia): every
-// index with the media bit maps to one of two instantiations.
+// Media scenes and the neural guide run the full surface integrator (see
+// kSpecMedia, kSpecNeural): every index with those bits maps to one of four
+// instantiations (kSpecNeural without kSpecGuiding means nothing: dropped).
 constexpr uint32_t instantiated_spec(uint32_t s) {
+  if ((s & kSpecNeural) && (s & kSpecGuiding)) return kSpecNeural | kSpecSurfaceAll | (s & kSpecMedia);
+  s &= ~kSpecNeural;
   if (!(s & kSpecMedia)) return s;
   return kSpecMedia | (kSpecSurfaceAll & ~kSpecGuiding) | (s & kSpecGuiding);
 }

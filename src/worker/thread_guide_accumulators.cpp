@@ -1,9 +1,28 @@
 #include "worker/thread_guide_accumulators.h"
 
+#include <algorithm>
+
+#include "guidecache/neural_training_log.h"
+
 namespace tessera {
 
 const TileSettings& ThreadGuideAccumulators::for_this_thread() {
   const GuideView& g = shared_.path.guide;
+  const bool neural = shared_.neural_log != nullptr && shared_.path.neural.params != nullptr;
+  if (neural) {
+    bool exists = false;
+    Local& local = locals_.local(exists);
+    if (!exists) {
+      local.settings = shared_;
+      // Room for twice the targets a tile keeps on average: a tile that
+      // keeps more drops the rest (counted, and the same on every run).
+      local.targets.resize(2 * size_t(std::max(shared_.path.neural.tile_targets, 1u)) + 64);
+      local.sink.data = local.targets.data();
+      local.sink.capacity = static_cast<uint32_t>(local.targets.size());
+      local.settings.path.neural.sink = &local.sink;
+    }
+    return local.settings;
+  }
   if (g.acc == nullptr || g.acc_words == 0) return shared_;
   bool exists = false;
   Local& local = locals_.local(exists);
@@ -20,8 +39,28 @@ const TileSettings& ThreadGuideAccumulators::for_this_thread() {
   return local.settings;
 }
 
+void ThreadGuideAccumulators::begin_tile(const TileSettings& mine, const TileJob& job) const {
+  NeuralSampleSink* sink = mine.path.neural.sink;
+  if (!sink) return;
+  sink->count = 0;
+  sink->seen = 0;
+  sink->tile = job.index;
+  sink->rejected_nonfinite = sink->rejected_large = sink->dropped = 0;
+  // A path offers about two targets per sample; the tile keeps tile_targets of them on average.
+  const double offered = 2.0 * double(job.x1 - job.x0) * double(job.y1 - job.y0) * double(job.sample_end - job.sample_begin);
+  sink->keep_prob = offered > 0.0 ? static_cast<Float>(std::min(1.0, mine.path.neural.tile_targets / offered)) : 1.f;
+}
+
+void ThreadGuideAccumulators::end_tile(const TileSettings& mine) const {
+  if (mine.path.neural.sink && mine.neural_log) mine.neural_log->add_tile(*mine.path.neural.sink);
+}
+
 void ThreadGuideAccumulators::gather() {
   uint64_t* shared = shared_.path.guide.acc;
+  if (shared == nullptr) {
+    locals_.clear();
+    return;
+  }
   for (const Local& local : locals_)
     for (size_t i = 0; i < local.block.size(); ++i) shared[i] += local.block[i];
   locals_.clear();

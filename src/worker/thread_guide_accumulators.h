@@ -8,6 +8,10 @@
 // and gather() adds the copies into the shared block when the pass is done.
 // Integer sums do not depend on order, so the field learns exactly the same
 // numbers for any thread count, as with the shared block.
+//
+// For the neural guide each thread has a sink for one tile's learning
+// targets instead: begin_tile() empties it, end_tile() hands the tile's
+// targets to the pass's training log (guidecache/neural_training_log.h).
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
@@ -33,10 +37,16 @@ class ThreadGuideAccumulators {
   // pass's tiles are done and before the block is reduced or folded.
   void gather();
 
+  // Around each tile, with the settings for_this_thread() gave.
+  void begin_tile(const TileSettings& mine, const TileJob& job) const;
+  void end_tile(const TileSettings& mine) const;
+
  private:
   struct Local {
     TileSettings settings;
     std::vector<uint64_t> block;
+    std::vector<NeuralTrainingSample> targets;
+    NeuralSampleSink sink;
   };
   TileSettings shared_;
   tbb::enumerable_thread_specific<Local> locals_;

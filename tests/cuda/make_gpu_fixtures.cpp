@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
       opt.force_full_specialisation = true;
       cuda_check::GpuFixture f;
       f.name = name;
-      f.settings = make_tile_settings(opt, effective_specialisation(scene, opt, false), false);
+      f.settings = make_tile_settings(opt, effective_specialisation(scene, opt, nullptr), false);
       f.width = scene.view().camera.film_width;
       f.height = scene.view().camera.film_height;
       f.spp = spp;
@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
         EmbreeBackend embree(scene);
         Film embree_film(f.width, f.height);
         const auto e0 = std::chrono::steady_clock::now();
-        cuda_check::render_film_pass(embree, make_tile_settings(embree_opt, effective_specialisation(scene, embree_opt, false), false),
+        cuda_check::render_film_pass(embree, make_tile_settings(embree_opt, effective_specialisation(scene, embree_opt, nullptr), false),
                                      embree_film, 0, spp, f.host_threads);
         f.embree_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - e0).count();
       }

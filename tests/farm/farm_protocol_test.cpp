@@ -35,6 +35,12 @@ struct FarmScene {
     return std::make_unique<GuideField>(GuideConfig{}, scene.bounds().lo, scene.bounds().hi, scene.view().num_lights,
                                         scene.max_emitted_radiance());
   }
+  std::unique_ptr<NeuralGuide> make_neural() const {
+    NeuralGuideConfig c;
+    c.width = 16;
+    c.steps_per_pass = 4;
+    return std::make_unique<NeuralGuide>(c, scene.bounds().lo, scene.bounds().hi, scene.max_emitted_radiance());
+  }
 };
 
 SceneDesc door_ajar() {
@@ -46,24 +52,26 @@ SceneDesc door_ajar() {
 
 struct FarmRun {
   RenderResult result;
-  std::vector<std::unique_ptr<GuideField>> guides;  // every rank's field at the end
+  std::vector<std::unique_ptr<Guide>> guides;  // every rank's guide at the end
 };
 
 // Rank 0 runs the master (1 rendering thread), ranks 1.. run workers, each
 // with its own backend: backends[r], or Embree where none is named.
 FarmRun render_farm(const FarmScene& fs, int32_t ranks, bool guided, bool sync,
-                    const std::vector<std::string>& backends = {}) {
+                    const std::vector<std::string>& backends = {}, bool neural = false) {
   InProcessHub hub(ranks);
   std::vector<std::unique_ptr<Transport>> ends;
   FarmRun run;
   for (int32_t r = 0; r < ranks; ++r) {
     ends.push_back(hub.endpoint(r));
-    run.guides.push_back(guided ? fs.make_guide() : nullptr);
+    if (!guided) run.guides.push_back(nullptr);
+    else if (neural) run.guides.push_back(fs.make_neural());
+    else run.guides.push_back(fs.make_guide());
   }
   std::vector<std::unique_ptr<TileBackend>> rank_backends;
   for (int32_t r = 0; r < ranks; ++r)
     rank_backends.push_back(make_tile_backend(r < static_cast<int32_t>(backends.size()) ? backends[r] : "embree", fs.scene));
-  const uint32_t spec = effective_specialisation(fs.scene, fs.opt, guided);
+  const uint32_t spec = effective_specialisation(fs.scene, fs.opt, run.guides[0].get());
   std::vector<std::thread> workers;
   for (int32_t r = 1; r < ranks; ++r) {
     workers.emplace_back([&, r] {
@@ -122,7 +130,7 @@ TEST(FarmProtocol, SharedGuideGivesTheLocalImageAndFieldOnEveryRank) {
     FarmRun farm = render_farm(fs, ranks, true, true);
     EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
     expect_same_counters(farm.result.stats.counters, local.stats.counters);
-    for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(*farm.guides[r] == *local_guide) << "rank " << r;
+    for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(farm.guides[r]->same_as(*local_guide)) << "rank " << r;
   }
 }
 
@@ -141,7 +149,7 @@ TEST(FarmProtocol, GuideTrialGivesTheLocalImageAndDecisionForAnyRankCount) {
     EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
     expect_same_counters(farm.result.stats.counters, local.stats.counters);
     EXPECT_EQ(farm.result.stats.guide_trial.state, local.stats.guide_trial.state);
-    for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(*farm.guides[r] == *local_guide) << "rank " << r;
+    for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(farm.guides[r]->same_as(*local_guide)) << "rank " << r;
   }
 }
 
@@ -161,7 +169,7 @@ TEST(FarmProtocol, MixedBackendsAgreeWithTheLocalImage) {
   for (const PixelAccum& p : farm.result.film.pixels)
     for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(p.sum[c]));
   testing::expect_agree(testing::channel_stats(local.film), testing::channel_stats(farm.result.film), "mixed farm");
-  for (int32_t r = 1; r < 3; ++r) EXPECT_TRUE(*farm.guides[r] == *farm.guides[0]) << "rank " << r;
+  for (int32_t r = 1; r < 3; ++r) EXPECT_TRUE(farm.guides[r]->same_as(*farm.guides[0])) << "rank " << r;
 }
 
 TEST(FarmProtocol, GuideSyncOffLetsEachRankLearnAlone) {
@@ -171,14 +179,38 @@ TEST(FarmProtocol, GuideSyncOffLetsEachRankLearnAlone) {
   // Every target reaches every field when shared; alone, a rank's field has
   // only its own tiles' targets.
   uint64_t alone_updates = 0;
+  auto updates = [](const Guide& g) {
+    GuideFieldStats t;
+    NeuralGuideStats n;
+    g.fill_stats(&t, &n);
+    return t.updates;
+  };
   for (const auto& g : alone.guides) {
-    EXPECT_LT(g->stats().updates, shared.guides[0]->stats().updates);
-    alone_updates += g->stats().updates;
+    EXPECT_LT(updates(*g), updates(*shared.guides[0]));
+    alone_updates += updates(*g);
   }
   EXPECT_GT(alone_updates, 0u);
   for (const PixelAccum& p : alone.result.film.pixels)
     for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(p.sum[c]));
   EXPECT_EQ(alone.result.stats.counters.samples, shared.result.stats.counters.samples);
+}
+
+// The network trained data-parallel: every rank computes fixed-point
+// gradients of its own tiles, the sums are all-reduced, and every rank takes
+// the same Adam steps. The farm's image, and every rank's weights and Adam
+// state, equal the local render's bit for bit, for any rank count.
+TEST(FarmProtocol, NeuralGuideGivesTheLocalImageAndWeightsOnEveryRank) {
+  FarmScene fs(door_ajar());
+  auto local_guide = fs.make_neural();
+  RenderResult local = render(fs.scene, fs.embree, fs.opt, local_guide.get());
+  ASSERT_GT(local.stats.counters.path.guided_samples, 0u);
+  ASSERT_GT(local_guide->stats().steps, 0u);
+  for (int32_t ranks : {1, 2, 3}) {
+    FarmRun farm = render_farm(fs, ranks, true, true, {}, true);
+    EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
+    expect_same_counters(farm.result.stats.counters, local.stats.counters);
+    for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(farm.guides[r]->same_as(*local_guide)) << "rank " << r;
+  }
 }
 
 TEST(FarmProtocol, SceneSurvivesTheWire) {

@@ -276,7 +276,7 @@ TEST(DeviceBackend, FarmOfDeviceAndBvhRanksEqualsTheLocalImage) {
     guides.push_back(std::make_unique<GuideField>(make_guide(scene)));
     backends.push_back(std::make_unique<CountingBackend>(make_tile_backend(r == 0 ? "bvh" : "emulated-device", scene, 1)));
   }
-  const uint32_t spec = effective_specialisation(scene, opt, true);
+  const uint32_t spec = effective_specialisation(scene, opt, guides[0].get());
   std::vector<std::thread> workers;
   for (int32_t r = 1; r < ranks; ++r)
     workers.emplace_back([&, r] {
@@ -352,7 +352,7 @@ class CountingTiles : public TileQueue {
 TEST(DeviceBackend, AnswersBetweenTilesWhileTheDeviceRenders) {
   const SceneData scene = shipped("cornell-box");
   const RenderOptions opt = small_options(scene, 4);
-  const TileSettings settings = make_tile_settings(opt, effective_specialisation(scene, opt, false), false);
+  const TileSettings settings = make_tile_settings(opt, effective_specialisation(scene, opt, nullptr), false);
   std::vector<TileJob> jobs;
   for (int32_t y = 0; y < 24; y += 8)
     for (int32_t x = 0; x < 32; x += 8) jobs.push_back(TileJob{x, y, x + 8, y + 8, 0, 4, static_cast<uint32_t>(jobs.size())});

@@ -208,7 +208,7 @@ TEST(ErrorEstimate, MatchesMeasuredRelMseOnFurnace) {
     SceneData scene(std::move(desc));
     EmbreeBackend embree(scene);
     RenderResult r = render(scene, embree, opt, nullptr, nullptr,
-                            [&](const RenderResult& so_far, const GuideField*) {
+                            [&](const RenderResult& so_far, const Guide*) {
                               const uint32_t spp = so_far.stats.spp;
                               if (spp != 16 && spp != 64 && spp != 256) return;
                               const ErrorEstimate est = estimate_rel_mse(so_far.film);

@@ -21,7 +21,10 @@ struct GuidedScene {
   GuideField make_guide(const GuideConfig& cfg = {}) const {
     return GuideField(cfg, scene.bounds().lo, scene.bounds().hi, scene.view().num_lights, scene.max_emitted_radiance());
   }
-  RenderResult run(GuideField* guide, RenderOptions opt = {}) const {
+  std::unique_ptr<NeuralGuide> make_neural(const NeuralGuideConfig& cfg = {}) const {
+    return std::make_unique<NeuralGuide>(cfg, scene.bounds().lo, scene.bounds().hi, scene.max_emitted_radiance());
+  }
+  RenderResult run(Guide* guide, RenderOptions opt = {}) const {
     opt.progress = false;
     opt.spp = static_cast<uint32_t>(scene.desc().spp);
     opt.max_depth = scene.desc().max_depth;

@@ -154,7 +154,8 @@ Shape "sphere" "float radius" [ 1 ]
                                  "<greedy>", "."));
   GuideField guide = s.make_guide();
   s.run(&guide);
-  const GuideView g = guide.view();
+  const GuideView view = guide.view();
+  TablePathGuide g{view};
   const EmbreeTracer tracer = s.embree.tracer();
   const SceneView& v = s.scene.view();
   for (int32_t depth : {0, 1, 3})

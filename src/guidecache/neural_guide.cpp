@@ -1,0 +1,355 @@
+#include "guidecache/neural_guide.h"
+
+#include <Eigen/Dense>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "guidecache/guide_field.h"
+#include "kernels/effects.h"
+
+namespace tessera {
+
+namespace {
+
+// Fixed point of gradient sums (per tile): 2^-32 resolution; a word beyond
+// kGradLimit saturates there (counted).
+constexpr double kGradScale = 4294967296.0;
+constexpr double kGradLimit = 4503599627370496.0;  // 2^52
+constexpr double kLossScale = 1048576.0;
+constexpr double kLossLimit = 1e6;                 // per target, for the loss statistic only
+constexpr float kLossEps = 1e-3f;                  // relative L2's denominator floor (in units of the output scale)
+constexpr float kGradClip = 10.f;                  // |dL/d output| per target
+constexpr double kAdamBeta1 = 0.9, kAdamBeta2 = 0.99, kAdamEps = 1e-10;
+// Target statistics of round 0: fixed point with unit radiance_scale * 2^-20.
+constexpr double kTargetUnit = 1.0 / 1048576.0;
+
+uint64_t splitmix(uint64_t* state) {
+  uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+float uniform_pm(uint64_t* state, float a) {  // uniform in [-a, a)
+  return a * (2.f * static_cast<float>(splitmix(state) >> 40) * (1.f / 16777216.f) - 1.f);
+}
+
+uint64_t to_word(int64_t v) { return static_cast<uint64_t>(v); }
+int64_t from_word(uint64_t w) { return static_cast<int64_t>(w); }
+
+}  // namespace
+
+NeuralGuide::NeuralGuide(const NeuralGuideConfig& config, const Vec3& lo, const Vec3& hi, Float radiance_scale)
+    : config_(config) {
+  if (config_.width < 1 || config_.width > kNeuralMaxWidth)
+    throw std::runtime_error("neural guide: width must be 1.." + std::to_string(kNeuralMaxWidth));
+  if (config_.steps_per_pass < 1) throw std::runtime_error("neural guide: at least one step per pass");
+  const Vec3 d = hi - lo;
+  extent_ = std::max({d.x, d.y, d.z, 1e-6f}) * 1.001f;
+  lo_ = lo - Vec3(extent_ * 0.0005f);
+  radiance_scale_ = radiance_scale > 0.f && std::isfinite(radiance_scale) ? radiance_scale : 1.f;
+  max_target_ = 1048576.f * radiance_scale_;
+  init_params();
+}
+
+void NeuralGuide::init_params() {
+  const NeuralLayout L{config_.width};
+  params_.assign(L.size(), 0.f);
+  adam_m_.assign(L.size(), 0.f);
+  adam_v_.assign(L.size(), 0.f);
+  uint64_t state = config_.seed;
+  // Hash-grid features start near zero (instant-ngp); layers He-uniform for
+  // ReLU, the output layer smaller, biases zero: outputs start near the scale.
+  for (uint32_t i = L.grid(); i < L.w1(); ++i) params_[i] = uniform_pm(&state, 1e-4f);
+  auto fill = [&](uint32_t from, uint32_t count, float a) {
+    for (uint32_t i = 0; i < count; ++i) params_[from + i] = uniform_pm(&state, a);
+  };
+  const float w = static_cast<float>(config_.width);
+  fill(L.w1(), kNeuralInputs * config_.width, std::sqrt(6.f / kNeuralInputs));
+  fill(L.w2(), config_.width * config_.width, std::sqrt(6.f / w));
+  fill(L.w3(), config_.width * kNeuralBins, 0.1f * std::sqrt(6.f / w));
+  build_bin_dirs();
+}
+
+void NeuralGuide::build_bin_dirs() {
+  bin_dirs_.resize(kNeuralBins);
+  for (uint32_t b = 0; b < kNeuralBins; ++b) {
+    const Vec2 sq((static_cast<Float>(b % kNeuralGrid) + 0.5f) / kNeuralGrid,
+                  (static_cast<Float>(b / kNeuralGrid) + 0.5f) / kNeuralGrid);
+    bin_dirs_[b] = glm::normalize(equal_area_square_to_sphere(sq));
+  }
+  bin_dir_soa_.resize(3 * kNeuralBins);
+  for (uint32_t b = 0; b < kNeuralBins; ++b)
+    for (uint32_t k = 0; k < 3; ++k) bin_dir_soa_[k * kNeuralBins + b] = bin_dirs_[b][k];
+}
+
+uint32_t NeuralGuide::spec_bits() const { return kSpecGuiding | kSpecNeural; }
+
+NeuralGuideView NeuralGuide::view() const {
+  NeuralGuideView v;
+  v.params = params_.data();
+  v.width = config_.width;
+  v.lo = lo_;
+  v.extent = extent_;
+  v.scale = scale_ > 0.f ? scale_ : radiance_scale_;
+  v.guide_prob = config_.guide_prob;
+  v.floor = config_.floor;
+  v.trained = steps_ > 0;
+  v.max_target = max_target_;
+  v.bin_dirs = bin_dirs_.data();
+  v.bin_dir_soa = bin_dir_soa_.data();
+  v.tile_targets = config_.tile_targets;
+  return v;
+}
+
+void NeuralGuide::views(GuideView* table, NeuralGuideView* neural) {
+  *table = GuideView{};
+  *neural = view();
+}
+
+uint32_t NeuralGuide::rounds() const { return 1 + (pass_targets_ > 0 ? config_.steps_per_pass : 0u); }
+
+double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& samples, uint32_t first, uint32_t stride,
+                                  std::vector<float>* grad, uint64_t* count) const {
+  using Mat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
+  using Vec = Eigen::Matrix<float, Eigen::Dynamic, 1>;
+  const NeuralLayout L{config_.width};
+  const Eigen::Index W = config_.width;
+  const size_t n = samples.size();
+  const Eigen::Index B = n > first ? static_cast<Eigen::Index>((n - first + stride - 1) / stride) : 0;
+  *count = static_cast<uint64_t>(B);
+  if (B == 0) return 0.0;
+  const NeuralGuideView v = view();
+  const float scale = v.scale;
+  Mat X(kNeuralInputs, B);
+  for (Eigen::Index b = 0; b < B; ++b) {
+    const NeuralTrainingSample& s = samples[first + static_cast<size_t>(b) * stride];
+    neural_encode(v, Vec3(s.p[0], s.p[1], s.p[2]), Vec3(s.n[0], s.n[1], s.n[2]), X.col(b).data());
+  }
+  const float* P = params_.data();
+  Eigen::Map<const Mat> W1(P + L.w1(), W, kNeuralInputs), W2(P + L.w2(), W, W), W3(P + L.w3(), kNeuralBins, W);
+  Eigen::Map<const Vec> b1(P + L.b1(), W), b2(P + L.b2(), W), b3(P + L.b3(), kNeuralBins);
+  const Mat H1 = ((W1 * X).colwise() + b1).cwiseMax(0.f);
+  const Mat H2 = ((W2 * H1).colwise() + b2).cwiseMax(0.f);
+
+  float* G = grad->data();
+  Eigen::Map<Mat> gW1(G + L.w1(), W, kNeuralInputs), gW2(G + L.w2(), W, W), gW3(G + L.w3(), kNeuralBins, W);
+  Eigen::Map<Vec> gb1(G + L.b1(), W), gb2(G + L.b2(), W), gb3(G + L.b3(), kNeuralBins);
+  Mat dH2(W, B);
+  double loss = 0.0;
+  for (Eigen::Index b = 0; b < B; ++b) {
+    const NeuralTrainingSample& s = samples[first + static_cast<size_t>(b) * stride];
+    const uint32_t bin = s.bin < kNeuralBins ? s.bin : 0u;
+    const float o = W3.row(bin).dot(H2.col(b)) + b3[bin];
+    const float q = neural_exp(o);
+    const float t = s.target / scale;
+    const float denom = q * q + kLossEps;
+    loss += std::min(static_cast<double>((q - t) * (q - t) / denom), kLossLimit);
+    const float go = std::clamp(2.f * (q - t) * q / denom, -kGradClip, kGradClip);
+    gW3.row(bin) += go * H2.col(b).transpose();
+    gb3[bin] += go;
+    dH2.col(b) = (W3.row(bin).transpose() * go).cwiseProduct((H2.col(b).array() > 0.f).cast<float>().matrix());
+  }
+  gW2.noalias() += dH2 * H1.transpose();
+  gb2 += dH2.rowwise().sum();
+  const Mat dH1 = (W2.transpose() * dH2).cwiseProduct((H1.array() > 0.f).cast<float>().matrix());
+  gW1.noalias() += dH1 * X.transpose();
+  gb1 += dH1.rowwise().sum();
+  const Mat dX = W1.transpose() * dH1;
+  for (Eigen::Index b = 0; b < B; ++b) {
+    const NeuralTrainingSample& s = samples[first + static_cast<size_t>(b) * stride];
+    const Vec3 u = neural_unit_position(v, Vec3(s.p[0], s.p[1], s.p[2]));
+    for (uint32_t l = 0; l < kNeuralLevels; ++l) {
+      uint32_t entry[8];
+      Float weight[8];
+      neural_level_corners(l, u, entry, weight);
+      float* table = G + L.grid() + static_cast<size_t>(l) * kNeuralTableSize * kNeuralFeatures;
+      for (uint32_t c = 0; c < 8; ++c)
+        for (uint32_t f = 0; f < kNeuralFeatures; ++f)
+          table[entry[c] * kNeuralFeatures + f] += weight[c] * dX(l * kNeuralFeatures + f, b);
+    }
+  }
+  return loss;
+}
+
+double NeuralGuide::loss_and_gradient(const std::vector<NeuralTrainingSample>& samples, std::vector<float>* grad) const {
+  grad->assign(params_.size(), 0.f);
+  uint64_t count = 0;
+  const double loss = tile_gradient(samples, 0, 1, grad, &count);
+  if (count == 0) return 0.0;
+  for (float& g : *grad) g /= static_cast<float>(count);
+  return loss / static_cast<double>(count);
+}
+
+std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (round == 0) {
+    pass_tiles_ = log_.take(&pass_counts_);
+    pass_targets_ = 0;
+    pass_loss_sum_ = 0.0;
+    pass_loss_count_ = 0;
+    uint64_t count = 0, sum = 0;
+    for (const NeuralTileTargets& t : pass_tiles_) {
+      count += t.samples.size();
+      for (const NeuralTrainingSample& s : t.samples)
+        sum += static_cast<uint64_t>(static_cast<double>(s.target) / radiance_scale_ / kTargetUnit + 0.5);
+    }
+    acc_ = {count, sum, pass_counts_.rejected_nonfinite, pass_counts_.rejected_large, pass_counts_.dropped};
+    return acc_;
+  }
+  // One minibatch: every steps_per_pass-th target of each tile, from round - 1.
+  const size_t P = params_.size();
+  const uint32_t first = round - 1, stride = config_.steps_per_pass;
+  struct Local {
+    std::vector<int64_t> sum;
+    std::vector<float> grad;
+    uint64_t loss = 0, count = 0, clamped = 0;
+  };
+  tbb::enumerable_thread_specific<Local> locals;
+  tbb::parallel_for(size_t(0), pass_tiles_.size(), [&](size_t i) {
+    Local& local = locals.local();
+    if (local.sum.empty()) local.sum.assign(P, 0);
+    local.grad.assign(P, 0.f);
+    uint64_t count = 0;
+    const double loss = tile_gradient(pass_tiles_[i].samples, first, stride, &local.grad, &count);
+    if (count == 0) return;
+    for (size_t k = 0; k < P; ++k) {
+      double g = static_cast<double>(local.grad[k]) * kGradScale;
+      if (!(std::fabs(g) <= kGradLimit)) {  // NaN counts too, and saturates at 0's sign
+        ++local.clamped;
+        g = g > 0.0 ? kGradLimit : (g < 0.0 ? -kGradLimit : 0.0);
+      }
+      local.sum[k] += static_cast<int64_t>(std::llround(g));
+    }
+    local.loss += static_cast<uint64_t>(std::llround(loss * kLossScale));
+    local.count += count;
+  });
+  acc_.assign(P + 3, 0);
+  for (const Local& local : locals) {
+    if (local.sum.empty()) continue;
+    for (size_t k = 0; k < P; ++k) acc_[k] += to_word(local.sum[k]);
+    acc_[P] += local.loss;
+    acc_[P + 1] += local.count;
+    acc_[P + 2] += local.clamped;
+  }
+  totals_.train_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return acc_;
+}
+
+void NeuralGuide::adam_step(const std::vector<double>& grad) {
+  ++steps_;
+  const double lr = config_.learning_rate;
+  const double c1 = 1.0 - std::pow(kAdamBeta1, static_cast<double>(steps_));
+  const double c2 = 1.0 - std::pow(kAdamBeta2, static_cast<double>(steps_));
+  for (size_t k = 0; k < params_.size(); ++k) {
+    const double m = kAdamBeta1 * adam_m_[k] + (1.0 - kAdamBeta1) * grad[k];
+    const double v = kAdamBeta2 * adam_v_[k] + (1.0 - kAdamBeta2) * grad[k] * grad[k];
+    adam_m_[k] = static_cast<float>(m);
+    adam_v_[k] = static_cast<float>(v);
+    params_[k] = static_cast<float>(params_[k] - lr * (m / c1) / (std::sqrt(v / c2) + kAdamEps));
+  }
+}
+
+void NeuralGuide::fold_round(uint32_t round) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (round == 0) {
+    pass_targets_ = acc_[0];
+    totals_.targets += acc_[0];
+    totals_.rejected_nonfinite += acc_[2];
+    totals_.rejected_large += acc_[3];
+    totals_.dropped += acc_[4];
+    // The first targets set the output scale: their mean radiance (a
+    // network that starts near 0 then predicts it, and learns in relative terms).
+    if (!(scale_ > 0.f) && acc_[0] > 0) {
+      const double mean = static_cast<double>(acc_[1]) * kTargetUnit * radiance_scale_ / static_cast<double>(acc_[0]);
+      scale_ = static_cast<Float>(std::max(mean, 1e-6 * radiance_scale_));
+    }
+    // This process's cost of one inference, for the stats.
+    if (!pass_tiles_.empty() && !pass_tiles_.front().samples.empty()) {
+      const NeuralGuideView v = view();
+      const std::vector<NeuralTrainingSample>& s = pass_tiles_.front().samples;
+      const size_t n = std::min<size_t>(s.size(), 256);
+      NeuralSite site;
+      Float sink = 0.f;
+      const auto i0 = std::chrono::steady_clock::now();
+      for (size_t i = 0; i < n; ++i) {
+        neural_infer(v, Vec3(s[i].p[0], s[i].p[1], s[i].p[2]), Vec3(s[i].n[0], s[i].n[1], s[i].n[2]), &site);
+        sink += site.irradiance;
+      }
+      const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - i0).count();
+      if (sink >= 0.f || sink < 0.f) totals_.inference_seconds = dt / static_cast<double>(n);
+    }
+    if (pass_targets_ == 0) pass_tiles_.clear();
+    return;
+  }
+  const size_t P = params_.size();
+  const uint64_t count = acc_[P + 1];
+  totals_.gradient_clamped += acc_[P + 2];
+  if (count > 0) {
+    std::vector<double> grad(P);
+    bool finite = true;
+    for (size_t k = 0; k < P; ++k) {
+      grad[k] = static_cast<double>(from_word(acc_[k])) / kGradScale / static_cast<double>(count);
+      finite = finite && std::isfinite(grad[k]);
+    }
+    if (finite) adam_step(grad);
+    else ++totals_.nonfinite_gradients;
+    pass_loss_sum_ += static_cast<double>(acc_[P]) / kLossScale;
+    pass_loss_count_ += count;
+  }
+  if (round == config_.steps_per_pass) {
+    pass_tiles_.clear();
+    if (pass_loss_count_ > 0) {
+      totals_.loss = pass_loss_sum_ / static_cast<double>(pass_loss_count_);
+      totals_.pass_loss.push_back(totals_.loss);
+    }
+  }
+  totals_.train_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void NeuralGuide::train_on(std::vector<NeuralTileTargets> tiles) {
+  for (NeuralTileTargets& t : tiles) {
+    NeuralSampleSink sink;
+    sink.tile = t.tile;
+    sink.data = t.samples.data();
+    sink.count = static_cast<uint32_t>(t.samples.size());
+    log_.add_tile(sink);
+  }
+  for (uint32_t r = 0; r < rounds(); ++r) {
+    round_accumulators(r);
+    fold_round(r);
+  }
+}
+
+NeuralGuideStats NeuralGuide::stats() const {
+  NeuralGuideStats s = totals_;
+  s.params = params_.size();
+  s.bytes = 3 * params_.size() * sizeof(float);
+  s.steps = steps_;
+  return s;
+}
+
+void NeuralGuide::fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const {
+  *table = GuideFieldStats{};
+  table->bytes = 3 * params_.size() * sizeof(float);
+  table->updates = totals_.targets;
+  table->rejected_nonfinite = totals_.rejected_nonfinite;
+  table->rejected_large = totals_.rejected_large;
+  *neural = stats();
+}
+
+bool NeuralGuide::operator==(const NeuralGuide& o) const {
+  return config_ == o.config_ && lo_ == o.lo_ && extent_ == o.extent_ && radiance_scale_ == o.radiance_scale_ &&
+         scale_ == o.scale_ && params_ == o.params_ && adam_m_ == o.adam_m_ && adam_v_ == o.adam_v_ &&
+         steps_ == o.steps_;
+}
+
+bool NeuralGuide::same_as(const Guide& other) const {
+  const NeuralGuide* o = dynamic_cast<const NeuralGuide*>(&other);
+  return o && *this == *o;
+}
+
+}  // namespace tessera

@@ -1,0 +1,132 @@
+// The neural guide (host side): owns the network's parameters and Adam's
+// moments, collects a pass's learning targets, and trains between passes.
+//
+// What it learns is what the Q-table learns: per direction bin, the radiance
+// arriving at a point (expected-SARSA targets, computed by the integrator
+// from the network frozen during the pass: the target network). The loss is
+// relative L2, (Q - T)^2 / (Q^2 + eps) with Q held constant in the
+// denominator (Müller et al. 2021), whose minimiser is the mean target, as
+// the table's running mean; its gradient is clipped, which bounds what a
+// firefly target moves.
+//
+// Data-parallel and deterministic: after a pass, round 0 sums target
+// statistics (the first one sets the output scale); each of the next
+// `steps_per_pass` rounds sums the gradient of one minibatch (every
+// steps_per_pass-th target of each tile), computed tile by tile and
+// quantised to 64-bit fixed point per tile, so that the sum is the same
+// whichever rank (or thread) rendered which tile. Every rank then applies
+// the same Adam step to the same sums: weights stay equal everywhere, and a
+// farm's image equals a single process's bit for bit.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <vector>
+
+#include "guidecache/guide.h"
+#include "guidecache/neural_training_log.h"
+
+namespace tessera {
+
+struct NeuralGuideConfig {
+  uint32_t width = 32;               // neurons per hidden layer (two layers), at most kNeuralMaxWidth
+  uint32_t steps_per_pass = 16;      // Adam steps (gradient all-reductions) after each learning pass
+  Float learning_rate = 5e-3f;
+  Float guide_prob = 0.5f;           // mixture weight of guided sampling once trained
+  Float floor = 0.02f;               // uniform share of each distribution (as the table's)
+  uint32_t tile_targets = 1024;      // learning targets kept per tile on average (the rest are skipped)
+  uint64_t seed = 1;                 // weight initialisation
+  bool operator==(const NeuralGuideConfig&) const = default;
+};
+
+struct NeuralGuideStats {
+  uint64_t params = 0;
+  uint64_t bytes = 0;                // parameters and Adam's two moments
+  uint64_t steps = 0;                // optimiser steps taken
+  uint64_t targets = 0;              // learning targets trained on (all passes, all ranks)
+  uint64_t rejected_nonfinite = 0;   // NaN/Inf/negative targets
+  uint64_t rejected_large = 0;       // targets beyond max_target
+  uint64_t dropped = 0;              // kept targets beyond a tile's buffer
+  uint64_t gradient_clamped = 0;     // fixed-point gradient words saturated (per tile)
+  uint64_t nonfinite_gradients = 0;  // minibatch gradients with NaN/Inf (the step was skipped)
+  double loss = 0.0;                 // mean loss of the last pass's minibatches
+  std::vector<double> pass_loss;     // the same, per learning pass
+  double train_seconds = 0.0;        // this process: gradients and steps
+  double inference_seconds = 0.0;    // one inference, as last measured on this process
+};
+
+class NeuralGuide final : public Guide {
+ public:
+  NeuralGuide() = default;
+  NeuralGuide(const NeuralGuide&) = delete;  // it owns the pass's training log
+  NeuralGuide& operator=(const NeuralGuide&) = delete;
+  // bounds_lo/hi: the scene's bounds (the encoded cube); radiance_scale: the
+  // brightest emitted radiance (sets which targets are rejected as too large).
+  NeuralGuide(const NeuralGuideConfig& config, const Vec3& bounds_lo, const Vec3& bounds_hi, Float radiance_scale);
+
+  std::string mode() const override { return "neural"; }
+  uint32_t spec_bits() const override;
+  void views(GuideView* table, NeuralGuideView* neural) override;
+  NeuralTrainingLog* training_log() override { return &log_; }
+  uint32_t rounds() const override;
+  std::vector<uint64_t>& round_accumulators(uint32_t round) override;
+  void fold_round(uint32_t round) override;
+  void set_guide_prob(Float p) override { config_.guide_prob = p; }
+  void save(std::ostream& out, uint64_t scene_fingerprint) const override;
+  void fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const override;
+  bool same_as(const Guide& other) const override;
+
+  static std::unique_ptr<NeuralGuide> load(std::istream& in, uint64_t scene_fingerprint);
+
+  const NeuralGuideConfig& config() const { return config_; }
+  const std::vector<float>& params() const { return params_; }
+  NeuralGuideView view() const;
+  NeuralGuideStats stats() const;
+  bool operator==(const NeuralGuide& o) const;
+
+  // Training on given targets, for tests and the library's own use: the
+  // same rounds a pass runs, on one process.
+  void train_on(std::vector<NeuralTileTargets> tiles);
+  // Loss (mean over the targets) and its gradient (sums over the targets,
+  // then divided by their count) for one tile's targets: what a round
+  // computes, exposed for the gradient check.
+  double loss_and_gradient(const std::vector<NeuralTrainingSample>& samples, std::vector<float>* grad) const;
+  std::vector<float>& mutable_params() { return params_; }
+  Float output_scale() const { return scale_; }
+  void set_output_scale(Float s) { scale_ = s; }
+
+  template <class Archive>
+  void serialize(Archive& ar);
+
+ private:
+  void init_params();
+  void build_bin_dirs();
+  // Adds the loss gradient of the given targets of one tile (every
+  // `stride`-th from `first`) to grad; returns the loss sum.
+  double tile_gradient(const std::vector<NeuralTrainingSample>& samples, uint32_t first, uint32_t stride,
+                       std::vector<float>* grad, uint64_t* count) const;
+  void adam_step(const std::vector<double>& grad);
+
+  NeuralGuideConfig config_;
+  Vec3 lo_{0.f};
+  Float extent_ = 1.f;
+  Float radiance_scale_ = 1.f;
+  Float max_target_ = 1.f;
+  Float scale_ = 0.f;                 // output scale: 0 until the first targets set it
+  std::vector<float> params_, adam_m_, adam_v_;
+  uint64_t steps_ = 0;
+  NeuralGuideStats totals_;
+
+  // Derived and per pass (not serialised).
+  std::vector<Vec3> bin_dirs_;
+  std::vector<Float> bin_dir_soa_;
+  NeuralTrainingLog log_;
+  std::vector<NeuralTileTargets> pass_tiles_;
+  NeuralLogCounts pass_counts_;
+  uint64_t pass_targets_ = 0;         // summed over ranks (round 0)
+  double pass_loss_sum_ = 0.0;
+  uint64_t pass_loss_count_ = 0;
+  std::vector<uint64_t> acc_;
+};
+
+}  // namespace tessera

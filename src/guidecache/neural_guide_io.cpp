@@ -1,0 +1,85 @@
+// Serialisation of the neural guide with cereal (portable binary), and the
+// one loader for either kind of guide (told by the file's magic).
+#include <cereal/archives/portable_binary.hpp>
+#include <cereal/types/vector.hpp>
+#include <cstring>
+#include <istream>
+#include <new>
+#include <ostream>
+#include <stdexcept>
+#include <string>
+
+#include "guidecache/guide_field.h"
+#include "guidecache/neural_guide.h"
+
+namespace tessera {
+
+template <class Archive>
+void serialize(Archive& ar, NeuralGuideConfig& c) {
+  ar(c.width, c.steps_per_pass, c.learning_rate, c.guide_prob, c.floor, c.tile_targets, c.seed);
+}
+
+template <class Archive>
+void NeuralGuide::serialize(Archive& ar) {
+  ar(config_, lo_.x, lo_.y, lo_.z, extent_, radiance_scale_, max_target_, scale_, params_, adam_m_, adam_v_, steps_);
+  ar(totals_.targets, totals_.rejected_nonfinite, totals_.rejected_large, totals_.dropped, totals_.gradient_clamped,
+     totals_.nonfinite_gradients, totals_.loss, totals_.pass_loss);
+}
+
+namespace {
+constexpr char kNeuralMagic[] = "tessera-neural-guide";
+constexpr char kTableMagic[] = "tessera-guide-cache";
+constexpr uint32_t kNeuralVersion = 1;
+}  // namespace
+
+void NeuralGuide::save(std::ostream& out, uint64_t scene_fingerprint) const {
+  out.write(kNeuralMagic, sizeof kNeuralMagic);
+  cereal::PortableBinaryOutputArchive ar(out);
+  ar(kNeuralVersion, scene_fingerprint);
+  const_cast<NeuralGuide*>(this)->serialize(ar);
+  if (!out) throw std::runtime_error("write failed");
+}
+
+std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_fingerprint) {
+  auto g = std::make_unique<NeuralGuide>();
+  char magic[sizeof kNeuralMagic] = {};
+  if (!in.read(magic, sizeof magic) || std::memcmp(magic, kNeuralMagic, sizeof kNeuralMagic) != 0)
+    throw std::runtime_error("not a Tessera neural guide");
+  try {
+    cereal::PortableBinaryInputArchive ar(in);
+    uint32_t version = 0;
+    uint64_t fingerprint = 0;
+    ar(version, fingerprint);
+    if (version != kNeuralVersion)
+      throw std::runtime_error("neural guide version " + std::to_string(version) + ", this build reads version " +
+                               std::to_string(kNeuralVersion));
+    if (fingerprint != scene_fingerprint) throw std::runtime_error("neural guide was learned on another scene");
+    g->serialize(ar);
+  } catch (const cereal::Exception& e) {
+    throw std::runtime_error(std::string("corrupt or truncated neural guide (") + e.what() + ")");
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error("corrupt neural guide (absurd array sizes)");
+  } catch (const std::length_error&) {
+    throw std::runtime_error("corrupt neural guide (absurd array sizes)");
+  }
+  const NeuralLayout L{g->config_.width};
+  const bool ok = g->config_.width >= 1 && g->config_.width <= kNeuralMaxWidth && g->config_.steps_per_pass >= 1 &&
+                  g->params_.size() == L.size() && g->adam_m_.size() == L.size() && g->adam_v_.size() == L.size() &&
+                  g->extent_ > 0.f && std::isfinite(g->extent_) && std::isfinite(g->scale_);
+  if (!ok) throw std::runtime_error("corrupt neural guide (inconsistent sizes)");
+  g->build_bin_dirs();
+  return g;
+}
+
+std::unique_ptr<Guide> load_guide(std::istream& in, uint64_t scene_fingerprint) {
+  char magic[sizeof kNeuralMagic] = {};
+  const std::streampos start = in.tellg();
+  in.read(magic, sizeof magic);
+  in.clear();
+  in.seekg(start);
+  if (std::memcmp(magic, kNeuralMagic, sizeof kNeuralMagic) == 0) return NeuralGuide::load(in, scene_fingerprint);
+  if (std::memcmp(magic, kTableMagic, sizeof kTableMagic) != 0) throw std::runtime_error("not a Tessera guide cache or neural guide");
+  return std::make_unique<GuideField>(GuideField::load(in, scene_fingerprint));
+}
+
+}  // namespace tessera

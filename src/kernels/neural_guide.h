@@ -1,0 +1,330 @@
+// Read side of the neural guide, shared by CPU and device code: a small MLP
+// over a multi-resolution hash-grid encoding of position (Müller et al.
+// 2022) plus the surface normal, whose 144 outputs are the log incident
+// radiance of the same equal-area direction bins as the Q-table's
+// (guide_view.h). One inference per path vertex fills a NeuralSite: the
+// bins' radiance Q, the guided distribution (Q x max(cos, 0) about the
+// vertex's normal, mixed with a uniform floor), its cdf, the irradiance and
+// the largest Q: everything the integrator reads from a Q-table cell, so
+// sampling, the mixture, the floor, the expected-SARSA targets and guided
+// roulette carry over unchanged.
+//
+// Plain loops over float arrays, no host types: the same code runs on a GPU.
+// Weights are frozen during a pass (the host trains between passes,
+// guidecache/neural_guide.h); learning targets go to a per-thread sink.
+#pragma once
+
+#include <cstring>
+
+#include "kernels/equal_area.h"
+#include "kernels/vecmath.h"
+
+namespace tessera {
+
+constexpr uint32_t kNeuralGrid = 12;                       // bins per side, as the table's default
+constexpr uint32_t kNeuralBins = kNeuralGrid * kNeuralGrid;  // 144
+constexpr uint32_t kNeuralLevels = 8;                      // hash-grid levels
+constexpr uint32_t kNeuralFeatures = 2;                    // features per level
+constexpr uint32_t kNeuralTableSize = 1u << 11;            // entries per level
+constexpr uint32_t kNeuralEncoded = kNeuralLevels * kNeuralFeatures;
+constexpr uint32_t kNeuralInputs = kNeuralEncoded + 3;     // encoding, then the normal
+constexpr uint32_t kNeuralMaxWidth = 64;
+// Network outputs are clamped here before exp(): a prediction never
+// overflows, and a bin is never exactly zero.
+constexpr Float kNeuralMinLog = -30.f, kNeuralMaxLog = 20.f;
+
+// Offsets of the parameter blocks in one flat float array. Weight matrices
+// are stored input-major (w[i * out + o]), so that a layer is a sum of
+// scaled columns: contiguous, independent lanes that compilers vectorise
+// without reassociating sums.
+struct NeuralLayout {
+  uint32_t width = 32;
+  TESSERA_HOST_DEVICE uint32_t grid() const { return 0; }
+  TESSERA_HOST_DEVICE uint32_t w1() const { return kNeuralLevels * kNeuralTableSize * kNeuralFeatures; }
+  TESSERA_HOST_DEVICE uint32_t b1() const { return w1() + kNeuralInputs * width; }
+  TESSERA_HOST_DEVICE uint32_t w2() const { return b1() + width; }
+  TESSERA_HOST_DEVICE uint32_t b2() const { return w2() + width * width; }
+  TESSERA_HOST_DEVICE uint32_t w3() const { return b2() + width; }
+  TESSERA_HOST_DEVICE uint32_t b3() const { return w3() + width * kNeuralBins; }
+  TESSERA_HOST_DEVICE uint32_t size() const { return b3() + kNeuralBins; }
+};
+
+// One learning target, as the integrator records it: the point and normal
+// of the vertex, the bin of the direction it took, and the target (radiance
+// arriving along it, in the scene's units).
+struct NeuralTrainingSample {
+  float p[3];
+  float n[3];
+  uint32_t bin;
+  float target;
+};
+
+// Where a thread's learning targets go while it renders one tile. A target
+// is kept with probability keep_prob, decided by a hash of (tile, its
+// number in the tile): deterministic, whichever thread or rank renders the
+// tile. Beyond `capacity` kept targets the rest of the tile's are dropped
+// (counted): also deterministic.
+struct NeuralSampleSink {
+  NeuralTrainingSample* data = nullptr;
+  uint32_t capacity = 0;
+  uint32_t count = 0;
+  uint32_t tile = 0;
+  uint32_t seen = 0;            // targets offered in this tile (accepted by the checks below)
+  Float keep_prob = 1.f;
+  uint64_t rejected_nonfinite = 0;  // NaN, Inf or negative targets
+  uint64_t rejected_large = 0;      // targets beyond max_target
+  uint64_t dropped = 0;             // kept targets beyond capacity
+};
+
+struct NeuralGuideView {
+  const float* params = nullptr;  // NeuralLayout(width) blocks
+  uint32_t width = 32;
+  Vec3 lo{0.f};                   // the encoded cube: [lo, lo + extent]^3 (the scene's bounds)
+  Float extent = 1.f;
+  Float scale = 1.f;              // Q = scale * exp(output)
+  Float guide_prob = 0.5f;        // mixture weight of guided sampling once the network has trained
+  Float floor = 0.02f;            // share of each distribution spread uniformly
+  bool trained = false;           // no optimiser step yet: nothing to guide with
+  Float max_target = 3.4e38f;     // larger targets are rejected (and counted), never clamped
+  const Vec3* bin_dirs = nullptr;  // kNeuralBins centre directions (as GuideView::bin_dirs)
+  const Float* bin_dir_soa = nullptr;  // the same, as x[kNeuralBins], y[...], z[...] (a loop over bins vectorises)
+  uint32_t tile_targets = 1024;   // learning targets a tile keeps on average (NeuralSampleSink::keep_prob)
+  NeuralSampleSink* sink = nullptr;  // the calling thread's (null: targets are not recorded)
+};
+
+// The network's answer at one vertex.
+struct NeuralSite {
+  Vec3 p{0.f}, n{0.f, 0.f, 1.f};
+  Float q[kNeuralBins];      // incident radiance per bin
+  Float pmf[kNeuralBins];    // guided distribution per bin (floor included)
+  Float cdf[kNeuralBins];    // inclusive running sum of pmf, cdf[last] = 1: built by the first sample
+  bool has_cdf = false;
+  Float irradiance = 0.f;    // sum over bins of Q max(cos, 0) dOmega about n
+  Float qmax = 0.f;          // largest Q over bins above the surface
+};
+
+// e^x for the network's outputs, clamped to [kNeuralMinLog, kNeuralMaxLog]:
+// x = n ln2 + f with |f| <= ln2 / 2, e^f by its Taylor series to degree 6
+// (relative error below 1e-6 over the range), 2^n from the exponent bits.
+// A loop over bins of it vectorises, which libm's expf does not (it was
+// most of an inference), and it is the same function on every machine.
+TESSERA_HOST_DEVICE inline Float neural_exp(Float x) {
+  x = x > kNeuralMinLog ? x : kNeuralMinLog;  // selects, not branches (NaN -> the minimum)
+  x = x < kNeuralMaxLog ? x : kNeuralMaxLog;
+  // round(log2(e) x): truncation of a positive number (offset by 128) is its floor.
+  const int32_t n = static_cast<int32_t>(x * 1.44269504f + 128.5f) - 128;
+  const Float f = x - static_cast<Float>(n) * 0.693147181f;
+  const Float p =
+      1.f + f * (1.f + f * (0.5f + f * (1.f / 6.f + f * (1.f / 24.f + f * (1.f / 120.f + f * (1.f / 720.f))))));
+  const uint32_t bits = static_cast<uint32_t>(n + 127) << 23;
+  Float scale;
+  memcpy(&scale, &bits, sizeof scale);
+  return p * scale;
+}
+
+// Cells per side of each level: geometric from 4 to 256 (4 * 64^(l / 7), rounded).
+TESSERA_HOST_DEVICE inline uint32_t neural_level_resolution(uint32_t level) {
+  const uint32_t res[kNeuralLevels] = {4, 7, 13, 24, 43, 78, 141, 256};
+  return res[level];
+}
+
+// Table entry of grid vertex (x, y, z) at a level with res cells per side:
+// dense while the level's vertices fit the table, hashed beyond (the
+// primes of Teschner et al., as instant-ngp).
+TESSERA_HOST_DEVICE inline uint32_t neural_grid_entry(uint32_t res, uint32_t x, uint32_t y, uint32_t z) {
+  const uint32_t side = res + 1;
+  if (side * side * side <= kNeuralTableSize) return (z * side + y) * side + x;
+  return (x ^ (y * 2654435761u) ^ (z * 805459861u)) & (kNeuralTableSize - 1);
+}
+
+// Position in the unit cube of the encoding (clamped: points on or beyond the bounds).
+TESSERA_HOST_DEVICE inline Vec3 neural_unit_position(const NeuralGuideView& v, const Vec3& p) {
+  const Vec3 u = (p - v.lo) / v.extent;
+  auto clamp01 = [](Float x) { return x > 0.f ? glm::min(x, 1.f) : 0.f; };  // NaN -> 0
+  return Vec3(clamp01(u.x), clamp01(u.y), clamp01(u.z));
+}
+
+// The 8 grid vertices around unit position u at a level and their
+// trilinear weights (shared by inference and training).
+TESSERA_HOST_DEVICE inline void neural_level_corners(uint32_t level, const Vec3& u, uint32_t entry[8], Float weight[8]) {
+  const uint32_t res = neural_level_resolution(level);
+  const Vec3 x = u * static_cast<Float>(res);
+  uint32_t i0[3];
+  Float f[3];
+  for (int k = 0; k < 3; ++k) {
+    i0[k] = glm::min(static_cast<uint32_t>(x[k]), res - 1);
+    f[k] = x[k] - static_cast<Float>(i0[k]);
+  }
+  for (uint32_t c = 0; c < 8; ++c) {
+    const uint32_t dx = c & 1u, dy = (c >> 1) & 1u, dz = (c >> 2) & 1u;
+    entry[c] = neural_grid_entry(res, i0[0] + dx, i0[1] + dy, i0[2] + dz);
+    weight[c] = (dx ? f[0] : 1.f - f[0]) * (dy ? f[1] : 1.f - f[1]) * (dz ? f[2] : 1.f - f[2]);
+  }
+}
+
+// The network's input for a point and normal: kNeuralInputs floats.
+TESSERA_HOST_DEVICE inline void neural_encode(const NeuralGuideView& v, const Vec3& p, const Vec3& n, Float* in) {
+  const Vec3 u = neural_unit_position(v, p);
+  for (uint32_t l = 0; l < kNeuralLevels; ++l) {
+    uint32_t entry[8];
+    Float weight[8];
+    neural_level_corners(l, u, entry, weight);
+    const float* table = v.params + (static_cast<size_t>(l) * kNeuralTableSize) * kNeuralFeatures;
+    Float f0 = 0.f, f1 = 0.f;
+    for (uint32_t c = 0; c < 8; ++c) {
+      f0 += weight[c] * table[entry[c] * kNeuralFeatures];
+      f1 += weight[c] * table[entry[c] * kNeuralFeatures + 1];
+    }
+    in[l * kNeuralFeatures] = f0;
+    in[l * kNeuralFeatures + 1] = f1;
+  }
+  in[kNeuralEncoded] = n.x;
+  in[kNeuralEncoded + 1] = n.y;
+  in[kNeuralEncoded + 2] = n.z;
+}
+
+// out[o] = b[o] + sum_i w[i * outs + o] in[i], then ReLU when asked.
+TESSERA_HOST_DEVICE inline void neural_layer(const float* w, const float* b, const Float* in, uint32_t ins,
+                                             uint32_t outs, bool relu, Float* out) {
+  for (uint32_t o = 0; o < outs; ++o) out[o] = b[o];
+  for (uint32_t i = 0; i < ins; ++i) {
+    const Float x = in[i];
+    if (x == 0.f) continue;  // ReLU zeros are common: their columns add nothing
+    const float* col = w + static_cast<size_t>(i) * outs;
+    for (uint32_t o = 0; o < outs; ++o) out[o] += col[o] * x;
+  }
+  if (relu)
+    for (uint32_t o = 0; o < outs; ++o) out[o] = glm::max(out[o], 0.f);
+}
+
+// Runs the network at a vertex (p on a surface whose normal on the path's
+// side is n) and builds the site's distribution.
+TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site) {
+  const NeuralLayout L{v.width};
+  Float in[kNeuralInputs], h1[kNeuralMaxWidth], h2[kNeuralMaxWidth];
+  neural_encode(v, p, n, in);
+  neural_layer(v.params + L.w1(), v.params + L.b1(), in, kNeuralInputs, v.width, true, h1);
+  neural_layer(v.params + L.w2(), v.params + L.b2(), h1, v.width, v.width, true, h2);
+  neural_layer(v.params + L.w3(), v.params + L.b3(), h2, v.width, kNeuralBins, false, site->q);
+  site->p = p;
+  site->n = n;
+  site->has_cdf = false;
+  // Loops over bins vectorise: no aliasing between the site's arrays and the
+  // view's, scalars in locals.
+  Float* __restrict q = site->q;
+  Float* __restrict pmf = site->pmf;
+  const Float* __restrict dx = v.bin_dir_soa;
+  const Float* __restrict dy = dx + kNeuralBins;
+  const Float* __restrict dz = dy + kNeuralBins;
+  const Float scale = v.scale, nx = n.x, ny = n.y, nz = n.z;
+  for (uint32_t j = 0; j < kNeuralBins; ++j) q[j] = scale * neural_exp(q[j]);
+  // Q x max(cos, 0), then its sum and the largest Q above the surface in 8
+  // lanes (a fixed order of additions).
+  Float above[kNeuralBins];  // Q of the bins above the surface, 0 below
+  for (uint32_t j = 0; j < kNeuralBins; ++j) {
+    const Float c = dx[j] * nx + dy[j] * ny + dz[j] * nz;
+    const Float cosine = c > 0.f ? c : 0.f;  // selects only: no speculated arithmetic
+    pmf[j] = q[j] * cosine;
+    above[j] = c > 0.f ? q[j] : 0.f;
+  }
+  constexpr uint32_t kLanes = 8;
+  static_assert(kNeuralBins % kLanes == 0, "bins in whole lanes");
+  Float lane_sum[kLanes] = {}, lane_max[kLanes] = {};
+  for (uint32_t j = 0; j < kNeuralBins; j += kLanes)
+    for (uint32_t k = 0; k < kLanes; ++k) {
+      lane_sum[k] += site->pmf[j + k];
+      lane_max[k] = lane_max[k] > above[j + k] ? lane_max[k] : above[j + k];
+    }
+  Float total = 0.f, qmax = 0.f;
+  for (uint32_t k = 0; k < kLanes; ++k) {
+    total += lane_sum[k];
+    qmax = glm::max(qmax, lane_max[k]);
+  }
+  site->irradiance = total * (4.f * kPi / static_cast<Float>(kNeuralBins));
+  site->qmax = qmax;
+  const Float floor = glm::clamp(v.floor, 0.f, 1.f);
+  const Float uniform = total > 0.f ? floor / static_cast<Float>(kNeuralBins) : 1.f / static_cast<Float>(kNeuralBins);
+  const Float w = total > 0.f ? (1.f - floor) / total : 0.f;
+  for (uint32_t j = 0; j < kNeuralBins; ++j) site->pmf[j] = site->pmf[j] * w + uniform;
+}
+
+// The site's cdf, built once per vertex by the first sample that needs it.
+TESSERA_HOST_DEVICE inline void neural_build_cdf(NeuralSite* site) {
+  Float acc = 0.f;
+  for (uint32_t j = 0; j < kNeuralBins; ++j) {
+    acc += site->pmf[j];
+    site->cdf[j] = acc;
+  }
+  // The last bin takes the rounding: u < 1 always finds a bin.
+  site->cdf[kNeuralBins - 1] = 1.f;
+  site->has_cdf = true;
+}
+
+TESSERA_HOST_DEVICE inline uint32_t neural_bin_of(const Vec3& dir) {
+  const Vec2 uv = equal_area_sphere_to_square(dir);
+  auto index = [](Float x) {
+    const Float last = static_cast<Float>(kNeuralGrid - 1);
+    return x > 0.f ? static_cast<uint32_t>(glm::min(x * static_cast<Float>(kNeuralGrid), last)) : 0u;
+  };
+  return index(uv.y) * kNeuralGrid + index(uv.x);
+}
+
+TESSERA_HOST_DEVICE inline Float neural_bin_pdf(const NeuralSite& site, uint32_t bin) {
+  return site.pmf[bin] * (static_cast<Float>(kNeuralBins) * kInv4Pi);
+}
+
+// Draws a bin from the site's cdf (u_bin) and a direction uniformly within it (u).
+TESSERA_HOST_DEVICE inline bool neural_sample(NeuralSite& site, Float u_bin, Vec2 u, Vec3* dir, Float* pdf,
+                                              uint32_t* bin_out) {
+  if (!site.has_cdf) neural_build_cdf(&site);
+  uint32_t lo = 0, hi = kNeuralBins - 1;  // the first bin whose cdf exceeds u_bin
+  while (lo < hi) {
+    const uint32_t mid = (lo + hi) / 2;
+    if (site.cdf[mid] > u_bin) hi = mid;
+    else lo = mid + 1;
+  }
+  const uint32_t bin = lo;
+  if (!(site.pmf[bin] > 0.f)) return false;
+  const uint32_t row = bin / kNeuralGrid, col = bin % kNeuralGrid;
+  const Float inv_grid = 1.f / static_cast<Float>(kNeuralGrid);
+  *dir = equal_area_square_to_sphere(Vec2((static_cast<Float>(col) + u.x) * inv_grid,
+                                          (static_cast<Float>(row) + u.y) * inv_grid));
+  *pdf = neural_bin_pdf(site, bin);
+  *bin_out = bin;
+  return true;
+}
+
+// Records a learning target for the site's bin into the calling thread's
+// sink. Returns false (and counts it) when the target is rejected.
+TESSERA_HOST_DEVICE inline bool neural_record(const NeuralGuideView& v, const NeuralSite& site, uint32_t bin, Float target) {
+  NeuralSampleSink* sink = v.sink;
+  if (!sink) return false;
+  if (!(target >= 0.f) || !(target <= 3.4e38f)) {
+    ++sink->rejected_nonfinite;
+    return false;
+  }
+  if (target > v.max_target) {
+    ++sink->rejected_large;
+    return false;
+  }
+  // A hash of (tile, number in tile) in [0, 1): which targets are kept.
+  uint32_t h = sink->tile * 0x9E3779B1u ^ (sink->seen++ * 0x85EBCA77u);
+  h ^= h >> 15;
+  h *= 0x2C1B3C6Du;
+  h ^= h >> 12;
+  if (static_cast<Float>(h >> 8) * (1.f / 16777216.f) >= sink->keep_prob) return true;
+  if (sink->count >= sink->capacity) {
+    ++sink->dropped;
+    return true;
+  }
+  NeuralTrainingSample& s = sink->data[sink->count++];
+  for (int k = 0; k < 3; ++k) {
+    s.p[k] = site.p[k];
+    s.n[k] = site.n[k];
+  }
+  s.bin = bin;
+  s.target = target;
+  return true;
+}
+
+}  // namespace tessera

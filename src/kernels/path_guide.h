@@ -1,0 +1,132 @@
+// The integrator's one interface to a guide, per path: locate a vertex,
+// the mixture weight there, sample a direction and its density, the
+// radiance predicted along a bin, and record learning targets. Two plain
+// implementations, picked at compile time by the specialisation bits
+// (kSpecGuiding, kSpecNeural): TablePathGuide over the Q-table's GuideView
+// (what trace_path did inline before, operation for operation, so its
+// images are unchanged), and NeuralPathGuide, which runs the network once
+// per vertex into one of two sites (the current vertex and the one whose
+// target is pending). A vertex is named by an int32_t handle: the table's
+// cell, the neural site's slot; -1 is none.
+#pragma once
+
+#include "guiding.h"
+#include "neural_guide.h"
+
+namespace tessera {
+
+struct TablePathGuide {
+  const GuideView& g;
+  // Light selection and next-event probability are learned per cell.
+  TESSERA_HOST_DEVICE const GuideView* light_guide() const { return &g; }
+
+  TESSERA_HOST_DEVICE int32_t locate(const Vec3& p, const Vec3& n_side) { return guide_find_cell(g, p, n_side); }
+  TESSERA_HOST_DEVICE uint32_t bins() const { return g.bins; }
+  TESSERA_HOST_DEVICE Vec3 bin_dir(uint32_t j) const { return g.bin_dirs[j]; }
+  TESSERA_HOST_DEVICE Float irradiance(int32_t cell) const { return g.irradiance[cell]; }
+  TESSERA_HOST_DEVICE void note_normal(int32_t cell, const Vec3& n_side) const { guide_record_normal(g, cell, n_side); }
+  TESSERA_HOST_DEVICE bool learned(int32_t cell) const { return g.learned(cell); }
+  TESSERA_HOST_DEVICE Float probability(int32_t cell, const BsdfParams& b, bool lambertian_only) const {
+    return guide_probability(g, cell, b, lambertian_only);
+  }
+  TESSERA_HOST_DEVICE void prefetch_sample(int32_t cell, Float uc) const { TESSERA_PREFETCH(g.alias_entry(cell, uc)); }
+  // The guide's density of a direction in two steps, so that its memory is
+  // fetched while a shadow ray is traced: lookup, then density.
+  using DirLookup = const GuideAlias*;
+  TESSERA_HOST_DEVICE DirLookup lookup(int32_t cell, const Vec3& dir) const {
+    const GuideAlias* e = g.bin_entry(cell, guide_bin_of(g, dir));
+    TESSERA_PREFETCH(e);
+    return e;
+  }
+  TESSERA_HOST_DEVICE Float lookup_pdf(DirLookup e) const { return g.entry_pdf(*e); }
+  TESSERA_HOST_DEVICE bool sample(int32_t cell, Float u_bin, Vec2 u, Vec3* dir, Float* pdf, uint32_t* bin) const {
+    return guide_sample(g, cell, u_bin, u, dir, pdf, bin);
+  }
+  TESSERA_HOST_DEVICE uint32_t bin_of(const Vec3& dir) const { return guide_bin_of(g, dir); }
+  TESSERA_HOST_DEVICE Float bin_pdf(int32_t cell, uint32_t bin) const { return guide_bin_pdf(g, cell, bin); }
+  TESSERA_HOST_DEVICE Float value(int32_t cell, uint32_t bin) const { return guide_value(g, cell, bin); }
+  TESSERA_HOST_DEVICE Float survival(int32_t cell, uint32_t bin, Float throughput, Float path_expected, Float window) const {
+    return guided_survival(g, cell, bin, throughput, path_expected, window);
+  }
+  template <class ToLocal>
+  TESSERA_HOST_DEVICE Float bins_integral(int32_t cell, const BsdfParams& b, bool lambertian, const Vec3& wo_local,
+                                          const ToLocal& to_local, PixelSampler& rng) const {
+    return guide_bins_integral(g, cell, b, lambertian, wo_local, to_local, rng);
+  }
+  TESSERA_HOST_DEVICE bool record(int32_t cell, uint32_t bin, Float target) const { return guide_record(g, cell, bin, target); }
+  TESSERA_HOST_DEVICE void record_light(int32_t cell, uint32_t li, Float learned) const {
+    if (g.lights > 0) guide_record(g, cell, g.bins + li, learned);
+  }
+  TESSERA_HOST_DEVICE void record_nee(int32_t cell, Float direct, Float indirect) const {
+    guide_record(g, cell, g.nee_entry, direct);
+    guide_record(g, cell, g.nee_entry + 1, indirect);
+  }
+  // Whether a vertex sampled with weight guide_p informs its cell's mixture weight.
+  TESSERA_HOST_DEVICE bool learns_mix(int32_t cell, Float guide_p) const {
+    return g.learn_mix && guide_p == g.cell_guide_prob(cell);
+  }
+  TESSERA_HOST_DEVICE void record_mix(int32_t cell, const GuideMixSample& m, Float target) const {
+    guide_record_mix(g, cell, m, target);
+  }
+};
+
+struct NeuralPathGuide {
+  const NeuralGuideView& v;
+  NeuralSite site[2];
+  int32_t last = 1;  // slot of the latest vertex located
+  // The sites are filled by locate(), not zeroed here (they are 3.5 kB).
+  TESSERA_HOST_DEVICE explicit NeuralPathGuide(const NeuralGuideView& view) : v(view) {}
+  // No learned light selection: power-based, next-event estimation always.
+  TESSERA_HOST_DEVICE const GuideView* light_guide() const { return nullptr; }
+
+  // Runs the network into the slot not holding the latest vertex: the latest
+  // one (a pending target's) stays readable.
+  TESSERA_HOST_DEVICE int32_t locate(const Vec3& p, const Vec3& n_side) {
+    last ^= 1;
+    neural_infer(v, p, n_side, &site[last]);
+    return last;
+  }
+  TESSERA_HOST_DEVICE uint32_t bins() const { return kNeuralBins; }
+  TESSERA_HOST_DEVICE Vec3 bin_dir(uint32_t j) const { return v.bin_dirs[j]; }
+  TESSERA_HOST_DEVICE Float irradiance(int32_t s) const { return site[s].irradiance; }
+  TESSERA_HOST_DEVICE void note_normal(int32_t, const Vec3&) const {}
+  TESSERA_HOST_DEVICE bool learned(int32_t s) const { return v.trained && site[s].irradiance > 0.f; }
+  TESSERA_HOST_DEVICE Float probability(int32_t s, const BsdfParams& b, bool lambertian_only) const {
+    return guide_probability_for_bsdf(learned(s) ? v.guide_prob : 0.f, b, lambertian_only);
+  }
+  TESSERA_HOST_DEVICE void prefetch_sample(int32_t, Float) const {}
+  using DirLookup = Float;
+  TESSERA_HOST_DEVICE DirLookup lookup(int32_t s, const Vec3& dir) const { return neural_bin_pdf(site[s], neural_bin_of(dir)); }
+  TESSERA_HOST_DEVICE Float lookup_pdf(DirLookup pdf) const { return pdf; }
+  TESSERA_HOST_DEVICE bool sample(int32_t s, Float u_bin, Vec2 u, Vec3* dir, Float* pdf, uint32_t* bin) {
+    return neural_sample(site[s], u_bin, u, dir, pdf, bin);
+  }
+  TESSERA_HOST_DEVICE uint32_t bin_of(const Vec3& dir) const { return neural_bin_of(dir); }
+  TESSERA_HOST_DEVICE Float bin_pdf(int32_t s, uint32_t bin) const { return neural_bin_pdf(site[s], bin); }
+  TESSERA_HOST_DEVICE Float value(int32_t s, uint32_t bin) const { return site[s].q[bin]; }
+  TESSERA_HOST_DEVICE Float survival(int32_t s, uint32_t bin, Float throughput, Float path_expected, Float window) const {
+    return glm::min(window * throughput * site[s].q[bin] / path_expected, 1.f);
+  }
+  // Expected SARSA's integral of Q f |cos| over y's bins (guide_bins_integral).
+  template <class ToLocal>
+  TESSERA_HOST_DEVICE Float bins_integral(int32_t s, const BsdfParams& b, bool lambertian, const Vec3& wo_local,
+                                          const ToLocal& to_local, PixelSampler& rng) {
+    NeuralSite& y = site[s];
+    if (lambertian) return luminance(b.reflectance) * kInvPi * y.irradiance;
+    Vec3 dir;
+    Float pdf = 0.f;
+    uint32_t j = 0;
+    const Float u = rng.uniform();
+    if (!neural_sample(y, u, Vec2(0.5f), &dir, &pdf, &j)) return 0.f;
+    const Vec3 wi = to_local(v.bin_dirs[j]);
+    const Float pmf = y.pmf[j];
+    return y.q[j] * luminance(bsdf_eval(b, wo_local, wi)) * fabsf(wi.z) * (4.f * kPi / static_cast<Float>(kNeuralBins)) / pmf;
+  }
+  TESSERA_HOST_DEVICE bool record(int32_t s, uint32_t bin, Float target) const { return neural_record(v, site[s], bin, target); }
+  TESSERA_HOST_DEVICE void record_light(int32_t, uint32_t, Float) const {}
+  TESSERA_HOST_DEVICE void record_nee(int32_t, Float, Float) const {}
+  TESSERA_HOST_DEVICE bool learns_mix(int32_t, Float) const { return false; }
+  TESSERA_HOST_DEVICE void record_mix(int32_t, const GuideMixSample&, Float) const {}
+};
+
+}  // namespace tessera

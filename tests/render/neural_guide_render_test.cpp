@@ -1,0 +1,138 @@
+// Rendering with the neural guide (--guide neural): the analytic furnace,
+// agreement with unguided renders on the hard scenes, bit-identical images
+// and weights for any thread count, and exact save/load and resume.
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "guided_helpers.h"
+#include "master/checkpoint.h"
+
+namespace tessera {
+namespace {
+
+using namespace testing;
+
+constexpr uint64_t kUnguidedSeed = 1000003;
+
+NeuralGuideConfig small_network() {
+  NeuralGuideConfig c;
+  c.width = 16;
+  c.steps_per_pass = 8;
+  return c;
+}
+
+TEST(NeuralGuided, ClosedSphereFurnaceMatchesTheAnalyticValue) {
+  // L = Le * sum_{k=0..5} 0.5^k with pbrt's depth counting.
+  const double expected = 1.96875;
+  const char* scene = R"(
+LookAt 0 0 0  0 0 1  0 1 0
+Camera "perspective" "float fov" [ 60 ]
+Film "rgb" "integer xresolution" [ 16 ] "integer yresolution" [ 16 ]
+Sampler "independent" "integer pixelsamples" [ 256 ]
+Integrator "path" "integer maxdepth" [ 5 ]
+WorldBegin
+Material "diffuse" "rgb reflectance" [ 0.5 0.5 0.5 ]
+AreaLightSource "diffuse" "rgb L" [ 1 1 1 ] "bool twosided" true
+Shape "sphere" "float radius" [ 10 ]
+)";
+  GuidedScene s(load_pbrt_string(scene, "<furnace>", "."));
+  for (bool nee : {true, false}) {
+    auto guide = s.make_neural(small_network());
+    RenderOptions opt;
+    opt.nee = nee;
+    RenderResult r = s.run(guide.get(), opt);
+    ChannelStats m = channel_stats(r.film);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.mean[c], expected, 0.01 * expected) << "nee " << nee;
+    EXPECT_GT(r.stats.counters.path.guided_samples, 0u);
+    EXPECT_GT(r.stats.neural_guide.steps, 0u);
+    EXPECT_GT(r.stats.neural_guide.targets, 0u);
+    EXPECT_EQ(r.stats.neural_guide.rejected_nonfinite, 0u);
+    EXPECT_EQ(r.stats.counters.rejected_nonfinite, 0u);
+    EXPECT_EQ(r.stats.guide_mode, "neural");
+  }
+}
+
+// The hard scenes: guided means agree with unguided ones within their
+// confidence interval.
+TEST(NeuralGuided, DoorAjarAndShelterAgreeWithUnguided) {
+  for (const char* name : {"door-ajar", "shelter"}) {
+    SCOPED_TRACE(name);
+    GuidedScene s(shipped(name, 40, 30, 192, 8));
+    auto guide = s.make_neural(small_network());
+    RenderResult g = s.run(guide.get());
+    RenderResult u = s.run(nullptr, seeded(kUnguidedSeed));
+    ChannelStats mu = channel_stats(u.film);
+    expect_precise(mu, 0.05, name);
+    expect_agree(channel_stats(g.film), mu, name);
+    EXPECT_TRUE(all_finite(g.film));
+    EXPECT_GT(g.stats.counters.path.guided_samples, g.stats.counters.path.vertices / 20);
+    EXPECT_GT(g.stats.neural_guide.steps, 0u);
+    EXPECT_EQ(g.stats.neural_guide.nonfinite_gradients, 0u);
+  }
+}
+
+TEST(NeuralGuided, BitIdenticalImageAndWeightsAcrossThreadCounts) {
+  GuidedScene s(shipped("shelter", 32, 24, 12, 6));
+  RenderResult results[3];
+  std::unique_ptr<NeuralGuide> guides[3];
+  const int threads[3] = {1, 2, 4};
+  for (int i = 0; i < 3; ++i) {
+    guides[i] = s.make_neural(small_network());
+    RenderOptions opt;
+    opt.threads = threads[i];
+    opt.tile_size = 8;
+    opt.seed = 7;
+    results[i] = s.run(guides[i].get(), opt);
+  }
+  EXPECT_GT(guides[0]->stats().steps, 0u);
+  EXPECT_TRUE(films_identical(results[0].film, results[1].film));
+  EXPECT_TRUE(films_identical(results[0].film, results[2].film));
+  EXPECT_TRUE(*guides[0] == *guides[1]);
+  EXPECT_TRUE(*guides[0] == *guides[2]);
+}
+
+// A saved network renders (and goes on learning) exactly as the one it was saved from.
+TEST(NeuralGuided, SavedNetworkRendersTheSameImage) {
+  GuidedScene s(shipped("door-ajar", 24, 18, 8, 6));
+  auto guide = s.make_neural(small_network());
+  s.run(guide.get());
+  std::stringstream bytes;
+  guide->save(bytes, s.scene.fingerprint());
+  std::unique_ptr<Guide> loaded = load_guide(bytes, s.scene.fingerprint());
+  ASSERT_TRUE(loaded->same_as(*guide));
+  RenderResult a = s.run(guide.get()), b = s.run(loaded.get());
+  EXPECT_TRUE(films_identical(a.film, b.film));
+  EXPECT_TRUE(loaded->same_as(*guide));
+}
+
+// A render stopped after some passes and resumed from its checkpoint (the
+// network's weights and Adam's moments inside) ends with the image and the
+// weights of an uninterrupted one.
+TEST(NeuralGuided, ResumedRenderEqualsTheUninterruptedOne) {
+  GuidedScene s(shipped("door-ajar", 24, 18, 24, 6));
+  RenderOptions opt;
+  opt.progress = false;
+  opt.spp = 24;
+  opt.max_depth = 6;
+  opt.seed = 3;
+  auto whole_guide = s.make_neural(small_network());
+  RenderResult whole = render(s.scene, s.embree, opt, whole_guide.get());
+
+  auto first_guide = s.make_neural(small_network());
+  RenderOptions part = opt;
+  part.spp = 4;  // passes of 1, 1, 2 spp
+  RenderResult first = render(s.scene, s.embree, part, first_guide.get());
+  const std::string path = ::testing::TempDir() + "/neural.ckpt";
+  write_checkpoint(path, first, first_guide.get(), s.scene.fingerprint(), 11);
+  const Checkpoint ck = read_checkpoint(path, s.scene.fingerprint(), 11);
+  std::istringstream gs(std::string(ck.guide.begin(), ck.guide.end()));
+  std::unique_ptr<Guide> resumed_guide = load_guide(gs, s.scene.fingerprint());
+  ASSERT_TRUE(resumed_guide->same_as(*first_guide));
+  RenderResult resumed = render(s.scene, s.embree, opt, resumed_guide.get(), &ck.so_far);
+  EXPECT_TRUE(films_identical(resumed.film, whole.film));
+  EXPECT_TRUE(resumed_guide->same_as(*whole_guide));
+}
+
+}  // namespace
+}  // namespace tessera
