@@ -125,7 +125,8 @@ int run_guide_viz(VizArgs a) {
     throw std::runtime_error("guide-viz: nothing to do; give --distribution FILE.exr and/or --diagnostic FILE.exr");
   SceneData scene(load_scene_or_builtin(a.scene));
   EmbreeBackend embree(scene);
-  if (a.guide.mode == "auto" || a.guide.mode == "none") a.guide.mode = "qtable";
+  // Without a file to load, something must be learned: the table unless --guide neural.
+  if (a.guide.mode == "none" || (a.guide.mode == "auto" && a.guide.in.empty())) a.guide.mode = "qtable";
   std::string why;
   std::unique_ptr<Guide> field = make_guide(a.guide, scene, &why);
   if (a.guide.in.empty()) {

@@ -410,6 +410,8 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, PassExecutor&
 std::unique_ptr<TileBackend> backend_for(const RenderArgs& a, const MasterSetup& m, bool log) {
   std::string why;
   const std::string name = resolve_backend(a.backend, m.scene.get(), m.opt.light_paths, &why);
+  if (m.guide && (m.guide->spec_bits() & kSpecNeural) && name != "embree" && name != "bvh")
+    throw std::runtime_error("--backend " + name + " has no neural guide yet (--backend embree or bvh has)");
   if (log) std::fprintf(stderr, "tessera: backend: %s%s%s\n", name.c_str(), why.empty() ? "" : " (", why.empty() ? "" : (why + ")").c_str());
   return make_tile_backend(name, *m.scene, render_threads(m.opt), m.opt.light_paths);
 }

@@ -15,10 +15,11 @@ namespace tessera {
 
 namespace {
 
-// Fixed point of gradient sums (per tile): 2^-32 resolution; a word beyond
-// kGradLimit saturates there (counted).
-constexpr double kGradScale = 4294967296.0;
-constexpr double kGradLimit = 4503599627370496.0;  // 2^52
+// Fixed point of gradient sums (per tile): 2^-24 resolution; a word beyond
+// kGradLimit (2^44, a gradient sum of 2^20) saturates there (counted), so
+// that 2^19 saturated tiles still sum within int64.
+constexpr double kGradScale = 16777216.0;
+constexpr double kGradLimit = 17592186044416.0;
 constexpr double kLossScale = 1048576.0;
 constexpr double kLossLimit = 1e6;                 // per target, for the loss statistic only
 constexpr float kLossEps = 1e-3f;                  // relative L2's denominator floor (in units of the output scale)
@@ -122,6 +123,11 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
   const Eigen::Index B = n > first ? static_cast<Eigen::Index>((n - first + stride - 1) / stride) : 0;
   *count = static_cast<uint64_t>(B);
   if (B == 0) return 0.0;
+  // Eigen blocks its products by the cache sizes it reads from the CPU, and
+  // the blocking decides the order of float sums: fixed sizes give every
+  // machine of a farm the same gradients.
+  static const bool fixed_blocking = (Eigen::setCpuCacheSizes(32 * 1024, 256 * 1024, 2 * 1024 * 1024), true);
+  (void)fixed_blocking;
   const NeuralGuideView v = view();
   const float scale = v.scale;
   Mat X(kNeuralInputs, B);
@@ -206,7 +212,7 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
   struct Local {
     std::vector<int64_t> sum;
     std::vector<float> grad;
-    uint64_t loss = 0, count = 0, clamped = 0;
+    uint64_t loss = 0, count = 0, clamped = 0, nonfinite = 0;
   };
   tbb::enumerable_thread_specific<Local> locals;
   tbb::parallel_for(size_t(0), pass_tiles_.size(), [&](size_t i) {
@@ -216,24 +222,33 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
     uint64_t count = 0;
     const double loss = tile_gradient(pass_tiles_[i].samples, first, stride, &local.grad, &count);
     if (count == 0) return;
+    // A tile whose gradient has a NaN or Inf adds nothing but a flag: the
+    // step is then skipped on every rank (fold_round).
+    bool finite = std::isfinite(loss);
+    for (size_t k = 0; finite && k < P; ++k) finite = std::isfinite(local.grad[k]);
+    if (!finite) {
+      ++local.nonfinite;
+      return;
+    }
     for (size_t k = 0; k < P; ++k) {
       double g = static_cast<double>(local.grad[k]) * kGradScale;
-      if (!(std::fabs(g) <= kGradLimit)) {  // NaN counts too, and saturates at 0's sign
+      if (!(std::fabs(g) <= kGradLimit)) {
         ++local.clamped;
-        g = g > 0.0 ? kGradLimit : (g < 0.0 ? -kGradLimit : 0.0);
+        g = g > 0.0 ? kGradLimit : -kGradLimit;
       }
       local.sum[k] += static_cast<int64_t>(std::llround(g));
     }
     local.loss += static_cast<uint64_t>(std::llround(loss * kLossScale));
     local.count += count;
   });
-  acc_.assign(P + 3, 0);
+  acc_.assign(P + 4, 0);
   for (const Local& local : locals) {
     if (local.sum.empty()) continue;
     for (size_t k = 0; k < P; ++k) acc_[k] += to_word(local.sum[k]);
     acc_[P] += local.loss;
     acc_[P + 1] += local.count;
     acc_[P + 2] += local.clamped;
+    acc_[P + 3] += local.nonfinite;
   }
   totals_.train_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return acc_;
@@ -276,7 +291,7 @@ void NeuralGuide::fold_round(uint32_t round) {
       Float sink = 0.f;
       const auto i0 = std::chrono::steady_clock::now();
       for (size_t i = 0; i < n; ++i) {
-        neural_infer(v, Vec3(s[i].p[0], s[i].p[1], s[i].p[2]), Vec3(s[i].n[0], s[i].n[1], s[i].n[2]), &site);
+        neural_infer_cpu(v, Vec3(s[i].p[0], s[i].p[1], s[i].p[2]), Vec3(s[i].n[0], s[i].n[1], s[i].n[2]), &site);
         sink += site.irradiance;
       }
       const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - i0).count();
@@ -288,15 +303,13 @@ void NeuralGuide::fold_round(uint32_t round) {
   const size_t P = params_.size();
   const uint64_t count = acc_[P + 1];
   totals_.gradient_clamped += acc_[P + 2];
-  if (count > 0) {
+  if (acc_[P + 3] > 0) {
+    ++totals_.nonfinite_gradients;  // some tile's gradient was NaN or Inf: no step this round
+  } else if (count > 0) {
     std::vector<double> grad(P);
-    bool finite = true;
-    for (size_t k = 0; k < P; ++k) {
+    for (size_t k = 0; k < P; ++k)
       grad[k] = static_cast<double>(from_word(acc_[k])) / kGradScale / static_cast<double>(count);
-      finite = finite && std::isfinite(grad[k]);
-    }
-    if (finite) adam_step(grad);
-    else ++totals_.nonfinite_gradients;
+    adam_step(grad);
     pass_loss_sum_ += static_cast<double>(acc_[P]) / kLossScale;
     pass_loss_count_ += count;
   }

@@ -29,7 +29,9 @@
 namespace tessera {
 
 struct NeuralGuideConfig {
-  uint32_t width = 32;               // neurons per hidden layer (two layers), at most kNeuralMaxWidth
+  // Neurons per hidden layer (two layers), at most kNeuralMaxWidth. 16 gave
+  // the error of 32 and 64 at equal samples (docs/neural-guide.md) for less time.
+  uint32_t width = 16;
   uint32_t steps_per_pass = 16;      // Adam steps (gradient all-reductions) after each learning pass
   Float learning_rate = 5e-3f;
   Float guide_prob = 0.5f;           // mixture weight of guided sampling once trained

@@ -2,6 +2,7 @@
 // one loader for either kind of guide (told by the file's magic).
 #include <cereal/archives/portable_binary.hpp>
 #include <cereal/types/vector.hpp>
+#include <cmath>
 #include <cstring>
 #include <istream>
 #include <new>
@@ -62,11 +63,20 @@ std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_
   } catch (const std::length_error&) {
     throw std::runtime_error("corrupt neural guide (absurd array sizes)");
   }
-  const NeuralLayout L{g->config_.width};
-  const bool ok = g->config_.width >= 1 && g->config_.width <= kNeuralMaxWidth && g->config_.steps_per_pass >= 1 &&
-                  g->params_.size() == L.size() && g->adam_m_.size() == L.size() && g->adam_v_.size() == L.size() &&
-                  g->extent_ > 0.f && std::isfinite(g->extent_) && std::isfinite(g->scale_);
-  if (!ok) throw std::runtime_error("corrupt neural guide (inconsistent sizes)");
+  // Every field a later pass relies on: a damaged file is refused here, never rendered with.
+  const NeuralGuideConfig& c = g->config_;
+  const NeuralLayout L{c.width};
+  auto finite_in = [](float x, float lo, float hi) { return std::isfinite(x) && x >= lo && x <= hi; };
+  bool ok = c.width >= 1 && c.width <= kNeuralMaxWidth && c.steps_per_pass >= 1 && c.steps_per_pass <= 1024 &&
+            c.tile_targets >= 1 && c.tile_targets <= (1u << 20) && finite_in(c.learning_rate, 1e-9f, 1.f) &&
+            finite_in(c.guide_prob, 0.f, 1.f) && finite_in(c.floor, 0.f, 1.f) && g->params_.size() == L.size() &&
+            g->adam_m_.size() == L.size() && g->adam_v_.size() == L.size() && finite_in(g->extent_, 1e-30f, 3e38f) &&
+            finite_in(g->radiance_scale_, 1e-30f, 3e38f) && finite_in(g->max_target_, 1e-30f, 3.4e38f) &&
+            finite_in(g->scale_, 0.f, 3e38f) && std::isfinite(g->lo_.x) && std::isfinite(g->lo_.y) &&
+            std::isfinite(g->lo_.z);
+  for (size_t i = 0; ok && i < L.size(); ++i)
+    ok = std::isfinite(g->params_[i]) && std::isfinite(g->adam_m_[i]) && std::isfinite(g->adam_v_[i]) && g->adam_v_[i] >= 0.f;
+  if (!ok) throw std::runtime_error("corrupt neural guide (inconsistent or non-finite fields)");
   g->build_bin_dirs();
   return g;
 }

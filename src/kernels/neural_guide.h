@@ -38,7 +38,7 @@ constexpr Float kNeuralMinLog = -30.f, kNeuralMaxLog = 20.f;
 // scaled columns: contiguous, independent lanes that compilers vectorise
 // without reassociating sums.
 struct NeuralLayout {
-  uint32_t width = 32;
+  uint32_t width = 16;
   TESSERA_HOST_DEVICE uint32_t grid() const { return 0; }
   TESSERA_HOST_DEVICE uint32_t w1() const { return kNeuralLevels * kNeuralTableSize * kNeuralFeatures; }
   TESSERA_HOST_DEVICE uint32_t b1() const { return w1() + kNeuralInputs * width; }
@@ -78,7 +78,7 @@ struct NeuralSampleSink {
 
 struct NeuralGuideView {
   const float* params = nullptr;  // NeuralLayout(width) blocks
-  uint32_t width = 32;
+  uint32_t width = 16;
   Vec3 lo{0.f};                   // the encoded cube: [lo, lo + extent]^3 (the scene's bounds)
   Float extent = 1.f;
   Float scale = 1.f;              // Q = scale * exp(output)
@@ -259,6 +259,16 @@ TESSERA_HOST_DEVICE inline void neural_build_cdf(NeuralSite* site) {
   site->cdf[kNeuralBins - 1] = 1.f;
   site->has_cdf = true;
 }
+
+#if !TESSERA_IS_GPU_CODE
+// neural_infer for the CPU, compiled for AVX2 where the processor has it
+// (guidecache/neural_infer_cpu.cpp; bit-identical either way).
+void neural_infer_cpu(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site);
+// Its two copies, for the test that they agree bit for bit.
+void neural_infer_avx2(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site);
+void neural_infer_portable(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site);
+bool neural_infer_has_avx2();
+#endif
 
 TESSERA_HOST_DEVICE inline uint32_t neural_bin_of(const Vec3& dir) {
   const Vec2 uv = equal_area_sphere_to_square(dir);

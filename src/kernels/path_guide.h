@@ -76,6 +76,7 @@ struct NeuralPathGuide {
   int32_t last = 1;  // slot of the latest vertex located
   // The sites are filled by locate(), not zeroed here (they are 3.5 kB).
   TESSERA_HOST_DEVICE explicit NeuralPathGuide(const NeuralGuideView& view) : v(view) {}
+  NeuralPathGuide(NeuralGuideView&&) = delete;  // it keeps a reference: not to a temporary
   // No learned light selection: power-based, next-event estimation always.
   TESSERA_HOST_DEVICE const GuideView* light_guide() const { return nullptr; }
 
@@ -83,7 +84,11 @@ struct NeuralPathGuide {
   // one (a pending target's) stays readable.
   TESSERA_HOST_DEVICE int32_t locate(const Vec3& p, const Vec3& n_side) {
     last ^= 1;
+#if TESSERA_IS_GPU_CODE
     neural_infer(v, p, n_side, &site[last]);
+#else
+    neural_infer_cpu(v, p, n_side, &site[last]);
+#endif
     return last;
   }
   TESSERA_HOST_DEVICE uint32_t bins() const { return kNeuralBins; }

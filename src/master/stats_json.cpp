@@ -90,7 +90,8 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
       j["guide_sync"] = (s.guide_sync);
       j["guide_syncs"] = (uint64_t(s.guide_syncs));
       j["guide_sync_seconds"] = (s.guide_sync_seconds);
-      j["guide_sync_bytes"] = (s.guide_sync_bytes);
+      j["guide_sync_bytes"] = (s.guide_sync_bytes);  // the largest single reduction
+      j["guide_sync_seconds_per_reduction"] = s.guide_syncs > 0 ? s.guide_sync_seconds / s.guide_syncs : 0.0;
       j["guide_sync_fraction"] = (s.seconds > 0 ? s.guide_sync_seconds / s.seconds : 0.0);
     }
     j["guide_learn_spp"] = (uint64_t{s.guide_learn.all_spp});

@@ -46,8 +46,11 @@ void ThreadGuideAccumulators::begin_tile(const TileSettings& mine, const TileJob
   sink->seen = 0;
   sink->tile = job.index;
   sink->rejected_nonfinite = sink->rejected_large = sink->dropped = 0;
-  // A path offers about two targets per sample; the tile keeps tile_targets of them on average.
-  const double offered = 2.0 * double(job.x1 - job.x0) * double(job.y1 - job.y0) * double(job.sample_end - job.sample_begin);
+  // A learning sample offers about two targets; the tile keeps tile_targets
+  // of them on average. Which samples learn follows the schedule (by index).
+  uint64_t learning = 0;
+  for (uint32_t si = job.sample_begin; si < job.sample_end; ++si) learning += mine.learn.learns(si) ? 1 : 0;
+  const double offered = 2.0 * double(job.x1 - job.x0) * double(job.y1 - job.y0) * double(learning);
   sink->keep_prob = offered > 0.0 ? static_cast<Float>(std::min(1.0, mine.path.neural.tile_targets / offered)) : 1.f;
 }
 
