@@ -126,7 +126,8 @@ int run_guide_viz(VizArgs a) {
   SceneData scene(load_scene_or_builtin(a.scene));
   EmbreeBackend embree(scene);
   // Without a file to load, something must be learned: the table unless --guide neural.
-  if (a.guide.mode == "none" || (a.guide.mode == "auto" && a.guide.in.empty())) a.guide.mode = "qtable";
+  if (!a.guide.in.empty()) a.guide.mode = "auto";  // the file says which kind
+  else if (a.guide.mode == "auto" || a.guide.mode == "none") a.guide.mode = "qtable";
   std::string why;
   std::unique_ptr<Guide> field = make_guide(a.guide, scene, &why);
   if (a.guide.in.empty()) {

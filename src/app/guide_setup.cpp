@@ -87,6 +87,7 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
   } else {
     *why = "--guide " + mode;
   }
+  if (mode == "none" && a.mode == "auto" && !a.in.empty()) mode = "qtable";  // auto with a file: the file decides
   if (mode == "none") {
     if (!a.in.empty()) throw std::runtime_error("--guide none and --guide-in " + a.in + " contradict each other");
     return nullptr;

@@ -17,7 +17,7 @@ namespace {
 
 // Fixed point of gradient sums (per tile): 2^-24 resolution; a word beyond
 // kGradLimit (2^44, a gradient sum of 2^20) saturates there (counted), so
-// that 2^19 saturated tiles still sum within int64.
+// that 2^19 - 1 saturated tiles still sum within int64.
 constexpr double kGradScale = 16777216.0;
 constexpr double kGradLimit = 17592186044416.0;
 constexpr double kLossScale = 1048576.0;
@@ -200,8 +200,9 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
     uint64_t count = 0, sum = 0;
     for (const NeuralTileTargets& t : pass_tiles_) {
       count += t.samples.size();
-      for (const NeuralTrainingSample& s : t.samples)
-        sum += static_cast<uint64_t>(static_cast<double>(s.target) / radiance_scale_ / kTargetUnit + 0.5);
+      for (const NeuralTrainingSample& s : t.samples)  // (the sinks let no non-finite target in; train_on may)
+        if (std::isfinite(s.target) && s.target >= 0.f && s.target <= max_target_)
+          sum += static_cast<uint64_t>(static_cast<double>(s.target) / radiance_scale_ / kTargetUnit + 0.5);
     }
     acc_ = {count, sum, pass_counts_.rejected_nonfinite, pass_counts_.rejected_large, pass_counts_.dropped};
     return acc_;
@@ -222,8 +223,9 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
     uint64_t count = 0;
     const double loss = tile_gradient(pass_tiles_[i].samples, first, stride, &local.grad, &count);
     if (count == 0) return;
-    // A tile whose gradient has a NaN or Inf adds nothing but a flag: the
-    // step is then skipped on every rank (fold_round).
+    // A tile whose gradient has a NaN or Inf adds nothing but a flag
+    // (counted): the step goes on with the other tiles, the same on every
+    // rank, as a tile's gradient does not depend on where it was computed.
     bool finite = std::isfinite(loss);
     for (size_t k = 0; finite && k < P; ++k) finite = std::isfinite(local.grad[k]);
     if (!finite) {
@@ -231,6 +233,7 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
       return;
     }
     for (size_t k = 0; k < P; ++k) {
+      if (local.grad[k] == 0.f) continue;  // most hash-grid entries: not touched by this tile
       double g = static_cast<double>(local.grad[k]) * kGradScale;
       if (!(std::fabs(g) <= kGradLimit)) {
         ++local.clamped;
@@ -254,11 +257,19 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
   return acc_;
 }
 
+// beta^steps by repeated multiplication, not pow(): libm's pow may differ in
+// its last bit between machines (glibc picks an FMA variant where it can).
+static double adam_power(double beta, uint64_t steps) {
+  double p = 1.0;
+  for (uint64_t i = 0; i < steps && p > 0.0; ++i) p *= beta;
+  return p;
+}
+
 void NeuralGuide::adam_step(const std::vector<double>& grad) {
   ++steps_;
   const double lr = config_.learning_rate;
-  const double c1 = 1.0 - std::pow(kAdamBeta1, static_cast<double>(steps_));
-  const double c2 = 1.0 - std::pow(kAdamBeta2, static_cast<double>(steps_));
+  const double c1 = 1.0 - adam_power(kAdamBeta1, steps_);
+  const double c2 = 1.0 - adam_power(kAdamBeta2, steps_);
   for (size_t k = 0; k < params_.size(); ++k) {
     const double m = kAdamBeta1 * adam_m_[k] + (1.0 - kAdamBeta1) * grad[k];
     const double v = kAdamBeta2 * adam_v_[k] + (1.0 - kAdamBeta2) * grad[k] * grad[k];
@@ -303,9 +314,8 @@ void NeuralGuide::fold_round(uint32_t round) {
   const size_t P = params_.size();
   const uint64_t count = acc_[P + 1];
   totals_.gradient_clamped += acc_[P + 2];
-  if (acc_[P + 3] > 0) {
-    ++totals_.nonfinite_gradients;  // some tile's gradient was NaN or Inf: no step this round
-  } else if (count > 0) {
+  totals_.nonfinite_gradients += acc_[P + 3];  // tiles left out of this step
+  if (count > 0) {
     std::vector<double> grad(P);
     for (size_t k = 0; k < P; ++k)
       grad[k] = static_cast<double>(from_word(acc_[k])) / kGradScale / static_cast<double>(count);

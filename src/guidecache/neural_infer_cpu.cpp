@@ -2,10 +2,11 @@
 // the same function body compiled twice, for AVX2 and for the portable
 // x86-64 baseline, and picked once by what the processor supports. The
 // inference is a few thousand independent multiply-adds per vertex; AVX2
-// halves its time. Without FMA (not enabled here) every lane computes the
-// same IEEE operations in the same order in either copy, so results are
-// bit-identical across machines with and without AVX2 (tested), and a farm
-// of mixed machines keeps its bit-identical image.
+// halves its time. Without FMA (not enabled here, and -ffp-contract=off)
+// every lane computes the same IEEE operations in the same order in either
+// copy, and no libm function is called: the results are bit-identical with
+// and without AVX2 (tested). (Elsewhere the renderer calls libm's sin, cos
+// and pow, which glibc may compute differently on machines with FMA.)
 #include "kernels/neural_guide.h"
 
 namespace tessera {

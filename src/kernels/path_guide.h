@@ -76,7 +76,7 @@ struct NeuralPathGuide {
   int32_t last = 1;  // slot of the latest vertex located
   // The sites are filled by locate(), not zeroed here (they are 3.5 kB).
   TESSERA_HOST_DEVICE explicit NeuralPathGuide(const NeuralGuideView& view) : v(view) {}
-  NeuralPathGuide(NeuralGuideView&&) = delete;  // it keeps a reference: not to a temporary
+  NeuralPathGuide(const NeuralGuideView&&) = delete;  // it keeps a reference: not to a temporary
   // No learned light selection: power-based, next-event estimation always.
   TESSERA_HOST_DEVICE const GuideView* light_guide() const { return nullptr; }
 
