@@ -13,7 +13,7 @@ constexpr char kMagic[] = "tessera-checkpoint";
 // 2: per-pass error estimates; 3: next-event skip counter, guide cache v2; 4: medium
 // vertex counter, --guide auto's trial; 5: guide cache v4; 6: light-path splats;
 // 7: splats summed per light path, lights in their own medium; 8: counter of
-// vertices the guide ratio left to the BSDF; 9: the neural guide's loss per pass
+// vertices the guide ratio left to the BSDF; 9: the guide's loss and learning time per pass
 constexpr uint32_t kVersion = 9;
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.

@@ -181,7 +181,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     if (opt.spp > 0) pass_spp = std::min(pass_spp, opt.spp - spp_done);
     const double pass_start = elapsed();
     const TileCounters before = stats.counters;
-    double pass_loss = -1.0;
+    double pass_loss = -1.0, pass_guide_seconds = 0.0;
     // Guided unless this is an unguided trial pass or the trial switched guiding off.
     const TrialPass trial_pass = guide_trial_next_pass(stats.guide_trial, spp_done);
     const bool guided = guide && trial_pass != TrialPass::Unguided &&
@@ -213,7 +213,8 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
       const double fold_start = elapsed();
       const size_t losses = stats.neural_guide.pass_loss.size();
       combine_guide_learning(*executor, *guide);
-      stats.guide_fold_seconds += elapsed() - fold_start;
+      pass_guide_seconds = elapsed() - fold_start;
+      stats.guide_fold_seconds += pass_guide_seconds;
       GuideFieldStats table_stats;
       guide->fill_stats(&table_stats, &stats.neural_guide);
       if (stats.neural_guide.pass_loss.size() > losses) pass_loss = stats.neural_guide.pass_loss.back();
@@ -230,6 +231,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     ps.guided_samples = stats.counters.path.guided_samples - before.path.guided_samples;
     ps.guidable_vertices = stats.counters.path.guidable_vertices - before.path.guidable_vertices;
     ps.guide_loss = pass_loss;
+    ps.guide_seconds = pass_guide_seconds;
     const ErrorEstimate err = estimate_rel_mse(result.film);
     ps.estimated_rel_mse = err.valid ? err.rel_mse : -1.0;
     stats.estimated_rel_mse = ps.estimated_rel_mse;

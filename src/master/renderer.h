@@ -55,6 +55,7 @@ struct PassStats {
   uint64_t guidable_vertices = 0;
   double estimated_rel_mse = -1.0;  // of the image after this pass; < 0 = not yet estimable
   double guide_loss = -1.0;   // neural guide: mean training loss after this pass (< 0: none)
+  double guide_seconds = 0.0; // the guide's learning after this pass (reductions, fold or training), of `seconds`
 };
 
 struct RenderStats {
@@ -78,7 +79,7 @@ struct RenderStats {
   std::string guide_mode = "none";  // none | qtable | qlearning | neural
   GuideFieldStats guide;            // as the guide stood at the end (when guided; the network fills bytes, updates, rejections)
   NeuralGuideStats neural_guide;    // the network's own (--guide neural)
-  double guide_fold_seconds = 0.0;
+  double guide_fold_seconds = 0.0;  // all passes' PassStats::guide_seconds
   double guide_sync_seconds = 0.0;  // farm: time in guide all-reductions (rank 0's view)
   uint64_t guide_sync_bytes = 0;    // farm: bytes all-reduced per sync
   uint32_t guide_syncs = 0;

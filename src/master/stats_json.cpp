@@ -131,7 +131,13 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
                       {"guided_sample_fraction",
                        p.guidable_vertices ? double(p.guided_samples) / double(p.guidable_vertices) : 0.0},
                       {"estimated_relmse", p.estimated_rel_mse},
-                      {"guide_loss", p.guide_loss}});
+                      {"guide_loss", p.guide_loss},
+                      {"guide_seconds", p.guide_seconds},
+                      // The network's inference, one per path vertex at its last measured cost.
+                      {"guide_inference_fraction",
+                       s.guide_mode == "neural" && p.seconds > 0
+                           ? double(p.vertices) * s.neural_guide.inference_seconds / (std::max(1, s.threads) * p.seconds)
+                           : 0.0}});
   }
   j["per_pass"] = passes;
   if (!snapshots.empty()) {

@@ -5,6 +5,7 @@
 
 #include <sstream>
 
+#include "furnace_scene.h"
 #include "guided_helpers.h"
 #include "master/checkpoint.h"
 
@@ -23,20 +24,8 @@ NeuralGuideConfig small_network() {
 }
 
 TEST(NeuralGuided, ClosedSphereFurnaceMatchesTheAnalyticValue) {
-  // L = Le * sum_{k=0..5} 0.5^k with pbrt's depth counting.
-  const double expected = 1.96875;
-  const char* scene = R"(
-LookAt 0 0 0  0 0 1  0 1 0
-Camera "perspective" "float fov" [ 60 ]
-Film "rgb" "integer xresolution" [ 16 ] "integer yresolution" [ 16 ]
-Sampler "independent" "integer pixelsamples" [ 256 ]
-Integrator "path" "integer maxdepth" [ 5 ]
-WorldBegin
-Material "diffuse" "rgb reflectance" [ 0.5 0.5 0.5 ]
-AreaLightSource "diffuse" "rgb L" [ 1 1 1 ] "bool twosided" true
-Shape "sphere" "float radius" [ 10 ]
-)";
-  GuidedScene s(load_pbrt_string(scene, "<furnace>", "."));
+  const double expected = expected_furnace(0.5, 5);
+  GuidedScene s(load_pbrt_string(furnace_scene(0.5, 5), "<furnace>", "."));
   for (bool nee : {true, false}) {
     auto guide = s.make_neural(small_network());
     RenderOptions opt;
