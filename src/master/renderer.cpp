@@ -18,7 +18,10 @@ namespace tessera {
 uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& options, const Guide* guide) {
   uint32_t spec = specialisation_for(scene.effects());
   if (options.force_full_specialisation) spec = (kSpecSurfaceAll & ~kSpecGuiding) | (spec & kSpecMedia);
-  return guide ? spec | guide->spec_bits() : spec;
+  if (!guide) return spec;
+  // The network runs the full surface integrator (instantiated_spec): the log and stats say so.
+  if (guide->spec_bits() & kSpecNeural) spec = kSpecSurfaceAll | (spec & kSpecMedia);
+  return spec | guide->spec_bits();
 }
 
 void combine_guide_learning(PassExecutor& executor, Guide& guide) {
