@@ -213,6 +213,24 @@ TEST(FarmProtocol, NeuralGuideGivesTheLocalImageAndWeightsOnEveryRank) {
   }
 }
 
+// --guide-sync off with the network: every rank trains on its own tiles
+// only (its own rounds, nothing reduced), so the ranks' weights differ;
+// the image stays finite and every sample is rendered.
+TEST(FarmProtocol, NeuralGuideSyncOffLetsEachRankTrainAlone) {
+  FarmScene fs(door_ajar());
+  FarmRun shared = render_farm(fs, 3, true, true, {}, true);
+  FarmRun alone = render_farm(fs, 3, true, false, {}, true);
+  for (const auto& g : alone.guides) {
+    const auto& n = dynamic_cast<const NeuralGuide&>(*g);
+    EXPECT_GT(n.stats().steps, 0u);
+    EXPECT_LT(n.stats().targets, dynamic_cast<const NeuralGuide&>(*shared.guides[0]).stats().targets);
+  }
+  EXPECT_FALSE(alone.guides[1]->same_as(*alone.guides[2]));
+  for (const PixelAccum& p : alone.result.film.pixels)
+    for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(p.sum[c]));
+  EXPECT_EQ(alone.result.stats.counters.samples, shared.result.stats.counters.samples);
+}
+
 TEST(FarmProtocol, SceneSurvivesTheWire) {
   SceneDesc d = door_ajar();
   d.warnings.push_back("x:1: a warning");
