@@ -114,7 +114,7 @@ void NeuralGuide::views(GuideView* table, NeuralGuideView* neural) {
 uint32_t NeuralGuide::rounds() const { return 1 + (pass_targets_ > 0 ? config_.steps_per_pass : 0u); }
 
 double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& samples, uint32_t first, uint32_t stride,
-                                  std::vector<float>* grad, uint64_t* count) const {
+                                  std::vector<float>* grad, uint64_t* count, std::vector<uint32_t>* touched) const {
   using Mat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
   using Vec = Eigen::Matrix<float, Eigen::Dynamic, 1>;
   const NeuralLayout L{config_.width};
@@ -172,10 +172,13 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
       uint32_t entry[8];
       Float weight[8];
       neural_level_corners(l, u, entry, weight);
-      float* table = G + L.grid() + static_cast<size_t>(l) * kNeuralTableSize * kNeuralFeatures;
+      const uint32_t level_base = L.grid() + l * kNeuralTableSize * kNeuralFeatures;
       for (uint32_t c = 0; c < 8; ++c)
-        for (uint32_t f = 0; f < kNeuralFeatures; ++f)
-          table[entry[c] * kNeuralFeatures + f] += weight[c] * dX(l * kNeuralFeatures + f, b);
+        for (uint32_t f = 0; f < kNeuralFeatures; ++f) {
+          const uint32_t k = level_base + entry[c] * kNeuralFeatures + f;
+          G[k] += weight[c] * dX(l * kNeuralFeatures + f, b);
+          if (touched) touched->push_back(k);
+        }
     }
   }
   return loss;
@@ -210,36 +213,49 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
   // One minibatch: every steps_per_pass-th target of each tile, from round - 1.
   const size_t P = params_.size();
   const uint32_t first = round - 1, stride = config_.steps_per_pass;
+  // A tile touches the layers (dense) and a few hash-grid entries: only
+  // those are quantised and cleared again, not every parameter per tile.
+  const size_t layers = NeuralLayout{config_.width}.w1();
   struct Local {
     std::vector<int64_t> sum;
-    std::vector<float> grad;
+    std::vector<float> grad;  // all zero between tiles
+    std::vector<uint32_t> touched;
     uint64_t loss = 0, count = 0, clamped = 0, nonfinite = 0;
   };
   tbb::enumerable_thread_specific<Local> locals;
   tbb::parallel_for(size_t(0), pass_tiles_.size(), [&](size_t i) {
     Local& local = locals.local();
-    if (local.sum.empty()) local.sum.assign(P, 0);
-    local.grad.assign(P, 0.f);
+    if (local.sum.empty()) {
+      local.sum.assign(P, 0);
+      local.grad.assign(P, 0.f);
+    }
+    local.touched.clear();
     uint64_t count = 0;
-    const double loss = tile_gradient(pass_tiles_[i].samples, first, stride, &local.grad, &count);
-    if (count == 0) return;
+    const double loss = tile_gradient(pass_tiles_[i].samples, first, stride, &local.grad, &count, &local.touched);
     // A tile whose gradient has a NaN or Inf adds nothing but a flag
     // (counted): the step goes on with the other tiles, the same on every
     // rank, as a tile's gradient does not depend on where it was computed.
     bool finite = std::isfinite(loss);
-    for (size_t k = 0; finite && k < P; ++k) finite = std::isfinite(local.grad[k]);
-    if (!finite) {
-      ++local.nonfinite;
-      return;
-    }
-    for (size_t k = 0; k < P; ++k) {
-      if (local.grad[k] == 0.f) continue;  // most hash-grid entries: not touched by this tile
-      double g = static_cast<double>(local.grad[k]) * kGradScale;
+    for (size_t k = layers; finite && k < P; ++k) finite = std::isfinite(local.grad[k]);
+    for (size_t t = 0; finite && t < local.touched.size(); ++t) finite = std::isfinite(local.grad[local.touched[t]]);
+    // Adds parameter k's gradient (then cleared: a repeated entry adds nothing more).
+    auto take = [&](size_t k) {
+      const float gk = local.grad[k];
+      local.grad[k] = 0.f;
+      if (!finite || gk == 0.f) return;
+      double g = static_cast<double>(gk) * kGradScale;
       if (!(std::fabs(g) <= kGradLimit)) {
         ++local.clamped;
         g = g > 0.0 ? kGradLimit : -kGradLimit;
       }
       local.sum[k] += static_cast<int64_t>(std::llround(g));
+    };
+    for (size_t k = layers; k < P; ++k) take(k);
+    for (uint32_t k : local.touched) take(k);
+    if (count == 0) return;
+    if (!finite) {
+      ++local.nonfinite;
+      return;
     }
     local.loss += static_cast<uint64_t>(std::llround(loss * kLossScale));
     local.count += count;
