@@ -53,6 +53,19 @@ class Guide {
   virtual bool same_as(const Guide& other) const = 0;
 };
 
+// A pass's learning, every round: reduce(accumulators) sums them across
+// ranks (or does nothing on one process), then the round is folded in.
+// rounds() is read again after each fold (a pass without targets has
+// nothing to train on); it is the same on every rank, as it follows the
+// summed round 0. The farm's master and workers both run this loop.
+template <class Reduce>
+void combine_guide_rounds(Guide& guide, Reduce&& reduce) {
+  for (uint32_t r = 0; r < guide.rounds(); ++r) {
+    reduce(guide.round_accumulators(r));
+    guide.fold_round(r);
+  }
+}
+
 // Loads what Guide::save wrote, whichever kind (told by its header).
 // Throws std::runtime_error when the stream is no guide, has another
 // version, or was learned on another scene.

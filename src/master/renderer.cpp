@@ -24,14 +24,6 @@ uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& o
   return spec | guide->spec_bits();
 }
 
-void combine_guide_learning(PassExecutor& executor, Guide& guide) {
-  // rounds() may shrink after round 0 (a pass without targets has nothing to train on).
-  for (uint32_t r = 0; r < guide.rounds(); ++r) {
-    executor.reduce_guide(guide.round_accumulators(r));
-    guide.fold_round(r);
-  }
-}
-
 TileSettings make_tile_settings(const RenderOptions& opt, uint32_t specialisation, bool guiding) {
   TileSettings ts;
   ts.seed = opt.seed;
@@ -215,7 +207,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     if (guided) {
       const double fold_start = elapsed();
       const size_t losses = stats.neural_guide.pass_loss.size();
-      combine_guide_learning(*executor, *guide);
+      combine_guide_rounds(*guide, [&](std::vector<uint64_t>& acc) { executor->reduce_guide(acc); });
       pass_guide_seconds = elapsed() - fold_start;
       stats.guide_fold_seconds += pass_guide_seconds;
       GuideFieldStats table_stats;

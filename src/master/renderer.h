@@ -132,10 +132,6 @@ class PassExecutor {
   virtual int32_t total_threads() const = 0;
 };
 
-// After a guided pass: every round of the guide's learning, reduced by the
-// executor (a farm sums it across ranks) and folded in.
-void combine_guide_learning(PassExecutor& executor, Guide& guide);
-
 // This process's backend: tiles handed out in order, as its threads ask.
 class LocalPassExecutor : public PassExecutor {
  public:

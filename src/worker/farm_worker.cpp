@@ -85,13 +85,9 @@ void run_farm_worker(Transport& t, TileBackend& backend, const TileSettings& bas
       render_pass_tiles(t, backend, threads, capacity);
       backend.end_pass();
       if (guided) {
-        // The same rounds as the master's combine_guide_learning (rounds()
-        // is the same on every rank: it follows the summed round 0).
-        for (uint32_t r = 0; r < guide->rounds(); ++r) {
-          std::vector<uint64_t>& acc = guide->round_accumulators(r);
+        combine_guide_rounds(*guide, [&](std::vector<uint64_t>& acc) {
           if (sync_guide) t.allreduce_sum(acc);
-          guide->fold_round(r);
-        }
+        });
       }
     }
   } catch (const std::exception& e) {
