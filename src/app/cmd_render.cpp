@@ -409,8 +409,9 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, PassExecutor&
 // which and, for auto, why.
 std::unique_ptr<TileBackend> backend_for(const RenderArgs& a, const MasterSetup& m, bool log) {
   std::string why;
-  const std::string name = resolve_backend(a.backend, m.scene.get(), m.opt.light_paths, &why);
-  if (m.guide && (m.guide->spec_bits() & kSpecNeural) && name != "embree" && name != "bvh")
+  const bool neural = m.guide && (m.guide->spec_bits() & kSpecNeural);
+  const std::string name = resolve_backend(a.backend, m.scene.get(), m.opt.light_paths, &why, neural);
+  if (neural && name != "embree" && name != "bvh")
     throw std::runtime_error("--backend " + name + " has no neural guide yet (--backend embree or bvh has)");
   if (log) std::fprintf(stderr, "tessera: backend: %s%s%s\n", name.c_str(), why.empty() ? "" : " (", why.empty() ? "" : (why + ")").c_str());
   return make_tile_backend(name, *m.scene, render_threads(m.opt), m.opt.light_paths);
@@ -520,7 +521,7 @@ CommandRunner add_render_command(CLI::App& app) {
   CLI::App* c = app.add_subcommand("render", "Render a pbrt-v4 scene (default: the built-in Cornell box) to OpenEXR + PNG; under mpirun, as a farm");
   c->add_option("scene", a->scene, "Scene file in pbrt-v4 syntax (omit for the built-in Cornell box)");
   c->add_option("--backend", a->backend,
-                "What renders the tiles: auto (embree until the CUDA backend has been checked on a GPU), "
+                "What renders the tiles: auto (cuda where there is a device and the scene and guide can go there, else embree), "
                 "embree, bvh (the GPU's BVH on the CPU), cuda, emulated-device (the GPU's kernel on the CPU, for "
                 "testing); bvh, cuda and emulated-device run the full integrator")
       ->check(CLI::IsMember({"auto", "embree", "bvh", "cuda", "emulated-device"}));

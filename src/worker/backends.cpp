@@ -9,11 +9,6 @@
 namespace tessera {
 namespace {
 
-// Whether auto may pick CUDA: not until the CUDA backend's renders have been
-// checked on a GPU (scripts/gpu_check.sh with GPU_BUNDLE). Until then a GPU
-// renders only when asked for with --backend cuda.
-constexpr bool kAutoPicksCuda = false;
-
 // Whether a CUDA device is there (asked once per process; makes no context).
 bool cuda_present(std::string* why) {
   static const std::string reason = [] {
@@ -27,17 +22,18 @@ bool cuda_present(std::string* why) {
 
 }  // namespace
 
-std::string resolve_backend(const std::string& requested, const SceneData* scene, bool light_paths, std::string* why) {
+std::string resolve_backend(const std::string& requested, const SceneData* scene, bool light_paths, std::string* why,
+                            bool neural_guide) {
   if (why) why->clear();
   if (requested == "embree" || requested == "bvh" || requested == "emulated-device") return requested;
   if (requested != "cuda" && requested != "auto")
     throw std::runtime_error("--backend " + requested + ": unknown backend (auto, embree, bvh, cuda, emulated-device)");
-  if (requested == "auto" && !kAutoPicksCuda) {
-    if (why) *why = "auto: the CUDA backend has not been checked on a GPU yet; --backend cuda uses one";
-    return "embree";
-  }
   std::string reason;
   bool ok = cuda_present(&reason);
+  if (ok && neural_guide) {
+    reason = "the neural guide does not run on the device yet";
+    ok = false;
+  }
   if (ok && scene) {
     reason = device_backend_obstacle(*scene, light_paths, false);
     ok = reason.empty();

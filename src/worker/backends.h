@@ -1,8 +1,7 @@
 // Picks and builds the backend a process renders with (--backend): the one
-// place that knows every backend. "auto" is Embree until the CUDA backend
-// has been checked on a GPU; then it will be CUDA where this binary was
-// built with it, a device is present and the scene can go there. Each rank
-// of a farm picks its own.
+// place that knows every backend. "auto" is CUDA where this binary was
+// built with it, a device is present and the scene and guide can go there,
+// else Embree. Each rank of a farm picks its own.
 #pragma once
 
 #include <memory>
@@ -16,10 +15,11 @@ namespace tessera {
 // The backend's name for `requested` (auto, embree, bvh, cuda) on this
 // process; *why says how auto decided (empty otherwise). With a scene (and
 // whether its caustics are traced from the lights), cuda is checked against
-// it too. Throws a one-line error for an unknown name and for cuda where it
-// cannot render.
+// it too, and against the guide: the neural guide runs on the CPU only.
+// Throws a one-line error for an unknown name and for cuda where it cannot
+// render.
 std::string resolve_backend(const std::string& requested, const SceneData* scene = nullptr, bool light_paths = false,
-                            std::string* why = nullptr);
+                            std::string* why = nullptr, bool neural_guide = false);
 
 // Builds backend `name` (as resolve_backend gives it) over `scene`, which
 // must outlive it (the device backends copy it and do not). host_threads:

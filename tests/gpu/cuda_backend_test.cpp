@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <memory>
+#include <stdexcept>
+#include <string>
 
 #include "../render/guided_helpers.h"
 #include "../render/render_helpers.h"
@@ -43,6 +45,18 @@ TEST(CudaBackend, AgreesWithEmbreeAndRepeatsBitForBit) {
       for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(p.sum[c])) << name;
     testing::expect_agree(testing::channel_stats(e.film), testing::channel_stats(g1.film), name);
   }
+}
+
+// auto takes the device, except for what cannot go there: the neural guide
+// stays on Embree, and cuda asked for with it is refused in one line.
+TEST(CudaBackend, AutoPicksTheDeviceButNotForTheNeuralGuide) {
+  if (!cuda_device_here()) GTEST_SKIP() << "no CUDA device";
+  std::string why;
+  EXPECT_EQ(resolve_backend("auto", nullptr, false, &why), "cuda");
+  EXPECT_EQ(why, "");
+  EXPECT_EQ(resolve_backend("auto", nullptr, false, &why, true), "embree");
+  EXPECT_NE(why.find("neural"), std::string::npos) << why;
+  EXPECT_THROW(resolve_backend("cuda", nullptr, false, nullptr, true), std::runtime_error);
 }
 
 TEST(CudaBackend, GuidedRenderLearnsOnTheDevice) {

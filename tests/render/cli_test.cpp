@@ -451,8 +451,8 @@ TEST_F(CliTest, BackendsRenderOrRefuseInOneLine) {
   EXPECT_NE(stats_backend("emulated-device").find("\"backend\": \"emulated-device\""), std::string::npos);
   std::string why;
   const bool device = cuda_device_count(&why) > 0;
-  // auto stays on Embree until the CUDA backend has been checked on a GPU (worker/backends.cpp).
-  EXPECT_NE(stats_backend("auto").find("\"backend\": \"embree\""), std::string::npos);
+  // auto: CUDA where there is a device, else Embree.
+  EXPECT_NE(stats_backend("auto").find(device ? "\"backend\": \"cuda\"" : "\"backend\": \"embree\""), std::string::npos);
   const std::string out = (dir_ / "cuda.exr").string();
   if (device) {
     EXPECT_EQ(run("render -q --backend cuda --spp 4 --res 16x12 --no-preview -o " + out).exit_code, 0);
