@@ -63,6 +63,13 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
                   "--guide neural: Adam steps after each learning pass (each all-reduces the gradients in a farm)")
       ->check(CLI::Range(int64_t{1}, int64_t{1024}));
   cmd->add_option("--neural-lr", a.neural_lr, "--guide neural: Adam's learning rate")->check(finite_range(1e-6, 1.0));
+  cmd->add_option("--neural-targets", a.neural_targets,
+                  "--guide neural: learning targets a tile keeps per learning pass, on average (training time grows with it)")
+      ->check(CLI::Range(int64_t{1}, int64_t{1} << 20));
+  cmd->add_option("--neural-table", a.neural_table_log2,
+                  "--guide neural: entries per hash-grid level, as a power of two (default 11: 2048 entries; 12 is "
+                  "the largest whose state stays under 1 MB)")
+      ->check(CLI::Range(int64_t{kNeuralMinTableLog2}, int64_t{kNeuralMaxTableLog2}));
 }
 
 void apply_guide_render_options(const GuideArgs& a, RenderOptions* opt) {
@@ -114,6 +121,8 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
     nc.width = static_cast<uint32_t>(a.neural_width);
     nc.steps_per_pass = static_cast<uint32_t>(a.neural_steps);
     nc.learning_rate = static_cast<Float>(a.neural_lr);
+    nc.tile_targets = static_cast<uint32_t>(a.neural_targets);
+    nc.table_log2 = static_cast<uint32_t>(a.neural_table_log2);
     if (a.mix) nc.guide_prob = static_cast<Float>(*a.mix);
     return std::make_unique<NeuralGuide>(nc, b.lo, b.hi, scene.max_emitted_radiance());
   }
@@ -155,7 +164,7 @@ std::string describe_guide(const Guide& guide) {
     std::snprintf(b, sizeof b,
                   "hash grid %u levels x %u entries x %u features + normal, MLP 2 x %u, %u direction bins, "
                   "%u Adam steps per pass (learning rate %g), %.2f MB",
-                  kNeuralLevels, kNeuralTableSize, kNeuralFeatures, c.width, kNeuralBins, c.steps_per_pass,
+                  kNeuralLevels, 1u << c.table_log2, kNeuralFeatures, c.width, kNeuralBins, c.steps_per_pass,
                   static_cast<double>(c.learning_rate), n->stats().bytes / 1048576.0);
   } else {
     return guide.mode();

@@ -35,6 +35,8 @@ struct GuideArgs {
   int64_t neural_width = NeuralGuideConfig{}.width;
   int64_t neural_steps = NeuralGuideConfig{}.steps_per_pass;
   double neural_lr = NeuralGuideConfig{}.learning_rate;
+  int64_t neural_targets = NeuralGuideConfig{}.tile_targets;
+  int64_t neural_table_log2 = NeuralGuideConfig{}.table_log2;
 };
 
 void add_guide_options(CLI::App* cmd, GuideArgs& args);

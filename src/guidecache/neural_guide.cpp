@@ -22,7 +22,10 @@ constexpr double kGradScale = 16777216.0;
 constexpr double kGradLimit = 17592186044416.0;
 constexpr double kLossScale = 1048576.0;
 constexpr double kLossLimit = 1e6;                 // per target, for the loss statistic only
-constexpr float kLossEps = 1e-3f;                  // relative L2's denominator floor (in units of the output scale)
+// Relative L2's denominator floor, in units of the output scale squared.
+// Below sqrt(eps) a bin's gradient fades: a large floor leaves dark bins
+// too bright, which flattens the distribution (docs/neural-guide.md).
+constexpr float kLossEps = 1e-6f;
 constexpr float kGradClip = 10.f;                  // |dL/d output| per target
 constexpr double kAdamBeta1 = 0.9, kAdamBeta2 = 0.99, kAdamEps = 1e-10;
 // Target statistics of round 0: fixed point with unit radiance_scale * 2^-20.
@@ -57,7 +60,7 @@ NeuralGuide::NeuralGuide(const NeuralGuideConfig& config, const Vec3& lo, const 
 }
 
 void NeuralGuide::init_params() {
-  const NeuralLayout L{config_.width};
+  const NeuralLayout L{config_.width, config_.table_log2};
   params_.assign(L.size(), 0.f);
   adam_m_.assign(L.size(), 0.f);
   adam_v_.assign(L.size(), 0.f);
@@ -93,6 +96,7 @@ NeuralGuideView NeuralGuide::view() const {
   NeuralGuideView v;
   v.params = params_.data();
   v.width = config_.width;
+  v.table_log2 = config_.table_log2;
   v.lo = lo_;
   v.extent = extent_;
   v.scale = scale_ > 0.f ? scale_ : radiance_scale_;
@@ -117,7 +121,7 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
                                   std::vector<float>* grad, uint64_t* count, std::vector<uint32_t>* touched) const {
   using Mat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
   using Vec = Eigen::Matrix<float, Eigen::Dynamic, 1>;
-  const NeuralLayout L{config_.width};
+  const NeuralLayout L{config_.width, config_.table_log2};
   const Eigen::Index W = config_.width;
   const size_t n = samples.size();
   const Eigen::Index B = n > first ? static_cast<Eigen::Index>((n - first + stride - 1) / stride) : 0;
@@ -171,8 +175,8 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
     for (uint32_t l = 0; l < kNeuralLevels; ++l) {
       uint32_t entry[8];
       Float weight[8];
-      neural_level_corners(l, u, entry, weight);
-      const uint32_t level_base = L.grid() + l * kNeuralTableSize * kNeuralFeatures;
+      neural_level_corners(L.table_size(), l, u, entry, weight);
+      const uint32_t level_base = L.grid() + l * L.table_size() * kNeuralFeatures;
       for (uint32_t c = 0; c < 8; ++c)
         for (uint32_t f = 0; f < kNeuralFeatures; ++f) {
           const uint32_t k = level_base + entry[c] * kNeuralFeatures + f;
@@ -215,7 +219,7 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
   const uint32_t first = round - 1, stride = config_.steps_per_pass;
   // A tile touches the layers (dense) and a few hash-grid entries: only
   // those are quantised and cleared again, not every parameter per tile.
-  const size_t layers = NeuralLayout{config_.width}.w1();
+  const size_t layers = NeuralLayout{config_.width, config_.table_log2}.w1();
   struct Local {
     std::vector<int64_t> sum;
     std::vector<float> grad;  // all zero between tiles

@@ -29,16 +29,24 @@
 namespace tessera {
 
 struct NeuralGuideConfig {
-  // Neurons per hidden layer (two layers), at most kNeuralMaxWidth. 16 gave
-  // the error of 32 and 64 at equal samples (docs/neural-guide.md) for less time.
-  uint32_t width = 16;
+  // Neurons per hidden layer (two layers), at most kNeuralMaxWidth. 4 to 64
+  // gave the same error at equal samples (docs/neural-guide.md); the output
+  // layer (width x 144) is most of an inference's arithmetic.
+  uint32_t width = 8;
   // Adam steps (gradient all-reductions) after each learning pass. At equal
   // samples 64 did no better than 16; 8 halves the training time of 16.
   uint32_t steps_per_pass = 8;
   Float learning_rate = 5e-3f;
   Float guide_prob = 0.5f;           // mixture weight of guided sampling once trained
   Float floor = 0.02f;               // uniform share of each distribution (as the table's)
-  uint32_t tile_targets = 1024;      // learning targets kept per tile on average (the rest are skipped)
+  // Learning targets a tile keeps per learning pass, on average (the rest
+  // are skipped). 64 to 1024 gave the same error at equal samples
+  // (docs/neural-guide.md); training time grows with it.
+  uint32_t tile_targets = 128;
+  // Entries per hash-grid level: 2^table_log2. 2^11 to 2^16 gave the same
+  // error at equal samples; 12 is the largest whose parameters and Adam's
+  // moments stay under 1 MB.
+  uint32_t table_log2 = 11;
   uint64_t seed = 1;                 // weight initialisation
   bool operator==(const NeuralGuideConfig&) const = default;
 };

@@ -17,7 +17,7 @@ namespace tessera {
 
 template <class Archive>
 void serialize(Archive& ar, NeuralGuideConfig& c) {
-  ar(c.width, c.steps_per_pass, c.learning_rate, c.guide_prob, c.floor, c.tile_targets, c.seed);
+  ar(c.width, c.steps_per_pass, c.learning_rate, c.guide_prob, c.floor, c.tile_targets, c.table_log2, c.seed);
 }
 
 template <class Archive>
@@ -30,7 +30,7 @@ void NeuralGuide::serialize(Archive& ar) {
 namespace {
 constexpr char kNeuralMagic[] = "tessera-neural-guide";
 constexpr char kTableMagic[] = "tessera-guide-cache";
-constexpr uint32_t kNeuralVersion = 1;
+constexpr uint32_t kNeuralVersion = 2;  // 2: the hash table's size is a setting
 }  // namespace
 
 void NeuralGuide::save(std::ostream& out, uint64_t scene_fingerprint) const {
@@ -65,7 +65,9 @@ std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_
   }
   // Every field a later pass relies on: a damaged file is refused here, never rendered with.
   const NeuralGuideConfig& c = g->config_;
-  const NeuralLayout L{c.width};
+  if (c.table_log2 < kNeuralMinTableLog2 || c.table_log2 > kNeuralMaxTableLog2)
+    throw std::runtime_error("corrupt neural guide (hash table size out of range)");
+  const NeuralLayout L{c.width, c.table_log2};
   auto finite_in = [](float x, float lo, float hi) { return std::isfinite(x) && x >= lo && x <= hi; };
   bool ok = c.width >= 1 && c.width <= kNeuralMaxWidth && c.steps_per_pass >= 1 && c.steps_per_pass <= 1024 &&
             c.tile_targets >= 1 && c.tile_targets <= (1u << 20) && finite_in(c.learning_rate, 1e-9f, 1.f) &&

@@ -25,7 +25,8 @@ constexpr uint32_t kNeuralGrid = 12;                       // bins per side, as 
 constexpr uint32_t kNeuralBins = kNeuralGrid * kNeuralGrid;  // 144
 constexpr uint32_t kNeuralLevels = 8;                      // hash-grid levels
 constexpr uint32_t kNeuralFeatures = 2;                    // features per level
-constexpr uint32_t kNeuralTableSize = 1u << 11;            // entries per level
+// Entries per level: 2^table_log2 (NeuralGuideConfig::table_log2), within these bounds.
+constexpr uint32_t kNeuralMinTableLog2 = 8, kNeuralMaxTableLog2 = 20;
 constexpr uint32_t kNeuralEncoded = kNeuralLevels * kNeuralFeatures;
 constexpr uint32_t kNeuralInputs = kNeuralEncoded + 3;     // encoding, then the normal
 constexpr uint32_t kNeuralMaxWidth = 64;
@@ -38,9 +39,11 @@ constexpr Float kNeuralMinLog = -30.f, kNeuralMaxLog = 20.f;
 // scaled columns: contiguous, independent lanes that compilers vectorise
 // without reassociating sums.
 struct NeuralLayout {
-  uint32_t width = 16;
+  uint32_t width;
+  uint32_t table_log2;  // entries per hash-grid level: 2^table_log2
+  TESSERA_HOST_DEVICE uint32_t table_size() const { return 1u << table_log2; }
   TESSERA_HOST_DEVICE uint32_t grid() const { return 0; }
-  TESSERA_HOST_DEVICE uint32_t w1() const { return kNeuralLevels * kNeuralTableSize * kNeuralFeatures; }
+  TESSERA_HOST_DEVICE uint32_t w1() const { return kNeuralLevels * table_size() * kNeuralFeatures; }
   TESSERA_HOST_DEVICE uint32_t b1() const { return w1() + kNeuralInputs * width; }
   TESSERA_HOST_DEVICE uint32_t w2() const { return b1() + width; }
   TESSERA_HOST_DEVICE uint32_t b2() const { return w2() + width * width; }
@@ -77,8 +80,9 @@ struct NeuralSampleSink {
 };
 
 struct NeuralGuideView {
-  const float* params = nullptr;  // NeuralLayout(width) blocks
-  uint32_t width = 16;
+  const float* params = nullptr;  // NeuralLayout{width, table_log2} blocks
+  uint32_t width = 8;
+  uint32_t table_log2 = 11;
   Vec3 lo{0.f};                   // the encoded cube: [lo, lo + extent]^3 (the scene's bounds)
   Float extent = 1.f;
   Float scale = 1.f;              // Q = scale * exp(output)
@@ -128,13 +132,15 @@ TESSERA_HOST_DEVICE inline uint32_t neural_level_resolution(uint32_t level) {
   return res[level];
 }
 
-// Table entry of grid vertex (x, y, z) at a level with res cells per side:
-// dense while the level's vertices fit the table, hashed beyond (the
-// primes of Teschner et al., as instant-ngp).
-TESSERA_HOST_DEVICE inline uint32_t neural_grid_entry(uint32_t res, uint32_t x, uint32_t y, uint32_t z) {
+// Entry of grid vertex (x, y, z) in a level's table of table_size (a power
+// of two) entries, at a level with res cells per side: dense while the
+// level's vertices fit the table, hashed beyond (the primes of Teschner et
+// al., as instant-ngp).
+TESSERA_HOST_DEVICE inline uint32_t neural_grid_entry(uint32_t table_size, uint32_t res, uint32_t x, uint32_t y,
+                                                      uint32_t z) {
   const uint32_t side = res + 1;
-  if (side * side * side <= kNeuralTableSize) return (z * side + y) * side + x;
-  return (x ^ (y * 2654435761u) ^ (z * 805459861u)) & (kNeuralTableSize - 1);
+  if (side * side * side <= table_size) return (z * side + y) * side + x;
+  return (x ^ (y * 2654435761u) ^ (z * 805459861u)) & (table_size - 1);
 }
 
 // Position in the unit cube of the encoding (clamped: points on or beyond the bounds).
@@ -146,7 +152,8 @@ TESSERA_HOST_DEVICE inline Vec3 neural_unit_position(const NeuralGuideView& v, c
 
 // The 8 grid vertices around unit position u at a level and their
 // trilinear weights (shared by inference and training).
-TESSERA_HOST_DEVICE inline void neural_level_corners(uint32_t level, const Vec3& u, uint32_t entry[8], Float weight[8]) {
+TESSERA_HOST_DEVICE inline void neural_level_corners(uint32_t table_size, uint32_t level, const Vec3& u, uint32_t entry[8],
+                                                     Float weight[8]) {
   const uint32_t res = neural_level_resolution(level);
   const Vec3 x = u * static_cast<Float>(res);
   uint32_t i0[3];
@@ -157,7 +164,7 @@ TESSERA_HOST_DEVICE inline void neural_level_corners(uint32_t level, const Vec3&
   }
   for (uint32_t c = 0; c < 8; ++c) {
     const uint32_t dx = c & 1u, dy = (c >> 1) & 1u, dz = (c >> 2) & 1u;
-    entry[c] = neural_grid_entry(res, i0[0] + dx, i0[1] + dy, i0[2] + dz);
+    entry[c] = neural_grid_entry(table_size, res, i0[0] + dx, i0[1] + dy, i0[2] + dz);
     weight[c] = (dx ? f[0] : 1.f - f[0]) * (dy ? f[1] : 1.f - f[1]) * (dz ? f[2] : 1.f - f[2]);
   }
 }
@@ -165,11 +172,12 @@ TESSERA_HOST_DEVICE inline void neural_level_corners(uint32_t level, const Vec3&
 // The network's input for a point and normal: kNeuralInputs floats.
 TESSERA_HOST_DEVICE inline void neural_encode(const NeuralGuideView& v, const Vec3& p, const Vec3& n, Float* in) {
   const Vec3 u = neural_unit_position(v, p);
+  const uint32_t table_size = 1u << v.table_log2;
   for (uint32_t l = 0; l < kNeuralLevels; ++l) {
     uint32_t entry[8];
     Float weight[8];
-    neural_level_corners(l, u, entry, weight);
-    const float* table = v.params + (static_cast<size_t>(l) * kNeuralTableSize) * kNeuralFeatures;
+    neural_level_corners(table_size, l, u, entry, weight);
+    const float* table = v.params + (static_cast<size_t>(l) * table_size) * kNeuralFeatures;
     Float f0 = 0.f, f1 = 0.f;
     for (uint32_t c = 0; c < 8; ++c) {
       f0 += weight[c] * table[entry[c] * kNeuralFeatures];
@@ -200,7 +208,7 @@ TESSERA_HOST_DEVICE inline void neural_layer(const float* w, const float* b, con
 // Runs the network at a vertex (p on a surface whose normal on the path's
 // side is n) and builds the site's distribution.
 TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site) {
-  const NeuralLayout L{v.width};
+  const NeuralLayout L{v.width, v.table_log2};
   Float in[kNeuralInputs], h1[kNeuralMaxWidth], h2[kNeuralMaxWidth];
   neural_encode(v, p, n, in);
   neural_layer(v.params + L.w1(), v.params + L.b1(), in, kNeuralInputs, v.width, true, h1);

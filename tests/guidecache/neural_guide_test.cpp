@@ -63,7 +63,7 @@ TEST(NeuralGuide, GradientMatchesFiniteDifferences) {
   // Larger hash features than the initial ones, so their gradients are not all tiny.
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-0.5f, 0.5f);
-  const NeuralLayout L{8};
+  const NeuralLayout L{8, NeuralGuideConfig{}.table_log2};
   for (uint32_t i = L.grid(); i < L.w1(); ++i) g.mutable_params()[i] = u(rng);
   // Targets near the predictions: the per-target gradient is not clipped.
   std::vector<NeuralTrainingSample> samples = random_samples(12, 5, 1.f);
@@ -198,6 +198,30 @@ TEST(NeuralGuide, SaveAndLoadAreExact) {
   g.train_on({{0, random_samples(64, 3, 1.f)}});
   loaded->train_on({{0, random_samples(64, 3, 1.f)}});
   EXPECT_TRUE(*loaded == g);
+}
+
+// The hash table's size (--neural-table) is the state's size: a larger
+// table has 2 features x 8 levels more per doubling, round-trips through a
+// file, and its inference reads only its own entries (finite everywhere).
+TEST(NeuralGuide, HashTableSizeIsASettingThatRoundTrips) {
+  NeuralGuideConfig c = small_config();
+  NeuralGuide small = make(c);
+  c.table_log2 = small_config().table_log2 + 1;
+  NeuralGuide large = make(c);
+  EXPECT_EQ(large.params().size() - small.params().size(),
+            size_t{kNeuralLevels} * kNeuralFeatures * (size_t{1} << small_config().table_log2));
+  large.train_on({{0, random_samples(200, 1, 2.f)}});
+  std::stringstream bytes;
+  large.save(bytes, 3);
+  std::unique_ptr<NeuralGuide> loaded = NeuralGuide::load(bytes, 3);
+  EXPECT_TRUE(*loaded == large);
+  EXPECT_EQ(loaded->config().table_log2, c.table_log2);
+  const NeuralGuideView v = loaded->view();
+  NeuralSite site;
+  for (float x : {0.f, 0.37f, 1.f}) {
+    neural_infer(v, Vec3(x, 1.f - x, 0.5f * x), Vec3(0.f, 1.f, 0.f), &site);
+    for (uint32_t j = 0; j < kNeuralBins; ++j) ASSERT_TRUE(std::isfinite(site.q[j]) && site.pmf[j] > 0.f);
+  }
 }
 
 TEST(NeuralGuide, LoadRejectsOtherScenesAndDamage) {
