@@ -96,7 +96,7 @@ def convergence_run(a, scene, scene_path, method, ref):
     shutil.rmtree(stem + "-snapshots", ignore_errors=True)
     cmd = [a.tessera, "render", scene_path, "-q", "--no-preview", "--guide", method, "--time", str(a.time),
            "--seed", str(a.seed), "--snapshot-every", "doubling", "--stats", stem + ".json", "-o", stem + ".exr",
-           *a.thread_args]
+           *a.thread_args, "--backend", a.backend]
     run(cmd)
     with open(stem + ".json") as f:
         stats = json.load(f)
@@ -119,7 +119,7 @@ def stop_run(a, scene, scene_path, method, ref, target, seed):
     stem = os.path.join(a.out, f"{scene}-{method}-target")
     cmd = [a.tessera, "render", scene_path, "-q", "--no-preview", "--guide", method, "--target-error", f"{target:.6g}",
            "--time", str(2 * a.time), "--seed", str(seed), "--stats", stem + ".json", "-o", stem + ".exr",
-           *a.thread_args]
+           *a.thread_args, "--backend", a.backend]
     run(cmd)
     with open(stem + ".json") as f:
         stats = json.load(f)
@@ -339,6 +339,7 @@ def main():
     ap.add_argument("--time", type=float, default=30.0, help="wall-clock seconds per render")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--threads", type=int, default=0, help="0 = all cores")
+    ap.add_argument("--backend", default="embree", help="what renders every method (default embree: on a GPU machine auto would put some methods on the GPU and the neural guide on the CPU, and their times would not compare)")
     ap.add_argument("--stop-repeats", type=int, default=3, help="seeds per scene and method for the stopping rule")
     ap.add_argument("--ref-spp", type=int, default=ref_cache.DEFAULT_SPP)
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "accuracy"), help="renders and snapshots")

@@ -76,6 +76,7 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--ref-spp", type=int, default=8192)
     ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--backend", default="embree", help="what renders every method (default embree: on a GPU machine auto would put some methods on the GPU and the neural guide on the CPU, and their times would not compare)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench-guiding"))
     ap.add_argument("--results", default="results.json", help="file name of the results, in --out")
     ap.add_argument("--guide-args", default="", help="extra options for the guided methods, e.g. '--guide-budget 4'")
@@ -113,7 +114,8 @@ def main():
                 extra = a.guide_args.split() if method != "none" else []
                 method_args = METHOD_ARGS.get(method, ["--guide", method])
                 run([a.tessera, "render", path, "-q", "--no-preview", *method_args, "--time", str(a.time),
-                     "--seed", str(rep + 1), "--stats", st, "-o", img, *threads, *extra, *res, *sampler])
+                     "--seed", str(rep + 1), "--stats", st, "-o", img, *threads, *extra, *res, *sampler,
+                     "--backend", a.backend])
                 s = json.load(open(st))
                 if a.no_reference:
                     c = {"relmse": s["estimated_relmse"], "reference_estimated_relmse": 0.0}

@@ -406,15 +406,25 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, PassExecutor&
 }
 
 // This process's backend (--backend), built over the scene; the log says
-// which and, for auto, why.
+// which and, for auto, why. auto falls back to Embree where the device it
+// picked cannot take the scene (out of device memory, say).
 std::unique_ptr<TileBackend> backend_for(const RenderArgs& a, const MasterSetup& m, bool log) {
   std::string why;
   const bool neural = m.guide && (m.guide->spec_bits() & kSpecNeural);
-  const std::string name = resolve_backend(a.backend, m.scene.get(), m.opt.light_paths, &why, neural);
+  std::string name = resolve_backend(a.backend, m.scene.get(), m.opt.light_paths, &why, neural);
   if (neural && name != "embree" && name != "bvh")
     throw std::runtime_error("--backend " + name + " has no neural guide yet (--backend embree or bvh has)");
+  std::unique_ptr<TileBackend> backend;
+  try {
+    backend = make_tile_backend(name, *m.scene, render_threads(m.opt), m.opt.light_paths);
+  } catch (const std::exception& e) {
+    if (a.backend != "auto" || name == "embree") throw;
+    why = "auto: " + name + " failed: " + e.what();
+    name = "embree";
+    backend = make_tile_backend(name, *m.scene, render_threads(m.opt), m.opt.light_paths);
+  }
   if (log) std::fprintf(stderr, "tessera: backend: %s%s%s\n", name.c_str(), why.empty() ? "" : " (", why.empty() ? "" : (why + ")").c_str());
-  return make_tile_backend(name, *m.scene, render_threads(m.opt), m.opt.light_paths);
+  return backend;
 }
 
 int run_render_local(const RenderArgs& a) {

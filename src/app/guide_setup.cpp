@@ -67,8 +67,9 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
                   "--guide neural: learning targets a tile keeps per learning pass, on average (training time grows with it)")
       ->check(CLI::Range(int64_t{1}, int64_t{1} << 20));
   cmd->add_option("--neural-table", a.neural_table_log2,
-                  "--guide neural: entries per hash-grid level, as a power of two (default 11: 2048 entries; 12 is "
-                  "the largest whose state stays under 1 MB)")
+                  "--guide neural: entries per hash-grid level, as a power of two (default " +
+                      std::to_string(NeuralGuideConfig{}.table_log2) +
+                      "; 12 is the largest whose state stays under 1 MB; the state doubles with each step)")
       ->check(CLI::Range(int64_t{kNeuralMinTableLog2}, int64_t{kNeuralMaxTableLog2}));
 }
 

@@ -22,10 +22,6 @@ constexpr double kGradScale = 16777216.0;
 constexpr double kGradLimit = 17592186044416.0;
 constexpr double kLossScale = 1048576.0;
 constexpr double kLossLimit = 1e6;                 // per target, for the loss statistic only
-// Relative L2's denominator floor, in units of the output scale squared.
-// Below sqrt(eps) a bin's gradient fades: a large floor leaves dark bins
-// too bright, which flattens the distribution (docs/neural-guide.md).
-constexpr float kLossEps = 1e-6f;
 constexpr float kGradClip = 10.f;                  // |dL/d output| per target
 constexpr double kAdamBeta1 = 0.9, kAdamBeta2 = 0.99, kAdamEps = 1e-10;
 // Target statistics of round 0: fixed point with unit radiance_scale * 2^-20.
@@ -51,6 +47,11 @@ NeuralGuide::NeuralGuide(const NeuralGuideConfig& config, const Vec3& lo, const 
   if (config_.width < 1 || config_.width > kNeuralMaxWidth)
     throw std::runtime_error("neural guide: width must be 1.." + std::to_string(kNeuralMaxWidth));
   if (config_.steps_per_pass < 1) throw std::runtime_error("neural guide: at least one step per pass");
+  if (config_.table_log2 < kNeuralMinTableLog2 || config_.table_log2 > kNeuralMaxTableLog2)
+    throw std::runtime_error("neural guide: hash table of 2^" + std::to_string(config_.table_log2) + " entries (2^" +
+                             std::to_string(kNeuralMinTableLog2) + " to 2^" + std::to_string(kNeuralMaxTableLog2) + ")");
+  if (config_.tile_targets < 1 || config_.tile_targets > (1u << 20))
+    throw std::runtime_error("neural guide: " + std::to_string(config_.tile_targets) + " targets per tile (1 to 2^20)");
   const Vec3 d = hi - lo;
   extent_ = std::max({d.x, d.y, d.z, 1e-6f}) * 1.001f;
   lo_ = lo - Vec3(extent_ * 0.0005f);
@@ -156,7 +157,7 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
     const float o = W3.row(bin).dot(H2.col(b)) + b3[bin];
     const float q = neural_exp(o);
     const float t = s.target / scale;
-    const float denom = q * q + kLossEps;
+    const float denom = q * q + kNeuralLossEps;
     loss += std::min(static_cast<double>((q - t) * (q - t) / denom), kLossLimit);
     const float go = std::clamp(2.f * (q - t) * q / denom, -kGradClip, kGradClip);
     gW3.row(bin) += go * H2.col(b).transpose();

@@ -29,9 +29,9 @@
 namespace tessera {
 
 struct NeuralGuideConfig {
-  // Neurons per hidden layer (two layers), at most kNeuralMaxWidth. 4 to 64
-  // gave the same error at equal samples (docs/neural-guide.md); the output
-  // layer (width x 144) is most of an inference's arithmetic.
+  // Neurons per hidden layer (two layers), at most kNeuralMaxWidth. Wider
+  // did not lower the error (docs/neural-guide.md), and the output layer
+  // (width x 144) is most of an inference's arithmetic.
   uint32_t width = 8;
   // Adam steps (gradient all-reductions) after each learning pass. At equal
   // samples 64 did no better than 16; 8 halves the training time of 16.
@@ -40,16 +40,21 @@ struct NeuralGuideConfig {
   Float guide_prob = 0.5f;           // mixture weight of guided sampling once trained
   Float floor = 0.02f;               // uniform share of each distribution (as the table's)
   // Learning targets a tile keeps per learning pass, on average (the rest
-  // are skipped). 64 to 1024 gave the same error at equal samples
-  // (docs/neural-guide.md); training time grows with it.
+  // are skipped). Training time grows with it; more did not lower the
+  // error (docs/neural-guide.md).
   uint32_t tile_targets = 128;
-  // Entries per hash-grid level: 2^table_log2. 2^11 to 2^16 gave the same
-  // error at equal samples; 12 is the largest whose parameters and Adam's
-  // moments stay under 1 MB.
+  // Entries per hash-grid level: 2^table_log2, in [kNeuralMinTableLog2,
+  // kNeuralMaxTableLog2]. A larger table did not lower the error; 12 is the
+  // largest whose parameters and Adam's moments stay under 1 MB.
   uint32_t table_log2 = 11;
   uint64_t seed = 1;                 // weight initialisation
   bool operator==(const NeuralGuideConfig&) const = default;
 };
+
+// Relative L2's denominator floor, in units of the output scale squared.
+// Below sqrt(eps) a bin's gradient fades: a large floor leaves dark bins
+// too bright, which flattens the distribution (docs/neural-guide.md).
+constexpr float kNeuralLossEps = 1e-6f;
 
 struct NeuralGuideStats {
   uint64_t params = 0;

@@ -25,8 +25,10 @@ constexpr uint32_t kNeuralGrid = 12;                       // bins per side, as 
 constexpr uint32_t kNeuralBins = kNeuralGrid * kNeuralGrid;  // 144
 constexpr uint32_t kNeuralLevels = 8;                      // hash-grid levels
 constexpr uint32_t kNeuralFeatures = 2;                    // features per level
-// Entries per level: 2^table_log2 (NeuralGuideConfig::table_log2), within these bounds.
-constexpr uint32_t kNeuralMinTableLog2 = 8, kNeuralMaxTableLog2 = 20;
+// Entries per level: 2^table_log2 (NeuralGuideConfig::table_log2), within
+// these bounds (at 2^16 the state is 12 MB, and every training thread holds
+// a gradient of that size).
+constexpr uint32_t kNeuralMinTableLog2 = 8, kNeuralMaxTableLog2 = 16;
 constexpr uint32_t kNeuralEncoded = kNeuralLevels * kNeuralFeatures;
 constexpr uint32_t kNeuralInputs = kNeuralEncoded + 3;     // encoding, then the normal
 constexpr uint32_t kNeuralMaxWidth = 64;
@@ -41,6 +43,7 @@ constexpr Float kNeuralMinLog = -30.f, kNeuralMaxLog = 20.f;
 struct NeuralLayout {
   uint32_t width;
   uint32_t table_log2;  // entries per hash-grid level: 2^table_log2
+  TESSERA_HOST_DEVICE NeuralLayout(uint32_t width_, uint32_t table_log2_) : width(width_), table_log2(table_log2_) {}
   TESSERA_HOST_DEVICE uint32_t table_size() const { return 1u << table_log2; }
   TESSERA_HOST_DEVICE uint32_t grid() const { return 0; }
   TESSERA_HOST_DEVICE uint32_t w1() const { return kNeuralLevels * table_size() * kNeuralFeatures; }
@@ -81,7 +84,7 @@ struct NeuralSampleSink {
 
 struct NeuralGuideView {
   const float* params = nullptr;  // NeuralLayout{width, table_log2} blocks
-  uint32_t width = 8;
+  uint32_t width = 8;             // NeuralGuide::view fills every field; these are NeuralGuideConfig's defaults
   uint32_t table_log2 = 11;
   Vec3 lo{0.f};                   // the encoded cube: [lo, lo + extent]^3 (the scene's bounds)
   Float extent = 1.f;
@@ -92,7 +95,7 @@ struct NeuralGuideView {
   Float max_target = 3.4e38f;     // larger targets are rejected (and counted), never clamped
   const Vec3* bin_dirs = nullptr;  // kNeuralBins centre directions (as GuideView::bin_dirs)
   const Float* bin_dir_soa = nullptr;  // the same, as x[kNeuralBins], y[...], z[...] (a loop over bins vectorises)
-  uint32_t tile_targets = 1024;   // learning targets a tile keeps on average (NeuralSampleSink::keep_prob)
+  uint32_t tile_targets = 128;    // learning targets a tile keeps on average (NeuralSampleSink::keep_prob)
   NeuralSampleSink* sink = nullptr;  // the calling thread's (null: targets are not recorded)
 };
 

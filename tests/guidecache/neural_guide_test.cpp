@@ -51,7 +51,7 @@ double frozen_loss(const NeuralGuide& g, const std::vector<NeuralTrainingSample>
   double sum = 0.0;
   const double scale = g.output_scale();
   for (size_t i = 0; i < s.size(); ++i) {
-    const double q = predicted(g, s[i]) / scale, t = s[i].target / scale, d = q0[i] * q0[i] + 1e-3;
+    const double q = predicted(g, s[i]) / scale, t = s[i].target / scale, d = q0[i] * q0[i] + kNeuralLossEps;
     sum += (q - t) * (q - t) / d;
   }
   return sum / static_cast<double>(s.size());
@@ -63,7 +63,7 @@ TEST(NeuralGuide, GradientMatchesFiniteDifferences) {
   // Larger hash features than the initial ones, so their gradients are not all tiny.
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-0.5f, 0.5f);
-  const NeuralLayout L{8, NeuralGuideConfig{}.table_log2};
+  const NeuralLayout L{g.config().width, g.config().table_log2};
   for (uint32_t i = L.grid(); i < L.w1(); ++i) g.mutable_params()[i] = u(rng);
   // Targets near the predictions: the per-target gradient is not clipped.
   std::vector<NeuralTrainingSample> samples = random_samples(12, 5, 1.f);
@@ -200,27 +200,51 @@ TEST(NeuralGuide, SaveAndLoadAreExact) {
   EXPECT_TRUE(*loaded == g);
 }
 
-// The hash table's size (--neural-table) is the state's size: a larger
-// table has 2 features x 8 levels more per doubling, round-trips through a
-// file, and its inference reads only its own entries (finite everywhere).
+// The hash table's size (--neural-table) is the state's size: doubling it
+// adds levels x features x 2^L parameters. It reaches the view and round-
+// trips through a file, and inference and training read the same table: a
+// guide trained on targets equal to its own predictions has zero loss. (The
+// smallest table, below the default: a view left at the default would read
+// past the parameters.)
 TEST(NeuralGuide, HashTableSizeIsASettingThatRoundTrips) {
   NeuralGuideConfig c = small_config();
+  c.table_log2 = kNeuralMinTableLog2;
   NeuralGuide small = make(c);
-  c.table_log2 = small_config().table_log2 + 1;
+  ASSERT_LT(c.table_log2, NeuralGuideConfig{}.table_log2);
+  c.table_log2 += 1;
   NeuralGuide large = make(c);
   EXPECT_EQ(large.params().size() - small.params().size(),
-            size_t{kNeuralLevels} * kNeuralFeatures * (size_t{1} << small_config().table_log2));
-  large.train_on({{0, random_samples(200, 1, 2.f)}});
+            size_t{kNeuralLevels} * kNeuralFeatures * (size_t{1} << kNeuralMinTableLog2));
+  EXPECT_EQ(small.view().table_log2, kNeuralMinTableLog2);
+  small.train_on({{0, random_samples(200, 1, 2.f)}});
   std::stringstream bytes;
-  large.save(bytes, 3);
+  small.save(bytes, 3);
   std::unique_ptr<NeuralGuide> loaded = NeuralGuide::load(bytes, 3);
-  EXPECT_TRUE(*loaded == large);
-  EXPECT_EQ(loaded->config().table_log2, c.table_log2);
-  const NeuralGuideView v = loaded->view();
-  NeuralSite site;
-  for (float x : {0.f, 0.37f, 1.f}) {
-    neural_infer(v, Vec3(x, 1.f - x, 0.5f * x), Vec3(0.f, 1.f, 0.f), &site);
-    for (uint32_t j = 0; j < kNeuralBins; ++j) ASSERT_TRUE(std::isfinite(site.q[j]) && site.pmf[j] > 0.f);
+  EXPECT_TRUE(*loaded == small);
+  EXPECT_EQ(loaded->config().table_log2, kNeuralMinTableLog2);
+  std::vector<NeuralTrainingSample> own = random_samples(40, 9, 1.f);
+  for (NeuralTrainingSample& s : own) {
+    s.target = static_cast<float>(predicted(*loaded, s));
+    ASSERT_TRUE(std::isfinite(s.target) && s.target > 0.f);
+  }
+  std::vector<float> grad;
+  EXPECT_LT(loaded->loss_and_gradient(own, &grad), 1e-8);
+  // Out of range: refused when made, and when loaded from a file.
+  c.table_log2 = kNeuralMaxTableLog2 + 1;
+  EXPECT_THROW(make(c), std::runtime_error);
+  c.table_log2 = kNeuralMinTableLog2 - 1;
+  EXPECT_THROW(make(c), std::runtime_error);
+  std::string file = bytes.str();
+  // The config follows the magic, cereal's endianness byte, the version and
+  // the scene fingerprint: width, steps, rate, mixture, floor, targets, table.
+  const size_t at = sizeof "tessera-neural-guide" + 1 + 4 + 8 + 4 * 6;
+  uint32_t word = 0;
+  std::memcpy(&word, file.data() + at, 4);
+  ASSERT_EQ(word, kNeuralMinTableLog2) << "the file's layout changed: update the offset";
+  for (uint32_t bad : {0u, 40u, kNeuralMaxTableLog2 + 1}) {
+    std::memcpy(file.data() + at, &bad, 4);
+    std::stringstream damaged(file);
+    EXPECT_THROW(NeuralGuide::load(damaged, 3), std::runtime_error) << bad;
   }
 }
 
