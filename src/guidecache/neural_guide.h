@@ -33,8 +33,9 @@ struct NeuralGuideConfig {
   // did not lower the error (docs/neural-guide.md), and the output layer
   // (width x 144) is most of an inference's arithmetic.
   uint32_t width = 8;
-  // Adam steps (gradient all-reductions) after each learning pass. At equal
-  // samples 64 did no better than 16; 8 halves the training time of 16.
+  // Adam steps (gradient all-reductions) after each learning pass. More
+  // did not lower the error at equal samples (docs/neural-guide.md) and
+  // cost training time.
   uint32_t steps_per_pass = 8;
   Float learning_rate = 5e-3f;
   Float guide_prob = 0.5f;           // mixture weight of guided sampling once trained
