@@ -125,7 +125,7 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
     nc.tile_targets = static_cast<uint32_t>(a.neural_targets);
     nc.table_log2 = static_cast<uint32_t>(a.neural_table_log2);
     if (a.mix) nc.guide_prob = static_cast<Float>(*a.mix);
-    return std::make_unique<NeuralGuide>(nc, b.lo, b.hi, scene.max_emitted_radiance());
+    return std::make_unique<NeuralGuide>(nc, b.lo, b.hi, scene.max_emitted_radiance(), scene.view().num_lights);
   }
   GuideConfig cfg;
   cfg.budget_bytes = static_cast<uint64_t>(std::llround(a.budget_mb * 1048576.0));
@@ -164,8 +164,9 @@ std::string describe_guide(const Guide& guide) {
     const NeuralGuideConfig& c = n->config();
     std::snprintf(b, sizeof b,
                   "hash grid %u levels x %u entries x %u features + normal, MLP 2 x %u, %u direction bins, "
-                  "%u Adam steps per pass (learning rate %g), %.2f MB",
-                  kNeuralLevels, 1u << c.table_log2, kNeuralFeatures, c.width, kNeuralBins, c.steps_per_pass,
+                  "%s light selection, %u Adam steps per pass (learning rate %g), %.2f MB",
+                  kNeuralLevels, 1u << c.table_log2, kNeuralFeatures, c.width, kNeuralBins,
+                  n->learned_lights() ? "learned" : "power-based", c.steps_per_pass,
                   static_cast<double>(c.learning_rate), n->stats().bytes / 1048576.0);
   } else {
     return guide.mode();

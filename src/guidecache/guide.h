@@ -44,6 +44,11 @@ class Guide {
   virtual std::vector<uint64_t>& round_accumulators(uint32_t round) = 0;
   virtual void fold_round(uint32_t round) = 0;
 
+  // Whether passes that learn from every sample should be one sample per
+  // pixel each. The network's targets bootstrap from the network as it
+  // stood at the start of the pass, so what it learns converges per pass
+  // (a fixed number of light bounces deeper each time), not per sample.
+  virtual bool single_sample_learning_passes() const { return false; }
   // A fixed mixture weight of guided sampling (--guide-mix).
   virtual void set_guide_prob(Float p) = 0;
   // Versioned binary serialisation tied to a scene fingerprint.

@@ -22,7 +22,10 @@ constexpr double kGradScale = 16777216.0;
 constexpr double kGradLimit = 17592186044416.0;
 constexpr double kLossScale = 1048576.0;
 constexpr double kLossLimit = 1e6;                 // per target, for the loss statistic only
-constexpr float kGradClip = 10.f;                  // |dL/d output| per target
+// |dL/d output| per target: a bound on what one firefly target moves, loose
+// enough that rare bright targets (light through a gap, a light seen from
+// few points) still pull their means up (docs/neural-guide.md).
+constexpr float kGradClip = 100.f;
 constexpr double kAdamBeta1 = 0.9, kAdamBeta2 = 0.99, kAdamEps = 1e-10;
 // Target statistics of round 0: fixed point with unit radiance_scale * 2^-20.
 constexpr double kTargetUnit = 1.0 / 1048576.0;
@@ -42,8 +45,10 @@ int64_t from_word(uint64_t w) { return static_cast<int64_t>(w); }
 
 }  // namespace
 
-NeuralGuide::NeuralGuide(const NeuralGuideConfig& config, const Vec3& lo, const Vec3& hi, Float radiance_scale)
-    : config_(config) {
+NeuralGuide::NeuralGuide(const NeuralGuideConfig& config, const Vec3& lo, const Vec3& hi, Float radiance_scale,
+                         uint32_t num_lights)
+    : config_(config),
+      lights_(num_lights >= kNeuralMinLights && num_lights <= kNeuralMaxLights ? num_lights : 0u) {
   if (config_.width < 1 || config_.width > kNeuralMaxWidth)
     throw std::runtime_error("neural guide: width must be 1.." + std::to_string(kNeuralMaxWidth));
   if (config_.steps_per_pass < 1) throw std::runtime_error("neural guide: at least one step per pass");
@@ -61,7 +66,7 @@ NeuralGuide::NeuralGuide(const NeuralGuideConfig& config, const Vec3& lo, const 
 }
 
 void NeuralGuide::init_params() {
-  const NeuralLayout L{config_.width, config_.table_log2};
+  const NeuralLayout L = layout();
   params_.assign(L.size(), 0.f);
   adam_m_.assign(L.size(), 0.f);
   adam_v_.assign(L.size(), 0.f);
@@ -75,7 +80,7 @@ void NeuralGuide::init_params() {
   const float w = static_cast<float>(config_.width);
   fill(L.w1(), kNeuralInputs * config_.width, std::sqrt(6.f / kNeuralInputs));
   fill(L.w2(), config_.width * config_.width, std::sqrt(6.f / w));
-  fill(L.w3(), config_.width * kNeuralBins, 0.1f * std::sqrt(6.f / w));
+  fill(L.w3(), config_.width * L.outputs(), 0.1f * std::sqrt(6.f / w));
   build_bin_dirs();
 }
 
@@ -98,6 +103,7 @@ NeuralGuideView NeuralGuide::view() const {
   v.params = params_.data();
   v.width = config_.width;
   v.table_log2 = config_.table_log2;
+  v.lights = lights_;
   v.lo = lo_;
   v.extent = extent_;
   v.scale = scale_ > 0.f ? scale_ : radiance_scale_;
@@ -122,8 +128,8 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
                                   std::vector<float>* grad, uint64_t* count, std::vector<uint32_t>* touched) const {
   using Mat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
   using Vec = Eigen::Matrix<float, Eigen::Dynamic, 1>;
-  const NeuralLayout L{config_.width, config_.table_log2};
-  const Eigen::Index W = config_.width;
+  const NeuralLayout L = layout();
+  const Eigen::Index W = config_.width, O = L.outputs();
   const size_t n = samples.size();
   const Eigen::Index B = n > first ? static_cast<Eigen::Index>((n - first + stride - 1) / stride) : 0;
   *count = static_cast<uint64_t>(B);
@@ -141,19 +147,19 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
     neural_encode(v, Vec3(s.p[0], s.p[1], s.p[2]), Vec3(s.n[0], s.n[1], s.n[2]), X.col(b).data());
   }
   const float* P = params_.data();
-  Eigen::Map<const Mat> W1(P + L.w1(), W, kNeuralInputs), W2(P + L.w2(), W, W), W3(P + L.w3(), kNeuralBins, W);
-  Eigen::Map<const Vec> b1(P + L.b1(), W), b2(P + L.b2(), W), b3(P + L.b3(), kNeuralBins);
+  Eigen::Map<const Mat> W1(P + L.w1(), W, kNeuralInputs), W2(P + L.w2(), W, W), W3(P + L.w3(), O, W);
+  Eigen::Map<const Vec> b1(P + L.b1(), W), b2(P + L.b2(), W), b3(P + L.b3(), O);
   const Mat H1 = ((W1 * X).colwise() + b1).cwiseMax(0.f);
   const Mat H2 = ((W2 * H1).colwise() + b2).cwiseMax(0.f);
 
   float* G = grad->data();
-  Eigen::Map<Mat> gW1(G + L.w1(), W, kNeuralInputs), gW2(G + L.w2(), W, W), gW3(G + L.w3(), kNeuralBins, W);
-  Eigen::Map<Vec> gb1(G + L.b1(), W), gb2(G + L.b2(), W), gb3(G + L.b3(), kNeuralBins);
+  Eigen::Map<Mat> gW1(G + L.w1(), W, kNeuralInputs), gW2(G + L.w2(), W, W), gW3(G + L.w3(), O, W);
+  Eigen::Map<Vec> gb1(G + L.b1(), W), gb2(G + L.b2(), W), gb3(G + L.b3(), O);
   Mat dH2(W, B);
   double loss = 0.0;
   for (Eigen::Index b = 0; b < B; ++b) {
     const NeuralTrainingSample& s = samples[first + static_cast<size_t>(b) * stride];
-    const uint32_t bin = s.bin < kNeuralBins ? s.bin : 0u;
+    const uint32_t bin = s.bin < L.outputs() ? s.bin : 0u;  // a direction bin or a light
     const float o = W3.row(bin).dot(H2.col(b)) + b3[bin];
     const float q = neural_exp(o);
     const float t = s.target / scale;
@@ -220,7 +226,7 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
   const uint32_t first = round - 1, stride = config_.steps_per_pass;
   // A tile touches the layers (dense) and a few hash-grid entries: only
   // those are quantised and cleared again, not every parameter per tile.
-  const size_t layers = NeuralLayout{config_.width, config_.table_log2}.w1();
+  const size_t layers = layout().w1();
   struct Local {
     std::vector<int64_t> sum;
     std::vector<float> grad;  // all zero between tiles
@@ -386,7 +392,7 @@ void NeuralGuide::fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) c
 }
 
 bool NeuralGuide::operator==(const NeuralGuide& o) const {
-  return config_ == o.config_ && lo_ == o.lo_ && extent_ == o.extent_ && radiance_scale_ == o.radiance_scale_ &&
+  return config_ == o.config_ && lights_ == o.lights_ && lo_ == o.lo_ && extent_ == o.extent_ && radiance_scale_ == o.radiance_scale_ &&
          scale_ == o.scale_ && params_ == o.params_ && adam_m_ == o.adam_m_ && adam_v_ == o.adam_v_ &&
          steps_ == o.steps_;
 }

@@ -33,11 +33,12 @@ struct NeuralGuideConfig {
   // did not lower the error (docs/neural-guide.md), and the output layer
   // (width x 144) is most of an inference's arithmetic.
   uint32_t width = 8;
-  // Adam steps (gradient all-reductions) after each learning pass. More
-  // did not lower the error at equal samples (docs/neural-guide.md) and
-  // cost training time.
-  uint32_t steps_per_pass = 8;
-  Float learning_rate = 5e-3f;
+  // Adam steps (gradient all-reductions) after each learning pass, each on
+  // its share of the pass's targets. Many small steps at a high rate are
+  // what lets the network follow what the table learns at once; more than
+  // this cost training time for little (docs/neural-guide.md).
+  uint32_t steps_per_pass = 32;
+  Float learning_rate = 2e-2f;
   Float guide_prob = 0.5f;           // mixture weight of guided sampling once trained
   Float floor = 0.02f;               // uniform share of each distribution (as the table's)
   // Learning targets a tile keeps per learning pass, on average (the rest
@@ -79,8 +80,11 @@ class NeuralGuide final : public Guide {
   NeuralGuide(const NeuralGuide&) = delete;  // it owns the pass's training log
   NeuralGuide& operator=(const NeuralGuide&) = delete;
   // bounds_lo/hi: the scene's bounds (the encoded cube); radiance_scale: the
-  // brightest emitted radiance (sets which targets are rejected as too large).
-  NeuralGuide(const NeuralGuideConfig& config, const Vec3& bounds_lo, const Vec3& bounds_hi, Float radiance_scale);
+  // brightest emitted radiance (sets which targets are rejected as too large);
+  // num_lights: the scene's lights (light selection is learned for
+  // kNeuralMinLights..kNeuralMaxLights of them).
+  NeuralGuide(const NeuralGuideConfig& config, const Vec3& bounds_lo, const Vec3& bounds_hi, Float radiance_scale,
+              uint32_t num_lights = 0);
 
   std::string mode() const override { return "neural"; }
   uint32_t spec_bits() const override;
@@ -89,6 +93,7 @@ class NeuralGuide final : public Guide {
   uint32_t rounds() const override;
   std::vector<uint64_t>& round_accumulators(uint32_t round) override;
   void fold_round(uint32_t round) override;
+  bool single_sample_learning_passes() const override { return true; }
   void set_guide_prob(Float p) override { config_.guide_prob = p; }
   void save(std::ostream& out, uint64_t scene_fingerprint) const override;
   void fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const override;
@@ -97,6 +102,8 @@ class NeuralGuide final : public Guide {
   static std::unique_ptr<NeuralGuide> load(std::istream& in, uint64_t scene_fingerprint);
 
   const NeuralGuideConfig& config() const { return config_; }
+  uint32_t learned_lights() const { return lights_; }
+  NeuralLayout layout() const { return NeuralLayout{config_.width, config_.table_log2, lights_}; }
   const std::vector<float>& params() const { return params_; }
   NeuralGuideView view() const;
   NeuralGuideStats stats() const;
@@ -128,6 +135,7 @@ class NeuralGuide final : public Guide {
   void adam_step(const std::vector<double>& grad);
 
   NeuralGuideConfig config_;
+  uint32_t lights_ = 0;               // learned lights (NeuralLayout::lights)
   Vec3 lo_{0.f};
   Float extent_ = 1.f;
   Float radiance_scale_ = 1.f;

@@ -22,7 +22,7 @@ void serialize(Archive& ar, NeuralGuideConfig& c) {
 
 template <class Archive>
 void NeuralGuide::serialize(Archive& ar) {
-  ar(config_, lo_.x, lo_.y, lo_.z, extent_, radiance_scale_, max_target_, scale_, params_, adam_m_, adam_v_, steps_);
+  ar(config_, lights_, lo_.x, lo_.y, lo_.z, extent_, radiance_scale_, max_target_, scale_, params_, adam_m_, adam_v_, steps_);
   ar(totals_.targets, totals_.rejected_nonfinite, totals_.rejected_large, totals_.dropped, totals_.gradient_clamped,
      totals_.nonfinite_gradients, totals_.loss, totals_.pass_loss);
 }
@@ -30,7 +30,7 @@ void NeuralGuide::serialize(Archive& ar) {
 namespace {
 constexpr char kNeuralMagic[] = "tessera-neural-guide";
 constexpr char kTableMagic[] = "tessera-guide-cache";
-constexpr uint32_t kNeuralVersion = 2;  // 2: the hash table's size is a setting
+constexpr uint32_t kNeuralVersion = 3;  // 2: the hash table's size is a setting; 3: learned light selection
 }  // namespace
 
 void NeuralGuide::save(std::ostream& out, uint64_t scene_fingerprint) const {
@@ -67,7 +67,9 @@ std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_
   const NeuralGuideConfig& c = g->config_;
   if (c.table_log2 < kNeuralMinTableLog2 || c.table_log2 > kNeuralMaxTableLog2)
     throw std::runtime_error("corrupt neural guide (hash table size out of range)");
-  const NeuralLayout L{c.width, c.table_log2};
+  if (g->lights_ != 0 && (g->lights_ < kNeuralMinLights || g->lights_ > kNeuralMaxLights))
+    throw std::runtime_error("corrupt neural guide (light count out of range)");
+  const NeuralLayout L = g->layout();
   auto finite_in = [](float x, float lo, float hi) { return std::isfinite(x) && x >= lo && x <= hi; };
   bool ok = c.width >= 1 && c.width <= kNeuralMaxWidth && c.steps_per_pass >= 1 && c.steps_per_pass <= 1024 &&
             c.tile_targets >= 1 && c.tile_targets <= (1u << 20) && finite_in(c.learning_rate, 1e-9f, 1.f) &&

@@ -181,6 +181,16 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     else return TablePathGuide{settings.guide};
   }();
   const GuideView* guide = kGuide ? pg.light_guide() : nullptr;
+  // Light selection at a vertex (its guide handle; -1: none): the guide's,
+  // learned where it learns one, else by power.
+  auto light_pmf_at = [&](int32_t cell, uint32_t li) -> Float {
+    if constexpr (kGuide) return pg.light_pmf(s, cell, li);
+    else return light_select_pmf(s, nullptr, cell, li);
+  };
+  auto pick_light_at = [&](int32_t cell, Float u, Float* pmf) -> uint32_t {
+    if constexpr (kGuide) return pg.pick_light(s, cell, u, pmf);
+    else return select_light(s, nullptr, cell, u, pmf);
+  };
   Rgb L(0.f), beta(1.f);
   // Russian roulette decides on the throughput BSDF sampling alone would have
   // (pbrt-v4's rule). Guided directions carry small weights exactly where the
@@ -316,7 +326,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             Float direct_estimate = 0.f;  // unweighted NEE estimate of light scattered here (guide targets)
             if (settings.nee && s.num_lights > 0 && !m.subsurface) {
               Float pmf = 0.f;
-              const uint32_t li = select_light(s, guide, -1, u_select, &pmf);
+              const uint32_t li = pick_light_at(-1, u_select, &pmf);
               LightSample ls;
               if (pmf > 0.f && sample_light(s, li, p, u_light, &ls, true)) {
                 ls.L = light_emission(s, wl, s.lights[li], ls.L);
@@ -377,7 +387,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           if (depth == 0 || specular_bounce || !settings.nee) {
             L += beta * Le;
           } else {
-            Float light_pdf = light_select_pmf(s, guide, prev_cell, li) * environment_pdf(s, li, from, ray.d);
+            Float light_pdf = light_pmf_at(prev_cell, li) * environment_pdf(s, li, from, ray.d);
             L += beta * Le * mis_weight(mis_pdf_of_last_direction(), light_pdf, prev_mis_balance);
             if constexpr (kGuide) note_mis_emission(luminance(Le), light_pdf);
           }
@@ -407,7 +417,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
           if (depth == 0 || specular_bounce || !settings.nee) {
             L += beta * Le_hit;
           } else {
-            Float light_pdf = light_select_pmf(s, guide, prev_cell, static_cast<uint32_t>(info.light)) *
+            Float light_pdf = light_pmf_at(prev_cell, static_cast<uint32_t>(info.light)) *
                               area_light_pdf_from(s, l, prev_p, h.p, cos_l, prev_in_medium);
             L += beta * Le_hit * mis_weight(mis_pdf_of_last_direction(), light_pdf, prev_mis_balance);
             if constexpr (kGuide) note_mis_emission(luminance(Le_hit), light_pdf);
@@ -490,7 +500,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       }
       Float pmf = 0.f;
       uint32_t li = 0;
-      if (traced) li = select_light(s, guide, cell, u_select, &pmf);
+      if (traced) li = pick_light_at(cell, u_select, &pmf);
       else ++c.nee_skipped;
       LightSample ls;
       Float learned = 0.f;  // unoccluded contribution of the selected light, for the guide

@@ -7,7 +7,10 @@
 // vertex's normal, mixed with a uniform floor), its cdf, the irradiance and
 // the largest Q: everything the integrator reads from a Q-table cell, so
 // sampling, the mixture, the floor, the expected-SARSA targets and guided
-// roulette carry over unchanged.
+// roulette carry over unchanged. In scenes of kNeuralMinLights to
+// kNeuralMaxLights lights the network has one more output per light, the
+// contribution next-event estimation gets from it at the point (the table's
+// learned light selection, kept as its cells keep it).
 //
 // Plain loops over float arrays, no host types: the same code runs on a GPU.
 // Weights are frozen during a pass (the host trains between passes,
@@ -32,32 +35,44 @@ constexpr uint32_t kNeuralMinTableLog2 = 8, kNeuralMaxTableLog2 = 16;
 constexpr uint32_t kNeuralEncoded = kNeuralLevels * kNeuralFeatures;
 constexpr uint32_t kNeuralInputs = kNeuralEncoded + 3;     // encoding, then the normal
 constexpr uint32_t kNeuralMaxWidth = 64;
+// Light selection is learned in scenes of this many lights (a single quad
+// light is two: the table's rule); each is one more output.
+constexpr uint32_t kNeuralMinLights = 3, kNeuralMaxLights = 16;
+constexpr uint32_t kNeuralMaxOutputs = kNeuralBins + kNeuralMaxLights;
+// Share of light selections drawn from the learned distribution once it has
+// seen light (the rest by power, as the table's GuideConfig::light_guide_prob).
+constexpr Float kNeuralLightGuideProb = 0.9f;
 // Network outputs are clamped here before exp(): a prediction never
 // overflows, and a bin is never exactly zero.
 constexpr Float kNeuralMinLog = -30.f, kNeuralMaxLog = 20.f;
 
-// Offsets of the parameter blocks in one flat float array. Weight matrices
+// Offsets of the parameter blocks in one flat float array (outputs: the
+// direction bins, then one per learned light). Weight matrices
 // are stored input-major (w[i * out + o]), so that a layer is a sum of
 // scaled columns: contiguous, independent lanes that compilers vectorise
 // without reassociating sums.
 struct NeuralLayout {
   uint32_t width;
   uint32_t table_log2;  // entries per hash-grid level: 2^table_log2
-  TESSERA_HOST_DEVICE NeuralLayout(uint32_t width_, uint32_t table_log2_) : width(width_), table_log2(table_log2_) {}
+  uint32_t lights;      // learned lights: 0 or kNeuralMinLights..kNeuralMaxLights
+  TESSERA_HOST_DEVICE NeuralLayout(uint32_t width_, uint32_t table_log2_, uint32_t lights_)
+      : width(width_), table_log2(table_log2_), lights(lights_) {}
   TESSERA_HOST_DEVICE uint32_t table_size() const { return 1u << table_log2; }
+  TESSERA_HOST_DEVICE uint32_t outputs() const { return kNeuralBins + lights; }
   TESSERA_HOST_DEVICE uint32_t grid() const { return 0; }
   TESSERA_HOST_DEVICE uint32_t w1() const { return kNeuralLevels * table_size() * kNeuralFeatures; }
   TESSERA_HOST_DEVICE uint32_t b1() const { return w1() + kNeuralInputs * width; }
   TESSERA_HOST_DEVICE uint32_t w2() const { return b1() + width; }
   TESSERA_HOST_DEVICE uint32_t b2() const { return w2() + width * width; }
   TESSERA_HOST_DEVICE uint32_t w3() const { return b2() + width; }
-  TESSERA_HOST_DEVICE uint32_t b3() const { return w3() + width * kNeuralBins; }
-  TESSERA_HOST_DEVICE uint32_t size() const { return b3() + kNeuralBins; }
+  TESSERA_HOST_DEVICE uint32_t b3() const { return w3() + width * outputs(); }
+  TESSERA_HOST_DEVICE uint32_t size() const { return b3() + outputs(); }
 };
 
 // One learning target, as the integrator records it: the point and normal
-// of the vertex, the bin of the direction it took, and the target (radiance
-// arriving along it, in the scene's units).
+// of the vertex, the output it trains (the bin of the direction it took, or
+// kNeuralBins + a light) and the target (radiance arriving along it, or
+// what the light's sample brought, in the scene's units).
 struct NeuralTrainingSample {
   float p[3];
   float n[3];
@@ -83,9 +98,10 @@ struct NeuralSampleSink {
 };
 
 struct NeuralGuideView {
-  const float* params = nullptr;  // NeuralLayout{width, table_log2} blocks
+  const float* params = nullptr;  // NeuralLayout{width, table_log2, lights} blocks
   uint32_t width = 8;             // NeuralGuide::view fills every field; these are NeuralGuideConfig's defaults
   uint32_t table_log2 = 11;
+  uint32_t lights = 0;            // learned lights (NeuralLayout::lights): the scene's lights 0..lights-1
   Vec3 lo{0.f};                   // the encoded cube: [lo, lo + extent]^3 (the scene's bounds)
   Float extent = 1.f;
   Float scale = 1.f;              // Q = scale * exp(output)
@@ -102,12 +118,17 @@ struct NeuralGuideView {
 // The network's answer at one vertex.
 struct NeuralSite {
   Vec3 p{0.f}, n{0.f, 0.f, 1.f};
-  Float q[kNeuralBins];      // incident radiance per bin
+  Float q[kNeuralMaxOutputs];  // incident radiance per bin, then each learned light's contribution
   Float pmf[kNeuralBins];    // guided distribution per bin (floor included)
   Float cdf[kNeuralBins];    // inclusive running sum of pmf, cdf[last] = 1: built by the first sample
   bool has_cdf = false;
   Float irradiance = 0.f;    // sum over bins of Q max(cos, 0) dOmega about n
   Float qmax = 0.f;          // largest Q over bins above the surface
+  // Learned light selection: the share of selections drawn from light_cdf
+  // (0: by power alone, before the network has seen light here).
+  Float light_prob = 0.f;
+  Float light_pmf[kNeuralMaxLights];
+  Float light_cdf[kNeuralMaxLights];  // inclusive running sum of light_pmf, the last 1
 };
 
 // e^x for the network's outputs, clamped to [kNeuralMinLog, kNeuralMaxLog]:
@@ -208,15 +229,49 @@ TESSERA_HOST_DEVICE inline void neural_layer(const float* w, const float* b, con
     for (uint32_t o = 0; o < outs; ++o) out[o] = glm::max(out[o], 0.f);
 }
 
+// The learned light selection from the light outputs (the table's rule):
+// lights in proportion to their predicted contribution, mixed with the
+// uniform floor; drawn with probability kNeuralLightGuideProb, by power
+// otherwise. An untrained network, or one that predicts no light here,
+// leaves selection to power alone.
+TESSERA_HOST_DEVICE inline void neural_light_distribution(const NeuralGuideView& v, NeuralSite* site) {
+  site->light_prob = 0.f;
+  const uint32_t lights = v.lights <= kNeuralMaxLights ? v.lights : 0u;
+  Float* c = site->q + kNeuralBins;
+  Float total = 0.f;
+  for (uint32_t i = 0; i < lights; ++i) {
+    c[i] = v.scale * neural_exp(c[i]);
+    total += c[i];
+  }
+  if (lights == 0 || !v.trained || !(total > 0.f) || !(total <= 3.4e38f)) return;
+  const Float floor = glm::clamp(v.floor, 0.f, 1.f);
+  const Float w = (1.f - floor) / total, uniform = floor / static_cast<Float>(lights);
+  Float acc = 0.f;
+  for (uint32_t i = 0; i < lights; ++i) {
+    site->light_pmf[i] = c[i] * w + uniform;
+    acc += site->light_pmf[i];
+    site->light_cdf[i] = acc;
+  }
+  site->light_cdf[lights - 1] = 1.f;  // the last light takes the rounding
+  site->light_prob = kNeuralLightGuideProb;
+}
+
+// A light from the site's learned distribution (u in [0, 1)).
+TESSERA_HOST_DEVICE inline uint32_t neural_sample_light(const NeuralGuideView& v, const NeuralSite& site, Float u) {
+  uint32_t i = 0;
+  while (i + 1 < v.lights && !(site.light_cdf[i] > u)) ++i;
+  return i;
+}
+
 // Runs the network at a vertex (p on a surface whose normal on the path's
-// side is n) and builds the site's distribution.
+// side is n) and builds the site's distributions.
 TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site) {
-  const NeuralLayout L{v.width, v.table_log2};
+  const NeuralLayout L{v.width, v.table_log2, v.lights};
   Float in[kNeuralInputs], h1[kNeuralMaxWidth], h2[kNeuralMaxWidth];
   neural_encode(v, p, n, in);
   neural_layer(v.params + L.w1(), v.params + L.b1(), in, kNeuralInputs, v.width, true, h1);
   neural_layer(v.params + L.w2(), v.params + L.b2(), h1, v.width, v.width, true, h2);
-  neural_layer(v.params + L.w3(), v.params + L.b3(), h2, v.width, kNeuralBins, false, site->q);
+  neural_layer(v.params + L.w3(), v.params + L.b3(), h2, v.width, L.outputs(), false, site->q);
   site->p = p;
   site->n = n;
   site->has_cdf = false;
@@ -257,6 +312,7 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   const Float uniform = total > 0.f ? floor / static_cast<Float>(kNeuralBins) : 1.f / static_cast<Float>(kNeuralBins);
   const Float w = total > 0.f ? (1.f - floor) / total : 0.f;
   for (uint32_t j = 0; j < kNeuralBins; ++j) site->pmf[j] = site->pmf[j] * w + uniform;
+  neural_light_distribution(v, site);
 }
 
 // The site's cdf, built once per vertex by the first sample that needs it.

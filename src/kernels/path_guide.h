@@ -19,6 +19,14 @@ struct TablePathGuide {
   const GuideView& g;
   // Light selection and next-event probability are learned per cell.
   TESSERA_HOST_DEVICE const GuideView* light_guide() const { return &g; }
+  // Probability that next-event estimation at `cell` (-1: none, as in a
+  // medium) traces a shadow ray to light li, and the draw of that light.
+  TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, int32_t cell, uint32_t li) const {
+    return light_select_pmf(s, &g, cell, li);
+  }
+  TESSERA_HOST_DEVICE uint32_t pick_light(const SceneView& s, int32_t cell, Float u, Float* pmf) const {
+    return select_light(s, &g, cell, u, pmf);
+  }
 
   TESSERA_HOST_DEVICE int32_t locate(const Vec3& p, const Vec3& n_side) { return guide_find_cell(g, p, n_side); }
   TESSERA_HOST_DEVICE uint32_t bins() const { return g.bins; }
@@ -77,8 +85,26 @@ struct NeuralPathGuide {
   // The sites are filled by locate(), not zeroed here (they are 3.5 kB).
   TESSERA_HOST_DEVICE explicit NeuralPathGuide(const NeuralGuideView& view) : v(view) {}
   NeuralPathGuide(const NeuralGuideView&&) = delete;  // it keeps a reference: not to a temporary
-  // No learned light selection: power-based, next-event estimation always.
+  // Next-event estimation at every vertex (no table to learn its probability).
   TESSERA_HOST_DEVICE const GuideView* light_guide() const { return nullptr; }
+  // Light selection as the table's (light_select_pmf, select_light), from
+  // the site's learned distribution where it has one, else by power.
+  TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, int32_t slot, uint32_t li) const {
+    const Float p_power = s.light_select.discrete_pmf(li);
+    if (slot < 0) return p_power;
+    const NeuralSite& x = site[slot];
+    const Float lp = x.light_prob;
+    if (!(lp > 0.f)) return p_power;
+    return (1.f - lp) * p_power + lp * (li < v.lights ? x.light_pmf[li] : 0.f);
+  }
+  TESSERA_HOST_DEVICE uint32_t pick_light(const SceneView& s, int32_t slot, Float u, Float* pmf) const {
+    const Float lp = slot >= 0 ? site[slot].light_prob : 0.f;
+    if (!(lp > 0.f)) return s.light_select.sample_discrete(u, pmf);
+    const uint32_t li = u < lp ? neural_sample_light(v, site[slot], glm::min(u / lp, 0x1.fffffep-1f))
+                               : s.light_select.sample_discrete(glm::min((u - lp) / (1.f - lp), 0x1.fffffep-1f), nullptr);
+    *pmf = light_pmf(s, slot, li);
+    return li;
+  }
 
   // Runs the network into the slot not holding the latest vertex: the latest
   // one (a pending target's) stays readable.
@@ -128,7 +154,9 @@ struct NeuralPathGuide {
     return y.q[j] * luminance(bsdf_eval(b, wo_local, wi)) * fabsf(wi.z) * (4.f * kPi / static_cast<Float>(kNeuralBins)) / pmf;
   }
   TESSERA_HOST_DEVICE bool record(int32_t s, uint32_t bin, Float target) const { return neural_record(v, site[s], bin, target); }
-  TESSERA_HOST_DEVICE void record_light(int32_t, uint32_t, Float) const {}
+  TESSERA_HOST_DEVICE void record_light(int32_t s, uint32_t li, Float learned) const {
+    if (li < v.lights) neural_record(v, site[s], kNeuralBins + li, learned);
+  }
   TESSERA_HOST_DEVICE void record_nee(int32_t, Float, Float) const {}
   TESSERA_HOST_DEVICE bool learns_mix(int32_t, Float) const { return false; }
   TESSERA_HOST_DEVICE void record_mix(int32_t, const GuideMixSample&, Float) const {}

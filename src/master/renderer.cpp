@@ -47,7 +47,9 @@ int32_t render_threads(const RenderOptions& opt, int32_t ranks_on_this_machine) 
   return std::max(1, std::min(usable_cores(), machine / std::max(1, ranks_on_this_machine)));
 }
 
-uint32_t pass_spp_for(uint32_t pass, uint32_t max_pass_spp) {
+uint32_t pass_spp_for(uint32_t pass, uint32_t max_pass_spp, uint32_t single_passes) {
+  if (pass < single_passes) return 1;
+  if (single_passes > 0) pass = pass - single_passes + 2;  // then 2, 4, ...
   return std::min<uint32_t>(max_pass_spp, pass == 0 ? 1u : (1u << std::min(pass - 1, 20u)));
 }
 
@@ -153,6 +155,10 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     stats.guide_trial.state = GuideTrialState::Pending;
   if (!stats.pass_stats.empty()) progress.set_error(stats.estimated_rel_mse, opt.target_error);
 
+  // A guide that converges per pass learns in passes of one sample (each
+  // pass one bootstrap step) while every sample learns.
+  const uint32_t single_passes =
+      guide && guide->single_sample_learning_passes() ? opt.guide_learn.all_spp : 0u;
   uint32_t spp_done = stats.spp;
   double last_pass_s = stats.pass_stats.empty() ? 0.0 : stats.pass_stats.back().seconds;
   for (uint32_t pass = stats.passes;; ++pass) {
@@ -172,7 +178,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
       stats.stop_reason = "time";
       break;
     }
-    uint32_t pass_spp = pass_spp_for(pass, opt.max_pass_spp);
+    uint32_t pass_spp = pass_spp_for(pass, opt.max_pass_spp, single_passes);
     if (opt.spp > 0) pass_spp = std::min(pass_spp, opt.spp - spp_done);
     const double pass_start = elapsed();
     const TileCounters before = stats.counters;

@@ -39,7 +39,8 @@ struct FarmScene {
     NeuralGuideConfig c;
     c.width = 16;
     c.steps_per_pass = 4;
-    return std::make_unique<NeuralGuide>(c, scene.bounds().lo, scene.bounds().hi, scene.max_emitted_radiance());
+    return std::make_unique<NeuralGuide>(c, scene.bounds().lo, scene.bounds().hi, scene.max_emitted_radiance(),
+                                         scene.view().num_lights);
   }
 };
 

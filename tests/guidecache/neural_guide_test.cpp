@@ -22,7 +22,9 @@ NeuralGuideConfig small_config(uint32_t width = 8) {
   return c;
 }
 
-NeuralGuide make(const NeuralGuideConfig& c) { return NeuralGuide(c, Vec3(0.f), Vec3(1.f), 1.f); }
+NeuralGuide make(const NeuralGuideConfig& c, uint32_t lights = 0) {
+  return NeuralGuide(c, Vec3(0.f), Vec3(1.f), 1.f, lights);
+}
 
 std::vector<NeuralTrainingSample> random_samples(size_t n, uint32_t seed, float target_scale) {
   std::mt19937 rng(seed);
@@ -58,15 +60,17 @@ double frozen_loss(const NeuralGuide& g, const std::vector<NeuralTrainingSample>
 }
 
 TEST(NeuralGuide, GradientMatchesFiniteDifferences) {
-  NeuralGuide g = make(small_config());
+  NeuralGuide g = make(small_config(), 4);  // with four light outputs
+  ASSERT_EQ(g.learned_lights(), 4u);
   g.set_output_scale(1.f);
   // Larger hash features than the initial ones, so their gradients are not all tiny.
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-0.5f, 0.5f);
-  const NeuralLayout L{g.config().width, g.config().table_log2};
+  const NeuralLayout L = g.layout();
   for (uint32_t i = L.grid(); i < L.w1(); ++i) g.mutable_params()[i] = u(rng);
   // Targets near the predictions: the per-target gradient is not clipped.
   std::vector<NeuralTrainingSample> samples = random_samples(12, 5, 1.f);
+  for (size_t i = 0; i < samples.size(); i += 3) samples[i].bin = kNeuralBins + static_cast<uint32_t>(i / 3) % 4;
   for (NeuralTrainingSample& s : samples) s.target = static_cast<float>(predicted(g, s) * (s.bin % 2 ? 1.6 : 0.5));
   std::vector<double> q0;
   for (const NeuralTrainingSample& s : samples) q0.push_back(predicted(g, s));
@@ -76,7 +80,7 @@ TEST(NeuralGuide, GradientMatchesFiniteDifferences) {
   std::vector<uint32_t> check;
   for (uint32_t i = L.grid(); i < L.w1() && check.size() < 8; ++i)
     if (std::fabs(grad[i]) > 1e-3f) check.push_back(i);
-  for (uint32_t block : {L.w1(), L.b1(), L.w2(), L.b2(), L.w3(), L.b3()}) {
+  for (uint32_t block : {L.w1(), L.b1(), L.w2(), L.b2(), L.w3(), L.b3(), L.b3() + kNeuralBins}) {
     uint32_t found = 0;
     for (uint32_t i = block; i < L.size() && found < 4; ++i)
       if (std::fabs(grad[i]) > 1e-3f) check.push_back(i), ++found;
@@ -147,6 +151,66 @@ TEST(NeuralGuide, LearnsASingleBrightDirection) {
   }
 }
 
+// Light outputs learn each light's contribution; the site's light
+// distribution follows it (with the floor), is drawn from in proportion to
+// its pmf, and is only used once the network has trained.
+TEST(NeuralGuide, LearnsWhichLightContributes) {
+  constexpr uint32_t kLights = 5, kBright = 3;
+  NeuralGuideConfig c = small_config(16);
+  NeuralGuide g = make(c, kLights);
+  EXPECT_EQ(make(c, 2).learned_lights(), 0u);  // a single quad light: selection by power
+  EXPECT_EQ(make(c, kNeuralMaxLights + 1).learned_lights(), 0u);
+  {
+    NeuralSite site;
+    neural_infer(g.view(), Vec3(0.5f), Vec3(0.f, 0.f, 1.f), &site);
+    EXPECT_EQ(site.light_prob, 0.f);  // untrained: power alone
+  }
+  for (int pass = 0; pass < 40; ++pass) {
+    std::vector<NeuralTileTargets> tiles(4);
+    for (uint32_t t = 0; t < tiles.size(); ++t) {
+      tiles[t].tile = t;
+      tiles[t].samples = random_samples(256, 100 * pass + t, 1.f);
+      for (size_t i = 0; i < tiles[t].samples.size(); ++i) {
+        NeuralTrainingSample& s = tiles[t].samples[i];
+        if (i % 2 == 0) continue;  // half direction targets, half light targets
+        s.bin = kNeuralBins + static_cast<uint32_t>(i / 2) % kLights;
+        s.target = s.bin == kNeuralBins + kBright ? 2.f : 0.02f;
+      }
+    }
+    g.train_on(std::move(tiles));
+  }
+  const NeuralGuideView v = g.view();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (int i = 0; i < 10; ++i) {
+    NeuralSite site;
+    neural_infer(v, Vec3(u(rng), u(rng), u(rng)), Vec3(0.f, 0.f, 1.f), &site);
+    EXPECT_EQ(site.light_prob, kNeuralLightGuideProb);
+    EXPECT_NEAR(site.q[kNeuralBins + kBright], 2.0, 0.3);
+    double sum = 0.0;
+    for (uint32_t l = 0; l < kLights; ++l) {
+      sum += site.light_pmf[l];
+      EXPECT_GE(site.light_pmf[l], c.floor / kLights * 0.999f);
+      if (l != kBright) {
+        EXPECT_LT(site.q[kNeuralBins + l], 0.1) << "light " << l;
+      }
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-5);
+    EXPECT_EQ(site.light_cdf[kLights - 1], 1.f);
+    EXPECT_GT(site.light_pmf[kBright], 0.9f);
+    // Draws follow the pmf (chi-square over the lights, 4 degrees of freedom: 18.5 is p = 0.001).
+    std::vector<int> counts(kLights, 0);
+    const int n = 20000;
+    for (int k = 0; k < n; ++k) ++counts[neural_sample_light(v, site, (k + 0.5f) / n)];
+    double chi2 = 0.0;
+    for (uint32_t l = 0; l < kLights; ++l) {
+      const double e = n * site.light_pmf[l];
+      chi2 += (counts[l] - e) * (counts[l] - e) / e;
+    }
+    EXPECT_LT(chi2, 18.5);
+  }
+}
+
 // Data parallelism: the tiles split over two "ranks", each computing its
 // own rounds, their accumulators summed, every rank folding the sums, end
 // with the same weights as one process training on all tiles: bit for bit.
@@ -182,12 +246,15 @@ TEST(NeuralGuide, TrainingDoesNotDependOnWhichRankHadWhichTile) {
 }
 
 TEST(NeuralGuide, SaveAndLoadAreExact) {
-  NeuralGuide g = make(small_config());
-  g.train_on({{0, random_samples(200, 1, 2.f)}, {1, random_samples(100, 2, 2.f)}});
+  NeuralGuide g = make(small_config(), 3);
+  std::vector<NeuralTrainingSample> light_targets = random_samples(100, 2, 2.f);
+  for (size_t i = 0; i < light_targets.size(); ++i) light_targets[i].bin = kNeuralBins + static_cast<uint32_t>(i % 3);
+  g.train_on({{0, random_samples(200, 1, 2.f)}, {1, light_targets}});
   std::stringstream bytes;
   g.save(bytes, 42);
   std::unique_ptr<NeuralGuide> loaded = NeuralGuide::load(bytes, 42);
   EXPECT_TRUE(*loaded == g);
+  EXPECT_EQ(loaded->learned_lights(), 3u);
   // The generic loader tells the kinds apart.
   std::stringstream again;
   g.save(again, 42);
@@ -243,6 +310,15 @@ TEST(NeuralGuide, HashTableSizeIsASettingThatRoundTrips) {
   ASSERT_EQ(word, kNeuralMinTableLog2) << "the file's layout changed: update the offset";
   for (uint32_t bad : {0u, 40u, kNeuralMaxTableLog2 + 1}) {
     std::memcpy(file.data() + at, &bad, 4);
+    std::stringstream damaged(file);
+    EXPECT_THROW(NeuralGuide::load(damaged, 3), std::runtime_error) << bad;
+  }
+  // The learned light count follows the config (after its 64-bit seed).
+  file = bytes.str();
+  std::memcpy(&word, file.data() + at + 4 + 8, 4);
+  ASSERT_EQ(word, 0u) << "the file's layout changed: update the offset";
+  for (uint32_t bad : {1u, kNeuralMinLights - 1, kNeuralMaxLights + 1}) {
+    std::memcpy(file.data() + at + 4 + 8, &bad, 4);
     std::stringstream damaged(file);
     EXPECT_THROW(NeuralGuide::load(damaged, 3), std::runtime_error) << bad;
   }
@@ -302,8 +378,10 @@ TEST(NeuralGuide, NonFiniteAndHugeTargetsAreRejectedAndCounted) {
 // same bits: a farm of machines with and without AVX2 renders one image.
 TEST(NeuralGuide, AvxAndPortableInferenceAgreeBitForBit) {
   if (!neural_infer_has_avx2()) GTEST_SKIP() << "no AVX2 on this machine";
-  NeuralGuide g = make(small_config(16));
-  g.train_on({{0, random_samples(300, 4, 1.f)}});
+  NeuralGuide g = make(small_config(16), 4);
+  std::vector<NeuralTrainingSample> samples = random_samples(300, 4, 1.f);
+  for (size_t i = 0; i < samples.size(); i += 2) samples[i].bin = kNeuralBins + static_cast<uint32_t>(i / 2) % 4;
+  g.train_on({{0, samples}});
   const NeuralGuideView v = g.view();
   std::mt19937 rng(8);
   std::uniform_real_distribution<float> u(-0.2f, 1.2f);
@@ -313,8 +391,11 @@ TEST(NeuralGuide, AvxAndPortableInferenceAgreeBitForBit) {
     NeuralSite a, b;
     neural_infer_avx2(v, p, n, &a);
     neural_infer_portable(v, p, n, &b);
-    ASSERT_EQ(std::memcmp(a.q, b.q, sizeof a.q), 0) << i;
+    ASSERT_EQ(std::memcmp(a.q, b.q, sizeof(Float) * (kNeuralBins + 4)), 0) << i;
     ASSERT_EQ(std::memcmp(a.pmf, b.pmf, sizeof a.pmf), 0) << i;
+    ASSERT_EQ(a.light_prob, b.light_prob);
+    ASSERT_GT(a.light_prob, 0.f);
+    ASSERT_EQ(std::memcmp(a.light_pmf, b.light_pmf, sizeof(Float) * 4), 0) << i;
     ASSERT_EQ(a.irradiance, b.irradiance);
     ASSERT_EQ(a.qmax, b.qmax);
   }

@@ -22,7 +22,8 @@ struct GuidedScene {
     return GuideField(cfg, scene.bounds().lo, scene.bounds().hi, scene.view().num_lights, scene.max_emitted_radiance());
   }
   std::unique_ptr<NeuralGuide> make_neural(const NeuralGuideConfig& cfg = {}) const {
-    return std::make_unique<NeuralGuide>(cfg, scene.bounds().lo, scene.bounds().hi, scene.max_emitted_radiance());
+    return std::make_unique<NeuralGuide>(cfg, scene.bounds().lo, scene.bounds().hi, scene.max_emitted_radiance(),
+                                         scene.view().num_lights);
   }
   RenderResult run(Guide* guide, RenderOptions opt = {}) const {
     opt.progress = false;

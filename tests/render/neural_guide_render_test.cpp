@@ -49,6 +49,8 @@ TEST(NeuralGuided, DoorAjarAndShelterAgreeWithUnguided) {
     SCOPED_TRACE(name);
     GuidedScene s(shipped(name, 40, 30, 192, 8));
     auto guide = s.make_neural(small_network());
+    // Shelter's three quad lights (six triangles): selection is learned (and must stay unbiased).
+    EXPECT_EQ(guide->learned_lights(), std::string(name) == "shelter" ? 6u : 0u);
     RenderResult g = s.run(guide.get());
     RenderResult u = s.run(nullptr, seeded(kUnguidedSeed));
     ChannelStats mu = channel_stats(u.film);
@@ -81,6 +83,30 @@ TEST(NeuralGuided, BitIdenticalImageAndWeightsAcrossThreadCounts) {
   EXPECT_TRUE(*guides[0] == *guides[2]);
 }
 
+// The network learns in passes of one sample while every sample learns
+// (each pass refreshes the network its targets bootstrap from); the table
+// keeps the doubling schedule.
+TEST(NeuralGuided, LearnsInSingleSamplePassesWhileEverySampleLearns) {
+  const uint32_t table[] = {1, 1, 2, 4, 8, 8};
+  for (uint32_t p = 0; p < 6; ++p) EXPECT_EQ(pass_spp_for(p, 8), table[p]) << p;
+  for (uint32_t p = 0; p < 3; ++p) EXPECT_EQ(pass_spp_for(p, 8, 3), 1u) << p;
+  const uint32_t after[] = {2, 4, 8, 8};
+  for (uint32_t p = 0; p < 4; ++p) EXPECT_EQ(pass_spp_for(3 + p, 8, 3), after[p]) << p;
+
+  GuidedScene s(shipped("door-ajar", 16, 12, 8, 4));
+  RenderOptions opt;
+  opt.progress = false;
+  opt.spp = 11;
+  opt.max_depth = 4;
+  opt.guide_learn.all_spp = 4;
+  auto guide = s.make_neural(small_network());
+  RenderResult r = render(s.scene, s.embree, opt, guide.get());
+  std::vector<uint32_t> spp;
+  for (const PassStats& p : r.stats.pass_stats) spp.push_back(p.spp);
+  EXPECT_EQ(spp, (std::vector<uint32_t>{1, 1, 1, 1, 2, 4, 1}));
+  EXPECT_GE(r.stats.neural_guide.pass_loss.size(), 4u);
+}
+
 // A saved network renders (and goes on learning) exactly as the one it was saved from.
 TEST(NeuralGuided, SavedNetworkRendersTheSameImage) {
   GuidedScene s(shipped("door-ajar", 24, 18, 8, 6));
@@ -110,7 +136,7 @@ TEST(NeuralGuided, ResumedRenderEqualsTheUninterruptedOne) {
 
   auto first_guide = s.make_neural(small_network());
   RenderOptions part = opt;
-  part.spp = 4;  // passes of 1, 1, 2 spp
+  part.spp = 4;  // four passes of 1 spp (the network learns in single-sample passes)
   RenderResult first = render(s.scene, s.embree, part, first_guide.get());
   const std::string path = ::testing::TempDir() + "/neural.ckpt";
   write_checkpoint(path, first, first_guide.get(), s.scene.fingerprint(), 11);
