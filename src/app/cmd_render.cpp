@@ -149,7 +149,9 @@ Bytes guide_bytes(const Guide& guide, const SceneData& scene) {
 
 std::unique_ptr<Guide> guide_from_bytes(const Bytes& bytes, const SceneData& scene) {
   std::istringstream s(std::string(bytes.begin(), bytes.end()), std::ios::binary);
-  return load_guide(s, scene.fingerprint());
+  std::unique_ptr<Guide> g = load_guide(s, scene.fingerprint());
+  check_guide_fits_scene(*g, scene);
+  return g;
 }
 
 // An exception's message for the one-line error ("std::bad_alloc" says little).

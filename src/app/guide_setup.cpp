@@ -105,6 +105,7 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
     if (!f) throw std::runtime_error("--guide-in: cannot open " + a.in);
     try {
       std::unique_ptr<Guide> g = load_guide(f, scene.fingerprint());
+      check_guide_fits_scene(*g, scene);
       // A table file serves qtable and qlearning (its rule comes from the file); auto takes either kind.
       if (a.mode != "auto" && (g->mode() == "neural") != (mode == "neural"))
         throw std::runtime_error("holds a " + g->mode() + " guide, not --guide " + mode);
@@ -151,6 +152,15 @@ void save_guide(const GuideArgs& a, const Guide& guide, const SceneData& scene) 
     if (!f) throw std::runtime_error("--guide-out: cannot write " + tmp);
   }
   std::filesystem::rename(tmp, a.out);
+}
+
+void check_guide_fits_scene(const Guide& guide, const SceneData& scene) {
+  const auto* n = dynamic_cast<const NeuralGuide*>(&guide);
+  if (!n) return;
+  const uint32_t expected = NeuralGuide::learned_lights_for(scene.view().num_lights);
+  if (n->learned_lights() != expected)
+    throw std::runtime_error("the network learns selection over " + std::to_string(n->learned_lights()) +
+                             " lights, the scene needs " + std::to_string(expected));
 }
 
 std::string describe_guide(const Guide& guide) {

@@ -53,6 +53,10 @@ bool guiding_helps(uint32_t effects);
 // and budget then come from the file). *why explains the choice for the log.
 std::unique_ptr<Guide> make_guide(const GuideArgs& args, const SceneData& scene, std::string* why);
 
+// Throws std::runtime_error where a loaded guide does not fit the scene in a
+// way the scene fingerprint cannot tell (a network's light outputs).
+void check_guide_fits_scene(const Guide& guide, const SceneData& scene);
+
 // Writes the cache to --guide-out when given (temp file + rename: never a torn file).
 void save_guide(const GuideArgs& args, const Guide& guide, const SceneData& scene);
 

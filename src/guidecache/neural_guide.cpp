@@ -48,7 +48,7 @@ int64_t from_word(uint64_t w) { return static_cast<int64_t>(w); }
 NeuralGuide::NeuralGuide(const NeuralGuideConfig& config, const Vec3& lo, const Vec3& hi, Float radiance_scale,
                          uint32_t num_lights)
     : config_(config),
-      lights_(num_lights >= kNeuralMinLights && num_lights <= kNeuralMaxLights ? num_lights : 0u) {
+      lights_(learned_lights_for(num_lights)) {
   if (config_.width < 1 || config_.width > kNeuralMaxWidth)
     throw std::runtime_error("neural guide: width must be 1.." + std::to_string(kNeuralMaxWidth));
   if (config_.steps_per_pass < 1) throw std::runtime_error("neural guide: at least one step per pass");
@@ -259,7 +259,8 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
         ++local.clamped;
         g = g > 0.0 ? kGradLimit : -kGradLimit;
       }
-      local.sum[k] += static_cast<int64_t>(std::llround(g));
+      // Half away from zero, as llround (exact: |g| <= 2^44), without its call.
+      local.sum[k] += static_cast<int64_t>(g + (g >= 0.0 ? 0.5 : -0.5));
     };
     for (size_t k = layers; k < P; ++k) take(k);
     for (uint32_t k : local.touched) take(k);

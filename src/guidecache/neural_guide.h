@@ -31,7 +31,7 @@ namespace tessera {
 struct NeuralGuideConfig {
   // Neurons per hidden layer (two layers), at most kNeuralMaxWidth. Wider
   // did not lower the error (docs/neural-guide.md), and the output layer
-  // (width x 144) is most of an inference's arithmetic.
+  // (width x (144 + learned lights)) is most of an inference's arithmetic.
   uint32_t width = 8;
   // Adam steps (gradient all-reductions) after each learning pass, each on
   // its share of the pass's targets. Many small steps at a high rate are
@@ -103,6 +103,10 @@ class NeuralGuide final : public Guide {
 
   const NeuralGuideConfig& config() const { return config_; }
   uint32_t learned_lights() const { return lights_; }
+  // The lights a network made for a scene of num_lights learns selection over.
+  static uint32_t learned_lights_for(uint32_t num_lights) {
+    return num_lights >= kNeuralMinLights && num_lights <= kNeuralMaxLights ? num_lights : 0u;
+  }
   NeuralLayout layout() const { return NeuralLayout{config_.width, config_.table_log2, lights_}; }
   const std::vector<float>& params() const { return params_; }
   NeuralGuideView view() const;

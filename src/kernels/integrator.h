@@ -175,7 +175,8 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   // are the radiance arriving at x, after the medium between.
   Float segment_tr = 1.f;
   const bool learn = kGuide && settings.learn;
-  // The guide, per vertex (path_guide.h); light selection reads the table's cells only.
+  // The guide, per vertex (path_guide.h); `guide` is the table's view where
+  // it learns next-event probability (the network does not: null).
   auto pg = [&]() {
     if constexpr (kNeural) return NeuralPathGuide(settings.neural);
     else return TablePathGuide{settings.guide};

@@ -125,7 +125,9 @@ struct NeuralSite {
   Float irradiance = 0.f;    // sum over bins of Q max(cos, 0) dOmega about n
   Float qmax = 0.f;          // largest Q over bins above the surface
   // Learned light selection: the share of selections drawn from light_cdf
-  // (0: by power alone, before the network has seen light here).
+  // (0: by power alone: no learned lights, or before the first optimiser
+  // step; then kNeuralLightGuideProb everywhere, where the table waits for
+  // a cell's first light target).
   Float light_prob = 0.f;
   Float light_pmf[kNeuralMaxLights];
   Float light_cdf[kNeuralMaxLights];  // inclusive running sum of light_pmf, the last 1
@@ -232,8 +234,8 @@ TESSERA_HOST_DEVICE inline void neural_layer(const float* w, const float* b, con
 // The learned light selection from the light outputs (the table's rule):
 // lights in proportion to their predicted contribution, mixed with the
 // uniform floor; drawn with probability kNeuralLightGuideProb, by power
-// otherwise. An untrained network, or one that predicts no light here,
-// leaves selection to power alone.
+// otherwise. An untrained network leaves selection to power alone (as
+// would non-finite predictions, which the clamped exp rules out).
 TESSERA_HOST_DEVICE inline void neural_light_distribution(const NeuralGuideView& v, NeuralSite* site) {
   site->light_prob = 0.f;
   const uint32_t lights = v.lights <= kNeuralMaxLights ? v.lights : 0u;

@@ -157,8 +157,11 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
 
   // A guide that converges per pass learns in passes of one sample (each
   // pass one bootstrap step) while every sample learns.
+  // At most 64 of them: a render told to learn from every sample for
+  // longer goes on in larger passes (fewer reductions, and trial passes of
+  // --guide auto need two samples per pixel).
   const uint32_t single_passes =
-      guide && guide->single_sample_learning_passes() ? opt.guide_learn.all_spp : 0u;
+      guide && guide->single_sample_learning_passes() ? std::min(opt.guide_learn.all_spp, 64u) : 0u;
   uint32_t spp_done = stats.spp;
   double last_pass_s = stats.pass_stats.empty() ? 0.0 : stats.pass_stats.back().seconds;
   for (uint32_t pass = stats.passes;; ++pass) {

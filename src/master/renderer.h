@@ -111,7 +111,7 @@ int32_t render_threads(const RenderOptions& options, int32_t ranks_on_this_machi
 // learns early), later ones amortise the per-pass overhead. With
 // single_passes > 0 the first single_passes passes are 1 spp each and the
 // doubling then goes on from 2 (Guide::single_sample_learning_passes: the
-// passes in which every sample learns). Depends on the pass index and the
+// passes in which every sample learns, up to 64). Depends on the pass index and the
 // options only, so a resumed render continues the same schedule.
 uint32_t pass_spp_for(uint32_t pass, uint32_t max_pass_spp, uint32_t single_passes = 0);
 

@@ -58,6 +58,12 @@ TEST(NeuralGuided, DoorAjarAndShelterAgreeWithUnguided) {
     expect_agree(channel_stats(g.film), mu, name);
     EXPECT_TRUE(all_finite(g.film));
     EXPECT_GT(g.stats.counters.path.guided_samples, g.stats.counters.path.vertices / 20);
+    if (guide->learned_lights() > 0) {
+      // The render selected lights from the network's distribution (after its first step).
+      NeuralSite site;
+      neural_infer(guide->view(), 0.5f * (s.scene.bounds().lo + s.scene.bounds().hi), Vec3(0.f, 1.f, 0.f), &site);
+      EXPECT_EQ(site.light_prob, kNeuralLightGuideProb);
+    }
     EXPECT_GT(g.stats.neural_guide.steps, 0u);
     EXPECT_EQ(g.stats.neural_guide.nonfinite_gradients, 0u);
   }
