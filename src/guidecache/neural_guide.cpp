@@ -1,6 +1,7 @@
 #include "guidecache/neural_guide.h"
 
 #include <Eigen/Dense>
+#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -293,18 +294,24 @@ static double adam_power(double beta, uint64_t steps) {
   return p;
 }
 
-void NeuralGuide::adam_step(const std::vector<double>& grad) {
+// The step from the summed fixed-point gradients (acc_[0..P), over `count`
+// targets). Parameter by parameter, so threads change no result.
+void NeuralGuide::adam_step(uint64_t count) {
   ++steps_;
   const double lr = config_.learning_rate;
   const double c1 = 1.0 - adam_power(kAdamBeta1, steps_);
   const double c2 = 1.0 - adam_power(kAdamBeta2, steps_);
-  for (size_t k = 0; k < params_.size(); ++k) {
-    const double m = kAdamBeta1 * adam_m_[k] + (1.0 - kAdamBeta1) * grad[k];
-    const double v = kAdamBeta2 * adam_v_[k] + (1.0 - kAdamBeta2) * grad[k] * grad[k];
-    adam_m_[k] = static_cast<float>(m);
-    adam_v_[k] = static_cast<float>(v);
-    params_[k] = static_cast<float>(params_[k] - lr * (m / c1) / (std::sqrt(v / c2) + kAdamEps));
-  }
+  const double per_target = 1.0 / kGradScale / static_cast<double>(count);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, params_.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k < r.end(); ++k) {
+      const double g = static_cast<double>(from_word(acc_[k])) * per_target;
+      const double m = kAdamBeta1 * adam_m_[k] + (1.0 - kAdamBeta1) * g;
+      const double v = kAdamBeta2 * adam_v_[k] + (1.0 - kAdamBeta2) * g * g;
+      adam_m_[k] = static_cast<float>(m);
+      adam_v_[k] = static_cast<float>(v);
+      params_[k] = static_cast<float>(params_[k] - lr * (m / c1) / (std::sqrt(v / c2) + kAdamEps));
+    }
+  });
 }
 
 void NeuralGuide::fold_round(uint32_t round) {
@@ -344,10 +351,7 @@ void NeuralGuide::fold_round(uint32_t round) {
   totals_.gradient_clamped += acc_[P + 2];
   totals_.nonfinite_gradients += acc_[P + 3];  // tiles left out of this step
   if (count > 0) {
-    std::vector<double> grad(P);
-    for (size_t k = 0; k < P; ++k)
-      grad[k] = static_cast<double>(from_word(acc_[k])) / kGradScale / static_cast<double>(count);
-    adam_step(grad);
+    adam_step(count);
     pass_loss_sum_ += static_cast<double>(acc_[P]) / kLossScale;
     pass_loss_count_ += count;
   }

@@ -136,7 +136,7 @@ class NeuralGuide final : public Guide {
   // repeats possible); the layers' block is dense.
   double tile_gradient(const std::vector<NeuralTrainingSample>& samples, uint32_t first, uint32_t stride,
                        std::vector<float>* grad, uint64_t* count, std::vector<uint32_t>* touched = nullptr) const;
-  void adam_step(const std::vector<double>& grad);
+  void adam_step(uint64_t count);
 
   NeuralGuideConfig config_;
   uint32_t lights_ = 0;               // learned lights (NeuralLayout::lights)

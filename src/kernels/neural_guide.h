@@ -120,7 +120,9 @@ struct NeuralSite {
   Vec3 p{0.f}, n{0.f, 0.f, 1.f};
   Float q[kNeuralMaxOutputs];  // incident radiance per bin, then each learned light's contribution
   Float pmf[kNeuralBins];    // guided distribution per bin (floor included)
-  Float cdf[kNeuralBins];    // inclusive running sum of pmf, cdf[last] = 1: built by the first sample
+  // Inclusive running sum of the rows' pmf (kNeuralGrid bins each), the
+  // last 1: built by the first sample (neural_build_cdf).
+  Float row_cdf[kNeuralGrid];
   bool has_cdf = false;
   Float irradiance = 0.f;    // sum over bins of Q max(cos, 0) dOmega about n
   Float qmax = 0.f;          // largest Q over bins above the surface
@@ -317,15 +319,21 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   neural_light_distribution(v, site);
 }
 
-// The site's cdf, built once per vertex by the first sample that needs it.
+// The site's cdf over rows of bins, built once per vertex by the first
+// sample that needs it. Two levels (a row, then a bin in it) instead of
+// one running sum over the 144 bins: that chain of dependent additions was
+// most of a sample's cost, the rows' sums are independent.
 TESSERA_HOST_DEVICE inline void neural_build_cdf(NeuralSite* site) {
+  Float row[kNeuralGrid] = {};
+  for (uint32_t c = 0; c < kNeuralGrid; ++c)
+    for (uint32_t r = 0; r < kNeuralGrid; ++r) row[r] += site->pmf[r * kNeuralGrid + c];
   Float acc = 0.f;
-  for (uint32_t j = 0; j < kNeuralBins; ++j) {
-    acc += site->pmf[j];
-    site->cdf[j] = acc;
+  for (uint32_t r = 0; r < kNeuralGrid; ++r) {
+    acc += row[r];
+    site->row_cdf[r] = acc;
   }
-  // The last bin takes the rounding: u < 1 always finds a bin.
-  site->cdf[kNeuralBins - 1] = 1.f;
+  // The last row takes the rounding: u < 1 always finds a row.
+  site->row_cdf[kNeuralGrid - 1] = 1.f;
   site->has_cdf = true;
 }
 
@@ -356,15 +364,17 @@ TESSERA_HOST_DEVICE inline Float neural_bin_pdf(const NeuralSite& site, uint32_t
 TESSERA_HOST_DEVICE inline bool neural_sample(NeuralSite& site, Float u_bin, Vec2 u, Vec3* dir, Float* pdf,
                                               uint32_t* bin_out) {
   if (!site.has_cdf) neural_build_cdf(&site);
-  uint32_t lo = 0, hi = kNeuralBins - 1;  // the first bin whose cdf exceeds u_bin
-  while (lo < hi) {
-    const uint32_t mid = (lo + hi) / 2;
-    if (site.cdf[mid] > u_bin) hi = mid;
-    else lo = mid + 1;
-  }
-  const uint32_t bin = lo;
+  uint32_t row = 0;  // the first row whose cdf exceeds u_bin
+  while (row + 1 < kNeuralGrid && !(site.row_cdf[row] > u_bin)) ++row;
+  // Then the bin where the running sum within the row passes what is left
+  // of u_bin (the row's last bin takes the rounding).
+  const Float t = u_bin - (row > 0 ? site.row_cdf[row - 1] : 0.f);
+  const Float* p = site.pmf + row * kNeuralGrid;
+  uint32_t col = 0;
+  Float acc = p[0];
+  while (col + 1 < kNeuralGrid && !(acc > t)) acc += p[++col];
+  const uint32_t bin = row * kNeuralGrid + col;
   if (!(site.pmf[bin] > 0.f)) return false;
-  const uint32_t row = bin / kNeuralGrid, col = bin % kNeuralGrid;
   const Float inv_grid = 1.f / static_cast<Float>(kNeuralGrid);
   *dir = equal_area_square_to_sphere(Vec2((static_cast<Float>(col) + u.x) * inv_grid,
                                           (static_cast<Float>(row) + u.y) * inv_grid));

@@ -443,6 +443,31 @@ TEST(NeuralGuide, InferenceGivesAProperDistribution) {
   }
   EXPECT_LT(chi2, 220.0);
   EXPECT_LE(elsewhere, kDraws / 1000);
+
+  // A sharp distribution too (a trained network's can be): a few bins with
+  // most of the mass, in the first, a middle and the last row.
+  NeuralSite sharp = site;
+  double total = 0.0;
+  for (uint32_t j = 0; j < kNeuralBins; ++j) {
+    sharp.pmf[j] = j == 0 || j == 77 || j == 143 ? 0.3f : 1e-3f;
+    total += sharp.pmf[j];
+  }
+  for (uint32_t j = 0; j < kNeuralBins; ++j) sharp.pmf[j] = static_cast<Float>(sharp.pmf[j] / total);
+  sharp.has_cdf = false;
+  std::fill(counts.begin(), counts.end(), 0);
+  for (int i = 0; i < kDraws; ++i) {
+    Vec3 dir;
+    Float pdf = 0.f;
+    uint32_t bin = 0;
+    ASSERT_TRUE(neural_sample(sharp, u(rng), Vec2(u(rng), u(rng)), &dir, &pdf, &bin));
+    ++counts[bin];
+  }
+  chi2 = 0.0;
+  for (uint32_t j = 0; j < kNeuralBins; ++j) {
+    const double expected = kDraws * static_cast<double>(sharp.pmf[j]);
+    chi2 += (counts[j] - expected) * (counts[j] - expected) / expected;
+  }
+  EXPECT_LT(chi2, 220.0);
 }
 
 }  // namespace
