@@ -301,10 +301,10 @@ void NeuralGuide::adam_step(uint64_t count) {
   const double lr = config_.learning_rate;
   const double c1 = 1.0 - adam_power(kAdamBeta1, steps_);
   const double c2 = 1.0 - adam_power(kAdamBeta2, steps_);
-  const double per_target = 1.0 / kGradScale / static_cast<double>(count);
+  const double n = static_cast<double>(count);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, params_.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k < r.end(); ++k) {
-      const double g = static_cast<double>(from_word(acc_[k])) * per_target;
+      const double g = static_cast<double>(from_word(acc_[k])) / kGradScale / n;
       const double m = kAdamBeta1 * adam_m_[k] + (1.0 - kAdamBeta1) * g;
       const double v = kAdamBeta2 * adam_v_[k] + (1.0 - kAdamBeta2) * g * g;
       adam_m_[k] = static_cast<float>(m);

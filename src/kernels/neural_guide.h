@@ -4,8 +4,8 @@
 // radiance of the same equal-area direction bins as the Q-table's
 // (guide_view.h). One inference per path vertex fills a NeuralSite: the
 // bins' radiance Q, the guided distribution (Q x max(cos, 0) about the
-// vertex's normal, mixed with a uniform floor), its cdf, the irradiance and
-// the largest Q: everything the integrator reads from a Q-table cell, so
+// vertex's normal, mixed with a uniform floor; its cdf is built by the
+// first sample), the irradiance and the largest Q: everything the integrator reads from a Q-table cell, so
 // sampling, the mixture, the floor, the expected-SARSA targets and guided
 // roulette carry over unchanged. In scenes of kNeuralMinLights to
 // kNeuralMaxLights lights the network has one more output per light, the
@@ -320,9 +320,9 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
 }
 
 // The site's cdf over rows of bins, built once per vertex by the first
-// sample that needs it. Two levels (a row, then a bin in it) instead of
-// one running sum over the 144 bins: that chain of dependent additions was
-// most of a sample's cost, the rows' sums are independent.
+// sample that needs it. Sampling takes two levels (a row, then a bin in
+// it): the rows' sums are independent chains of additions, where one
+// running sum over the 144 bins is a single long one.
 TESSERA_HOST_DEVICE inline void neural_build_cdf(NeuralSite* site) {
   Float row[kNeuralGrid] = {};
   for (uint32_t c = 0; c < kNeuralGrid; ++c)

@@ -82,7 +82,7 @@ struct NeuralPathGuide {
   const NeuralGuideView& v;
   NeuralSite site[2];
   int32_t last = 1;  // slot of the latest vertex located
-  // The sites are filled by locate(), not zeroed here (about 4 kB each).
+  // The sites are filled by locate(), not zeroed here (about 1.5 kB each).
   TESSERA_HOST_DEVICE explicit NeuralPathGuide(const NeuralGuideView& view) : v(view) {}
   NeuralPathGuide(const NeuralGuideView&&) = delete;  // it keeps a reference: not to a temporary
   // Next-event estimation at every vertex (no table to learn its probability).
