@@ -39,6 +39,19 @@ std::vector<NeuralTrainingSample> random_samples(size_t n, uint32_t seed, float 
   return out;
 }
 
+// One pass of 4 tiles of 256 random targets each, every target then
+// reshaped by shape(its number in the tile, the target).
+template <class Shape>
+std::vector<NeuralTileTargets> training_pass(int pass, Shape shape) {
+  std::vector<NeuralTileTargets> tiles(4);
+  for (uint32_t t = 0; t < tiles.size(); ++t) {
+    tiles[t].tile = t;
+    tiles[t].samples = random_samples(256, 100 * pass + t, 1.f);
+    for (size_t i = 0; i < tiles[t].samples.size(); ++i) shape(i, tiles[t].samples[i]);
+  }
+  return tiles;
+}
+
 // The network's Q for a sample's bin, through the kernels' inference.
 double predicted(const NeuralGuide& g, const NeuralTrainingSample& s) {
   const NeuralGuideView v = g.view();
@@ -118,19 +131,11 @@ TEST(NeuralGuide, LearnsASingleBrightDirection) {
   NeuralGuide g = make(c);
   const NeuralGuideView v0 = g.view();
   ASSERT_GT(glm::dot(v0.bin_dirs[kBright], Vec3(0.f, 0.f, 1.f)), 0.3f);
-  for (int pass = 0; pass < 40; ++pass) {
-    std::vector<NeuralTileTargets> tiles(4);
-    for (uint32_t t = 0; t < tiles.size(); ++t) {
-      tiles[t].tile = t;
-      tiles[t].samples = random_samples(256, 100 * pass + t, 1.f);
-      for (size_t i = 0; i < tiles[t].samples.size(); ++i) {
-        NeuralTrainingSample& s = tiles[t].samples[i];
-        if (i % 3 == 0) s.bin = kBright;  // a third of the samples took the bright direction
-        s.target = s.bin == kBright ? 1.f : 0.01f;
-      }
-    }
-    g.train_on(std::move(tiles));
-  }
+  for (int pass = 0; pass < 40; ++pass)
+    g.train_on(training_pass(pass, [&](size_t i, NeuralTrainingSample& s) {
+      if (i % 3 == 0) s.bin = kBright;  // a third of the samples took the bright direction
+      s.target = s.bin == kBright ? 1.f : 0.01f;
+    }));
   EXPECT_EQ(g.stats().steps, 40u * c.steps_per_pass);
   const NeuralGuideView v = g.view();
   std::mt19937 rng(99);
@@ -165,20 +170,12 @@ TEST(NeuralGuide, LearnsWhichLightContributes) {
     neural_infer(g.view(), Vec3(0.5f), Vec3(0.f, 0.f, 1.f), &site);
     EXPECT_EQ(site.light_prob, 0.f);  // untrained: power alone
   }
-  for (int pass = 0; pass < 40; ++pass) {
-    std::vector<NeuralTileTargets> tiles(4);
-    for (uint32_t t = 0; t < tiles.size(); ++t) {
-      tiles[t].tile = t;
-      tiles[t].samples = random_samples(256, 100 * pass + t, 1.f);
-      for (size_t i = 0; i < tiles[t].samples.size(); ++i) {
-        NeuralTrainingSample& s = tiles[t].samples[i];
-        if (i % 2 == 0) continue;  // half direction targets, half light targets
-        s.bin = kNeuralBins + static_cast<uint32_t>(i / 2) % kLights;
-        s.target = s.bin == kNeuralBins + kBright ? 2.f : 0.02f;
-      }
-    }
-    g.train_on(std::move(tiles));
-  }
+  for (int pass = 0; pass < 40; ++pass)
+    g.train_on(training_pass(pass, [&](size_t i, NeuralTrainingSample& s) {
+      if (i % 2 == 0) return;  // half direction targets, half light targets
+      s.bin = kNeuralBins + static_cast<uint32_t>(i / 2) % kLights;
+      s.target = s.bin == kNeuralBins + kBright ? 2.f : 0.02f;
+    }));
   const NeuralGuideView v = g.view();
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u(0.f, 1.f);
