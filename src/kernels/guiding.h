@@ -17,6 +17,21 @@ TESSERA_HOST_DEVICE inline Float nee_probability(const GuideView* g, int32_t cel
   return g && cell >= 0 ? g->nee_prob[cell] : 1.f;
 }
 
+// Learned light selection, shared by both guides: with probability lp a
+// light is drawn from the learned distribution, else by power. Its pmf for a
+// light of power-based pmf p_power and learned pmf p_learned:
+TESSERA_HOST_DEVICE inline Float mixed_light_pmf(Float lp, Float p_power, Float p_learned) {
+  return (1.f - lp) * p_power + lp * p_learned;
+}
+// ... and the draw with one uniform number u (lp > 0): the part of u below lp,
+// rescaled, picks from the learned distribution (sample_learned(u')).
+template <class SampleLearned>
+TESSERA_HOST_DEVICE inline uint32_t pick_mixed_light(const SceneView& s, Float lp, Float u,
+                                                     const SampleLearned& sample_learned) {
+  if (u < lp) return sample_learned(glm::min(u / lp, 0x1.fffffep-1f));
+  return s.light_select.sample_discrete(glm::min((u - lp) / (1.f - lp), 0x1.fffffep-1f), nullptr);
+}
+
 // Probability that next-event estimation at a point in `cell` samples light
 // li: that it is traced at all, times the selection probability (cell < 0 or
 // no learned lights: the power-based distribution alone). The density of the
@@ -27,7 +42,7 @@ TESSERA_HOST_DEVICE inline Float light_select_pmf(const SceneView& s, const Guid
   const Float p_nee = g->nee_prob[cell];
   if (g->lights == 0) return p_nee * p_power;
   const Float lp = g->cell_light_prob[cell];
-  return p_nee * ((1.f - lp) * p_power + lp * g->light_distribution(cell).discrete_pmf(li));
+  return p_nee * mixed_light_pmf(lp, p_power, g->light_distribution(cell).discrete_pmf(li));
 }
 
 // Selects a light with one uniform number, given that next-event estimation
@@ -40,12 +55,8 @@ TESSERA_HOST_DEVICE inline uint32_t select_light(const SceneView& s, const Guide
     *pmf *= nee_probability(g, cell);
     return li;
   }
-  uint32_t li;
-  if (u < lp) {
-    li = g->light_distribution(cell).sample_discrete(glm::min(u / lp, 0x1.fffffep-1f), nullptr);
-  } else {
-    li = s.light_select.sample_discrete(glm::min((u - lp) / (1.f - lp), 0x1.fffffep-1f), nullptr);
-  }
+  const uint32_t li = pick_mixed_light(
+      s, lp, u, [&](Float ul) { return g->light_distribution(cell).sample_discrete(ul, nullptr); });
   *pmf = light_select_pmf(s, g, cell, li);
   return li;
 }

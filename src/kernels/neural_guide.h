@@ -5,9 +5,9 @@
 // (guide_view.h). One inference per path vertex fills a NeuralSite: the
 // bins' radiance Q, the guided distribution (Q x max(cos, 0) about the
 // vertex's normal, mixed with a uniform floor; its cdf is built by the
-// first sample), the irradiance and the largest Q: everything the integrator reads from a Q-table cell, so
-// sampling, the mixture, the floor, the expected-SARSA targets and guided
-// roulette carry over unchanged. In scenes of kNeuralMinLights to
+// first sample), the irradiance and the largest Q: everything the
+// integrator reads from a Q-table cell, so sampling, the mixture, the floor,
+// the expected-SARSA targets and guided roulette carry over unchanged. In scenes of kNeuralMinLights to
 // kNeuralMaxLights lights the network has one more output per light, the
 // contribution next-event estimation gets from it at the point (the table's
 // learned light selection, kept as its cells keep it).

@@ -95,13 +95,12 @@ struct NeuralPathGuide {
     const NeuralSite& x = site[slot];
     const Float lp = x.light_prob;
     if (!(lp > 0.f)) return p_power;
-    return (1.f - lp) * p_power + lp * (li < v.lights ? x.light_pmf[li] : 0.f);
+    return mixed_light_pmf(lp, p_power, li < v.lights ? x.light_pmf[li] : 0.f);
   }
   TESSERA_HOST_DEVICE uint32_t pick_light(const SceneView& s, int32_t slot, Float u, Float* pmf) const {
     const Float lp = slot >= 0 ? site[slot].light_prob : 0.f;
     if (!(lp > 0.f)) return s.light_select.sample_discrete(u, pmf);
-    const uint32_t li = u < lp ? neural_sample_light(v, site[slot], glm::min(u / lp, 0x1.fffffep-1f))
-                               : s.light_select.sample_discrete(glm::min((u - lp) / (1.f - lp), 0x1.fffffep-1f), nullptr);
+    const uint32_t li = pick_mixed_light(s, lp, u, [&](Float ul) { return neural_sample_light(v, site[slot], ul); });
     *pmf = light_pmf(s, slot, li);
     return li;
   }
