@@ -452,15 +452,19 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     const bool delta_lobe = (lobes & kLobeSpecular) != 0;
 
     int32_t cell = -1;
+    // The network is not run where the path ends (it would guide nothing,
+    // and the pending target is dropped there); the table still notes the normal.
     if constexpr (kGuide) {
-      // The side the path is on: the two faces of a wall never share a cell.
-      Vec3 n_side = glm::dot(h.ng, wo) >= 0.f ? h.ng : -h.ng;
-      cell = pg.locate(h.p, n_side);
-      if (learn) {
-        pg.note_normal(cell, n_side);
-        // Emission the integrator weights by MIS is NEE's to deliver.
-        pend_le = (specular_bounce || !settings.nee) ? luminance(Le_hit) : 0.f;
-        pend_at_delta = delta_lobe;
+      if (!(kNeural && depth == settings.max_depth)) {
+        // The side the path is on: the two faces of a wall never share a cell.
+        Vec3 n_side = glm::dot(h.ng, wo) >= 0.f ? h.ng : -h.ng;
+        cell = pg.locate(h.p, n_side);
+        if (learn) {
+          pg.note_normal(cell, n_side);
+          // Emission the integrator weights by MIS is NEE's to deliver.
+          pend_le = (specular_bounce || !settings.nee) ? luminance(Le_hit) : 0.f;
+          pend_at_delta = delta_lobe;
+        }
       }
     }
 

@@ -20,6 +20,7 @@
 #include <cstring>
 
 #include "kernels/equal_area.h"
+#include "kernels/lanes8.h"
 #include "kernels/vecmath.h"
 
 namespace tessera {
@@ -154,6 +155,17 @@ TESSERA_HOST_DEVICE inline Float neural_exp(Float x) {
   return p * scale;
 }
 
+// neural_exp on eight lanes: the same operations, the same bits.
+TESSERA_HOST_DEVICE inline F8 neural_exp8(F8 x) {
+  const F8 lo = lanes_splat(kNeuralMinLog), hi = lanes_splat(kNeuralMaxLog);
+  x = lanes_select_gt(x, lo, x, lo);
+  x = lanes_select_gt(hi, x, x, hi);
+  const I8 n = lanes_trunc_i(x * 1.44269504f + 128.5f) - 128;
+  const F8 f = x - lanes_float_i(n) * 0.693147181f;
+  const F8 p = 1.f + f * (1.f + f * (0.5f + f * (1.f / 6.f + f * (1.f / 24.f + f * (1.f / 120.f + f * (1.f / 720.f))))));
+  return p * lanes_bits_to_float(lanes_u(n + 127) << 23u);
+}
+
 // Cells per side of each level: geometric from 4 to 256 (4 * 64^(l / 7), rounded).
 TESSERA_HOST_DEVICE inline uint32_t neural_level_resolution(uint32_t level) {
   const uint32_t res[kNeuralLevels] = {4, 7, 13, 24, 43, 78, 141, 256};
@@ -197,40 +209,72 @@ TESSERA_HOST_DEVICE inline void neural_level_corners(uint32_t table_size, uint32
   }
 }
 
-// The network's input for a point and normal: kNeuralInputs floats.
+// The network's input for a point and normal: kNeuralInputs floats. The
+// eight levels are computed side by side (lanes8.h), each lane as
+// neural_level_corners and a sum over its corners in their order.
 TESSERA_HOST_DEVICE inline void neural_encode(const NeuralGuideView& v, const Vec3& p, const Vec3& n, Float* in) {
+  static_assert(kNeuralLevels == kLanes8, "one lane per level");
+  static_assert(kNeuralFeatures == 2, "two features per level");
   const Vec3 u = neural_unit_position(v, p);
   const uint32_t table_size = 1u << v.table_log2;
-  for (uint32_t l = 0; l < kNeuralLevels; ++l) {
-    uint32_t entry[8];
-    Float weight[8];
-    neural_level_corners(table_size, l, u, entry, weight);
-    const float* table = v.params + (static_cast<size_t>(l) * table_size) * kNeuralFeatures;
-    Float f0 = 0.f, f1 = 0.f;
-    for (uint32_t c = 0; c < 8; ++c) {
-      f0 += weight[c] * table[entry[c] * kNeuralFeatures];
-      f1 += weight[c] * table[entry[c] * kNeuralFeatures + 1];
+  uint32_t res_list[kLanes8];
+  for (uint32_t l = 0; l < kLanes8; ++l) res_list[l] = neural_level_resolution(l);
+  const U8 res = lanes_make_u(res_list);
+  const U8 side = res + 1u;
+  // Levels whose vertices fit the table index it densely (neural_grid_entry).
+  const U8 vertices = side * side * side, entries = lanes_splat_u(table_size);
+  U8 i0[3];
+  F8 f[3], g[3];
+  for (int k = 0; k < 3; ++k) {
+    const F8 x = lanes_splat(u[k]) * lanes_float(res);
+    i0[k] = lanes_min_u(lanes_trunc_u(x), res - 1u);
+    f[k] = x - lanes_float(i0[k]);
+    g[k] = 1.f - f[k];
+  }
+  F8 f0 = lanes_splat(0.f), f1 = lanes_splat(0.f);
+  for (uint32_t c = 0; c < 8; ++c) {
+    const uint32_t dx = c & 1u, dy = (c >> 1) & 1u, dz = (c >> 2) & 1u;
+    const U8 x = i0[0] + dx, y = i0[1] + dy, z = i0[2] + dz;
+    const U8 entry = lanes_select_le_u(vertices, entries, (z * side + y) * side + x,
+                                       (x ^ (y * 2654435761u) ^ (z * 805459861u)) & (table_size - 1u));
+    const F8 weight = (dx ? f[0] : g[0]) * (dy ? f[1] : g[1]) * (dz ? f[2] : g[2]);
+    F8 t0, t1;
+    for (uint32_t l = 0; l < kLanes8; ++l) {
+      const float* e = v.params + (static_cast<size_t>(l) * table_size + entry[l]) * kNeuralFeatures;
+      t0[l] = e[0];
+      t1[l] = e[1];
     }
-    in[l * kNeuralFeatures] = f0;
-    in[l * kNeuralFeatures + 1] = f1;
+    f0 += weight * t0;
+    f1 += weight * t1;
+  }
+  for (uint32_t l = 0; l < kLanes8; ++l) {
+    in[l * kNeuralFeatures] = f0[l];
+    in[l * kNeuralFeatures + 1] = f1[l];
   }
   in[kNeuralEncoded] = n.x;
   in[kNeuralEncoded + 1] = n.y;
   in[kNeuralEncoded + 2] = n.z;
 }
 
-// out[o] = b[o] + sum_i w[i * outs + o] in[i], then ReLU when asked.
-TESSERA_HOST_DEVICE inline void neural_layer(const float* w, const float* b, const Float* in, uint32_t ins,
-                                             uint32_t outs, bool relu, Float* out) {
-  for (uint32_t o = 0; o < outs; ++o) out[o] = b[o];
-  for (uint32_t i = 0; i < ins; ++i) {
-    const Float x = in[i];
-    if (x == 0.f) continue;  // ReLU zeros are common: their columns add nothing
-    const float* col = w + static_cast<size_t>(i) * outs;
-    for (uint32_t o = 0; o < outs; ++o) out[o] += col[o] * x;
+// out[o] = max(b[o] + sum_i w[i * outs + o] in[i], 0): a hidden layer,
+// in blocks of 8 outputs where the width allows (each output's sum in the
+// same order either way). No test for zero inputs: ReLU zeros fall at
+// random, and the mispredicted branches cost more than the columns they skip.
+TESSERA_HOST_DEVICE inline void neural_hidden_layer(const float* w, const float* b, const Float* in, uint32_t ins,
+                                                    uint32_t outs, Float* out) {
+  const uint32_t blocked = outs - outs % kLanes8;
+  const F8 zero = lanes_splat(0.f);
+  for (uint32_t o = 0; o < blocked; o += kLanes8) {
+    F8 acc = lanes_load(b + o);
+    const float* col = w + o;
+    for (uint32_t i = 0; i < ins; ++i, col += outs) acc += lanes_load(col) * in[i];
+    lanes_store(out + o, lanes_select_gt(acc, zero, acc, zero));
   }
-  if (relu)
-    for (uint32_t o = 0; o < outs; ++o) out[o] = glm::max(out[o], 0.f);
+  for (uint32_t o = blocked; o < outs; ++o) {
+    Float acc = b[o];
+    for (uint32_t i = 0; i < ins; ++i) acc += w[static_cast<size_t>(i) * outs + o] * in[i];
+    out[o] = acc > 0.f ? acc : 0.f;
+  }
 }
 
 // The learned light selection from the light outputs (the table's rule):
@@ -273,40 +317,59 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   const NeuralLayout L{v.width, v.table_log2, v.lights};
   Float in[kNeuralInputs], h1[kNeuralMaxWidth], h2[kNeuralMaxWidth];
   neural_encode(v, p, n, in);
-  neural_layer(v.params + L.w1(), v.params + L.b1(), in, kNeuralInputs, v.width, true, h1);
-  neural_layer(v.params + L.w2(), v.params + L.b2(), h1, v.width, v.width, true, h2);
-  neural_layer(v.params + L.w3(), v.params + L.b3(), h2, v.width, L.outputs(), false, site->q);
+  neural_hidden_layer(v.params + L.w1(), v.params + L.b1(), in, kNeuralInputs, v.width, h1);
+  neural_hidden_layer(v.params + L.w2(), v.params + L.b2(), h1, v.width, v.width, h2);
   site->p = p;
   site->n = n;
   site->has_cdf = false;
-  // Loops over bins vectorise: no aliasing between the site's arrays and the
-  // view's, scalars in locals.
-  Float* __restrict q = site->q;
-  Float* __restrict pmf = site->pmf;
-  const Float* __restrict dx = v.bin_dir_soa;
-  const Float* __restrict dy = dx + kNeuralBins;
-  const Float* __restrict dz = dy + kNeuralBins;
-  const Float scale = v.scale, nx = n.x, ny = n.y, nz = n.z;
-  for (uint32_t j = 0; j < kNeuralBins; ++j) q[j] = scale * neural_exp(q[j]);
-  // Q x max(cos, 0), then its sum and the largest Q above the surface in 8
-  // lanes (a fixed order of additions).
-  Float above[kNeuralBins];  // Q of the bins above the surface, 0 below
-  for (uint32_t j = 0; j < kNeuralBins; ++j) {
-    const Float c = dx[j] * nx + dy[j] * ny + dz[j] * nz;
-    const Float cosine = c > 0.f ? c : 0.f;  // selects only: no speculated arithmetic
-    pmf[j] = q[j] * cosine;
-    above[j] = c > 0.f ? q[j] : 0.f;
-  }
-  constexpr uint32_t kLanes = 8;
-  static_assert(kNeuralBins % kLanes == 0, "bins in whole lanes");
-  Float lane_sum[kLanes] = {}, lane_max[kLanes] = {};
-  for (uint32_t j = 0; j < kNeuralBins; j += kLanes)
-    for (uint32_t k = 0; k < kLanes; ++k) {
-      lane_sum[k] += site->pmf[j + k];
-      lane_max[k] = lane_max[k] > above[j + k] ? lane_max[k] : above[j + k];
+  // The output layer, exp, Q x max(cos, 0), its sum and the largest Q above
+  // the surface in one pass over blocks of 8 bins, each block in registers
+  // (lanes8.h; each bin's sums in a fixed order).
+  static_assert(kNeuralBins % kLanes8 == 0, "bins in whole lanes");
+  const uint32_t outs = L.outputs(), width = v.width;
+  const float* w3 = v.params + L.w3();
+  const float* b3 = v.params + L.b3();
+  Float* q = site->q;
+  Float* pmf = site->pmf;
+  const Float* dx = v.bin_dir_soa;
+  const Float* dy = dx + kNeuralBins;
+  const Float* dz = dy + kNeuralBins;
+  const Float nx = n.x, ny = n.y, nz = n.z;
+  const F8 scale = lanes_splat(v.scale), zero = lanes_splat(0.f);
+  F8 lane_sum = zero, lane_max = zero;
+  // Six blocks at a time: their sums are independent chains of additions
+  // (one block's chain alone waits on each addition's latency).
+  constexpr uint32_t kGroup = 6;
+  static_assert(kNeuralBins % (kGroup * kLanes8) == 0, "bins in whole groups");
+  for (uint32_t j0 = 0; j0 < kNeuralBins; j0 += kGroup * kLanes8) {
+    F8 acc[kGroup];
+    for (uint32_t g = 0; g < kGroup; ++g) acc[g] = lanes_load(b3 + j0 + g * kLanes8);
+    const float* col = w3 + j0;
+    for (uint32_t i = 0; i < width; ++i, col += outs) {
+      const F8 x = lanes_splat(h2[i]);
+      for (uint32_t g = 0; g < kGroup; ++g) acc[g] += lanes_load(col + g * kLanes8) * x;
     }
+    for (uint32_t g = 0; g < kGroup; ++g) {
+      const uint32_t j = j0 + g * kLanes8;
+      const F8 qj = scale * neural_exp8(acc[g]);
+      const F8 c = lanes_load(dx + j) * nx + lanes_load(dy + j) * ny + lanes_load(dz + j) * nz;
+      const F8 cosine = lanes_select_gt(c, zero, c, zero);
+      const F8 above = lanes_select_gt(c, zero, qj, zero);  // Q of the bins above the surface, 0 below
+      const F8 weighted = qj * cosine;
+      lanes_store(q + j, qj);
+      lanes_store(pmf + j, weighted);
+      lane_sum += weighted;
+      lane_max = lanes_select_gt(lane_max, above, lane_max, above);
+    }
+  }
+  // The light outputs (raw: neural_light_distribution takes their exp).
+  for (uint32_t o = kNeuralBins; o < outs; ++o) {
+    Float acc = b3[o];
+    for (uint32_t i = 0; i < width; ++i) acc += w3[static_cast<size_t>(i) * outs + o] * h2[i];
+    q[o] = acc;
+  }
   Float total = 0.f, qmax = 0.f;
-  for (uint32_t k = 0; k < kLanes; ++k) {
+  for (uint32_t k = 0; k < kLanes8; ++k) {
     total += lane_sum[k];
     qmax = glm::max(qmax, lane_max[k]);
   }
@@ -315,7 +378,7 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   const Float floor = glm::clamp(v.floor, 0.f, 1.f);
   const Float uniform = total > 0.f ? floor / static_cast<Float>(kNeuralBins) : 1.f / static_cast<Float>(kNeuralBins);
   const Float w = total > 0.f ? (1.f - floor) / total : 0.f;
-  for (uint32_t j = 0; j < kNeuralBins; ++j) site->pmf[j] = site->pmf[j] * w + uniform;
+  for (uint32_t j = 0; j < kNeuralBins; ++j) pmf[j] = pmf[j] * w + uniform;
   neural_light_distribution(v, site);
 }
 

@@ -398,6 +398,88 @@ TEST(NeuralGuide, AvxAndPortableInferenceAgreeBitForBit) {
   }
 }
 
+// The inference computes eight lanes at a time (kernels/lanes8.h); each
+// output is still the plain definition, bit for bit: the encoding summed
+// over corners in order, each layer's sums in input order, exp by
+// neural_exp. Widths that fill whole lanes and widths that leave a tail.
+TEST(NeuralGuide, LaneInferenceEqualsThePlainDefinition) {
+  for (uint32_t width : {5u, 8u, 13u, 16u}) {
+    NeuralGuide g = make(small_config(width), 3);
+    std::vector<NeuralTrainingSample> samples = random_samples(200, 7, 1.f);
+    for (size_t i = 0; i < samples.size(); i += 3) samples[i].bin = kNeuralBins + static_cast<uint32_t>(i) % 3;
+    g.train_on({{0, samples}});
+    const NeuralGuideView v = g.view();
+    const NeuralLayout L = g.layout();
+    const float* P = g.params().data();
+    std::mt19937 rng(width);
+    std::uniform_real_distribution<float> u(-0.1f, 1.1f);
+    for (int t = 0; t < 50; ++t) {
+      const Vec3 p(u(rng), u(rng), u(rng));
+      const Vec3 n = glm::normalize(Vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f) + Vec3(0.f, 0.f, 1e-3f));
+      std::vector<float> in(kNeuralInputs), h1(width), h2(width);
+      const Vec3 up = neural_unit_position(v, p);
+      for (uint32_t l = 0; l < kNeuralLevels; ++l) {
+        uint32_t entry[8];
+        Float weight[8];
+        neural_level_corners(L.table_size(), l, up, entry, weight);
+        for (uint32_t f = 0; f < kNeuralFeatures; ++f) {
+          float sum = 0.f;
+          for (uint32_t c = 0; c < 8; ++c)
+            sum += weight[c] * P[(l * L.table_size() + entry[c]) * kNeuralFeatures + f];
+          in[l * kNeuralFeatures + f] = sum;
+        }
+      }
+      in[kNeuralEncoded] = n.x;
+      in[kNeuralEncoded + 1] = n.y;
+      in[kNeuralEncoded + 2] = n.z;
+      auto layer = [&](uint32_t w, uint32_t b, const std::vector<float>& x, uint32_t outs, bool relu) {
+        std::vector<float> out(outs);
+        for (uint32_t o = 0; o < outs; ++o) {
+          float acc = P[b + o];
+          for (size_t i = 0; i < x.size(); ++i) acc += P[w + i * outs + o] * x[i];
+          out[o] = relu ? (acc > 0.f ? acc : 0.f) : acc;
+        }
+        return out;
+      };
+      h1 = layer(L.w1(), L.b1(), in, width, true);
+      h2 = layer(L.w2(), L.b2(), h1, width, true);
+      const std::vector<float> o = layer(L.w3(), L.b3(), h2, L.outputs(), false);
+      NeuralSite site;
+      neural_infer_cpu(v, p, n, &site);
+      for (uint32_t j = 0; j < L.outputs(); ++j) {
+        const float expected = v.scale * neural_exp(o[j]);
+        ASSERT_EQ(std::memcmp(&site.q[j], &expected, sizeof expected), 0) << "width " << width << " output " << j;
+      }
+    }
+  }
+}
+
+// neural_exp on eight lanes is neural_exp, including its clamps and NaN.
+TEST(NeuralGuide, LaneExpEqualsScalarExp) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-40.f, 30.f);
+  for (int t = 0; t < 200; ++t) {
+    float x[kLanes8];
+    for (uint32_t k = 0; k < kLanes8; ++k) x[k] = u(rng);
+    if (t == 0) {
+      x[0] = std::nanf("");
+      x[1] = INFINITY;
+      x[2] = -INFINITY;
+      x[3] = kNeuralMinLog;
+      x[4] = kNeuralMaxLog;
+      x[5] = 0.f;
+      x[6] = -0.f;
+      x[7] = 1e-30f;
+    }
+    float y[kLanes8];
+    lanes_store(y, neural_exp8(lanes_make(x)));
+    for (uint32_t k = 0; k < kLanes8; ++k) {
+      const float e = neural_exp(x[k]);
+      ASSERT_EQ(std::memcmp(&y[k], &e, sizeof e), 0) << x[k];
+    }
+  }
+}
+
 // The distribution an inference builds is a distribution: positive
 // everywhere (the floor), summing to 1, and the density of a sampled
 // direction is that of its bin.
