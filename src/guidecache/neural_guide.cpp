@@ -143,9 +143,21 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
   const NeuralGuideView v = view();
   const float scale = v.scale;
   Mat X(kNeuralInputs, B);
+  // Targets, their bootstrapped parts recomputed by the network as it is
+  // now (NeuralTrainingSample): what the next vertex is predicted to send
+  // moves with every step, not only between passes.
+  std::vector<float> T(static_cast<size_t>(B));
+  NeuralSite y;
   for (Eigen::Index b = 0; b < B; ++b) {
     const NeuralTrainingSample& s = samples[first + static_cast<size_t>(b) * stride];
     neural_encode(v, Vec3(s.p[0], s.p[1], s.p[2]), Vec3(s.n[0], s.n[1], s.n[2]), X.col(b).data());
+    float t = s.target;
+    if (s.coef > 0.f && v.trained) {
+      neural_infer_cpu(v, Vec3(s.y_p[0], s.y_p[1], s.y_p[2]), Vec3(s.y_n[0], s.y_n[1], s.y_n[2]), &y);
+      const float refreshed = s.target + s.coef * (neural_bootstrap_value(y, s.y_bin) - s.value);
+      if (std::isfinite(refreshed)) t = std::min(std::max(refreshed, 0.f), max_target_);
+    }
+    T[static_cast<size_t>(b)] = t;
   }
   const float* P = params_.data();
   Eigen::Map<const Mat> W1(P + L.w1(), W, kNeuralInputs), W2(P + L.w2(), W, W), W3(P + L.w3(), O, W);
@@ -163,7 +175,7 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
     const uint32_t bin = s.bin < L.outputs() ? s.bin : 0u;  // a direction bin or a light
     const float o = W3.row(bin).dot(H2.col(b)) + b3[bin];
     const float q = neural_exp(o);
-    const float t = s.target / scale;
+    const float t = T[static_cast<size_t>(b)] / scale;
     const float denom = q * q + kNeuralLossEps;
     loss += std::min(static_cast<double>((q - t) * (q - t) / denom), kLossLimit);
     const float go = std::clamp(2.f * (q - t) * q / denom, -kGradClip, kGradClip);

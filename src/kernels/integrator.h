@@ -275,9 +275,11 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     pend_mix.light_pdf = (pend_mix.light_pdf * pend_mix.emitted + light_pdf * le) / total;
     pend_mix.emitted = total;
   };
-  auto finish_target = [&](Float target) {
+  // boot: the target's bootstrapped part (the network refreshes it as it trains).
+  auto finish_target = [&](Float target, GuideBootstrap boot) {
     target *= segment_tr;
-    if (pg.record(pend_cell, pend_bin, target)) {
+    boot.coef *= segment_tr;
+    if (pg.record(pend_cell, pend_bin, target, boot)) {
       ++c.guide_updates;
       if (pend_mix.mix_pdf > 0.f) {
         pend_mix.emitted *= segment_tr;
@@ -345,7 +347,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
             // The guide has no cells in media: a pending target ends here with
             // the light scattered here directly (multiple scattering is not learned).
             if (learn && pend_cell >= 0) {
-              finish_target(direct_estimate);
+              finish_target(direct_estimate, GuideBootstrap{});
               pend_cell = -1;
             }
             // Henyey-Greenstein sampling is exact: the weight p / pdf is 1.
@@ -396,7 +398,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       }
       if constexpr (kGuide) {
         const bool counted = specular_bounce || !settings.nee;  // else NEE delivers the environment
-        if (pend_cell >= 0) finish_target(counted ? luminance(Le_total) : 0.f);
+        if (pend_cell >= 0) finish_target(counted ? luminance(Le_total) : 0.f, GuideBootstrap{});
       }
       break;
     }
@@ -560,15 +562,16 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     const bool records_nee = learn && nee_vertex;
     if (completes_target || sets_expectation || records_nee) {
       const bool lambertian = (Spec & kSpecNonDiffuse) == 0 || bsdf.type == BsdfType::Diffuse;
+      GuideBootstrap boot;
       const Float indirect = pg.bins_integral(cell, bsdf, lambertian, wo_l,
-                                              [&](const Vec3& v) { return frame.to_local(v); }, rng);
+                                              [&](const Vec3& v) { return frame.to_local(v); }, rng, &boot);
       const Float reflected = direct_estimate + indirect;
       if (records_nee) {
         // The two shares of the light reflected here, for nee_prob.
         pg.record_nee(cell, direct_estimate, indirect);
       }
       if (completes_target) {
-        finish_target(pend_le + reflected);
+        finish_target(pend_le + reflected, boot);
         pend_cell = -1;
       }
       if (sets_expectation) path_expected = luminance(beta) * reflected;
@@ -612,7 +615,10 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     const Rgb weight = bs.f * (abs_cos_theta(bs.wi) / scatter_pdf);
     if (learn) {
       // A delta vertex's integral is the direction it actually took.
-      if (pend_at_delta && pend_cell >= 0) finish_target(pend_le + pg.value(cell, wi_bin) * luminance(weight));
+      if (pend_at_delta && pend_cell >= 0) {
+        const Float value = pg.value(cell, wi_bin);
+        finish_target(pend_le + value * luminance(weight), GuideBootstrap{cell, wi_bin, luminance(weight), value});
+      }
       pend_cell = cell;
       pend_bin = wi_bin;
       pend_at_delta = false;

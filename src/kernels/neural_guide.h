@@ -74,11 +74,24 @@ struct NeuralLayout {
 // of the vertex, the output it trains (the bin of the direction it took, or
 // kNeuralBins + a light) and the target (radiance arriving along it, or
 // what the light's sample brought, in the scene's units).
+//
+// Most targets are partly bootstrapped: target = known + coef x value, the
+// value being what the network predicted at the next vertex y (its
+// irradiance, y_bin == kNeuralIrradiance, or Q of bin y_bin) when the path
+// was traced. Training recomputes that value with the network as it is at
+// each optimiser step (NeuralGuide::tile_gradient), so that every step is a
+// bootstrap step, not only every pass. coef 0: nothing bootstrapped.
+constexpr uint32_t kNeuralIrradiance = 0xffffffffu;
 struct NeuralTrainingSample {
   float p[3];
   float n[3];
   uint32_t bin;
   float target;
+  float y_p[3] = {0.f, 0.f, 0.f};
+  float y_n[3] = {0.f, 0.f, 0.f};
+  uint32_t y_bin = 0;
+  float coef = 0.f;
+  float value = 0.f;
 };
 
 // Where a thread's learning targets go while it renders one tile. A target
@@ -446,9 +459,24 @@ TESSERA_HOST_DEVICE inline bool neural_sample(NeuralSite& site, Float u_bin, Vec
   return true;
 }
 
+// The bootstrapped part of a target, as NeuralTrainingSample keeps it:
+// coef x the value (y_bin: kNeuralIrradiance or a bin) predicted at site y.
+struct NeuralBootstrap {
+  const NeuralSite* y = nullptr;  // null: nothing bootstrapped
+  uint32_t y_bin = 0;
+  Float coef = 0.f;
+  Float value = 0.f;
+};
+
+// The value a bootstrap reads at a site.
+TESSERA_HOST_DEVICE inline Float neural_bootstrap_value(const NeuralSite& y, uint32_t y_bin) {
+  return y_bin == kNeuralIrradiance ? y.irradiance : y_bin < kNeuralBins ? y.q[y_bin] : 0.f;
+}
+
 // Records a learning target for the site's bin into the calling thread's
 // sink. Returns false (and counts it) when the target is rejected.
-TESSERA_HOST_DEVICE inline bool neural_record(const NeuralGuideView& v, const NeuralSite& site, uint32_t bin, Float target) {
+TESSERA_HOST_DEVICE inline bool neural_record(const NeuralGuideView& v, const NeuralSite& site, uint32_t bin, Float target,
+                                              const NeuralBootstrap& boot = NeuralBootstrap{}) {
   NeuralSampleSink* sink = v.sink;
   if (!sink) return false;
   if (!(target >= 0.f) || !(target <= 3.4e38f)) {
@@ -476,6 +504,17 @@ TESSERA_HOST_DEVICE inline bool neural_record(const NeuralGuideView& v, const Ne
   }
   s.bin = bin;
   s.target = target;
+  // A bootstrap whose coefficient or value is not a finite non-negative
+  // number is not refreshed: the target stays as recorded.
+  const bool refreshable = boot.y && boot.coef > 0.f && boot.coef <= 3.4e38f && boot.value >= 0.f &&
+                           boot.value <= 3.4e38f && boot.coef * boot.value <= target * 1.001f;
+  for (int k = 0; k < 3; ++k) {
+    s.y_p[k] = refreshable ? boot.y->p[k] : 0.f;
+    s.y_n[k] = refreshable ? boot.y->n[k] : 0.f;
+  }
+  s.y_bin = refreshable ? boot.y_bin : 0u;
+  s.coef = refreshable ? boot.coef : 0.f;
+  s.value = refreshable ? boot.value : 0.f;
   return true;
 }
 

@@ -15,6 +15,17 @@
 
 namespace tessera {
 
+// The bootstrapped part of a learning target: coef x the guide's value at
+// vertex `slot` (of bin `bin`, or kNeuralIrradiance: the irradiance), as it
+// was then (`value`). The network recomputes it as it trains
+// (NeuralTrainingSample); the table ignores it. slot -1: none.
+struct GuideBootstrap {
+  int32_t slot = -1;
+  uint32_t bin = 0;
+  Float coef = 0.f;
+  Float value = 0.f;
+};
+
 struct TablePathGuide {
   const GuideView& g;
   // Light selection and next-event probability are learned per cell.
@@ -58,10 +69,12 @@ struct TablePathGuide {
   }
   template <class ToLocal>
   TESSERA_HOST_DEVICE Float bins_integral(int32_t cell, const BsdfParams& b, bool lambertian, const Vec3& wo_local,
-                                          const ToLocal& to_local, PixelSampler& rng) const {
+                                          const ToLocal& to_local, PixelSampler& rng, GuideBootstrap*) const {
     return guide_bins_integral(g, cell, b, lambertian, wo_local, to_local, rng);
   }
-  TESSERA_HOST_DEVICE bool record(int32_t cell, uint32_t bin, Float target) const { return guide_record(g, cell, bin, target); }
+  TESSERA_HOST_DEVICE bool record(int32_t cell, uint32_t bin, Float target, const GuideBootstrap&) const {
+    return guide_record(g, cell, bin, target);
+  }
   TESSERA_HOST_DEVICE void record_light(int32_t cell, uint32_t li, Float learned) const {
     if (g.lights > 0) guide_record(g, cell, g.bins + li, learned);
   }
@@ -138,11 +151,16 @@ struct NeuralPathGuide {
     return glm::min(window * throughput * site[s].q[bin] / path_expected, 1.f);
   }
   // Expected SARSA's integral of Q f |cos| over y's bins (guide_bins_integral).
+  // It is coef x one value of y's, which *boot records.
   template <class ToLocal>
   TESSERA_HOST_DEVICE Float bins_integral(int32_t s, const BsdfParams& b, bool lambertian, const Vec3& wo_local,
-                                          const ToLocal& to_local, PixelSampler& rng) {
+                                          const ToLocal& to_local, PixelSampler& rng, GuideBootstrap* boot) {
     NeuralSite& y = site[s];
-    if (lambertian) return luminance(b.reflectance) * kInvPi * y.irradiance;
+    *boot = GuideBootstrap{};
+    if (lambertian) {
+      *boot = GuideBootstrap{s, kNeuralIrradiance, luminance(b.reflectance) * kInvPi, y.irradiance};
+      return boot->coef * boot->value;
+    }
     Vec3 dir;
     Float pdf = 0.f;
     uint32_t j = 0;
@@ -150,9 +168,16 @@ struct NeuralPathGuide {
     if (!neural_sample(y, u, Vec2(0.5f), &dir, &pdf, &j)) return 0.f;
     const Vec3 wi = to_local(v.bin_dirs[j]);
     const Float pmf = y.pmf[j];
-    return y.q[j] * luminance(bsdf_eval(b, wo_local, wi)) * fabsf(wi.z) * (4.f * kPi / static_cast<Float>(kNeuralBins)) / pmf;
+    *boot = GuideBootstrap{
+        s, j, luminance(bsdf_eval(b, wo_local, wi)) * fabsf(wi.z) * (4.f * kPi / static_cast<Float>(kNeuralBins)) / pmf,
+        y.q[j]};
+    return boot->value * boot->coef;
   }
-  TESSERA_HOST_DEVICE bool record(int32_t s, uint32_t bin, Float target) const { return neural_record(v, site[s], bin, target); }
+  TESSERA_HOST_DEVICE bool record(int32_t s, uint32_t bin, Float target, const GuideBootstrap& boot) const {
+    NeuralBootstrap nb;
+    if (boot.slot >= 0) nb = NeuralBootstrap{&site[boot.slot], boot.bin, boot.coef, boot.value};
+    return neural_record(v, site[s], bin, target, nb);
+  }
   TESSERA_HOST_DEVICE void record_light(int32_t s, uint32_t li, Float learned) const {
     if (li < v.lights) neural_record(v, site[s], kNeuralBins + li, learned);
   }
