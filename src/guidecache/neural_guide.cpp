@@ -170,9 +170,16 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
   Eigen::Map<Vec> gb1(G + L.b1(), W), gb2(G + L.b2(), W), gb3(G + L.b3(), O);
   Mat dH2(W, B);
   double loss = 0.0;
+  bool output_seen[kNeuralMaxOutputs] = {};
   for (Eigen::Index b = 0; b < B; ++b) {
     const NeuralTrainingSample& s = samples[first + static_cast<size_t>(b) * stride];
     const uint32_t bin = s.bin < L.outputs() ? s.bin : 0u;  // a direction bin or a light
+    // The output layer's gradient is non-zero only in the outputs trained.
+    if (touched && !output_seen[bin]) {
+      output_seen[bin] = true;
+      for (Eigen::Index i = 0; i < W; ++i) touched->push_back(L.w3() + static_cast<uint32_t>(i) * L.outputs() + bin);
+      touched->push_back(L.b3() + bin);
+    }
     const float o = W3.row(bin).dot(H2.col(b)) + b3[bin];
     const float q = neural_exp(o);
     const float t = T[static_cast<size_t>(b)] / scale;
@@ -200,8 +207,9 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
       for (uint32_t c = 0; c < 8; ++c)
         for (uint32_t f = 0; f < kNeuralFeatures; ++f) {
           const uint32_t k = level_base + entry[c] * kNeuralFeatures + f;
+          // An entry already non-zero in this tile is listed already.
+          if (touched && G[k] == 0.f) touched->push_back(k);
           G[k] += weight[c] * dX(l * kNeuralFeatures + f, b);
-          if (touched) touched->push_back(k);
         }
     }
   }
@@ -237,9 +245,10 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
   // One minibatch: every steps_per_pass-th target of each tile, from round - 1.
   const size_t P = params_.size();
   const uint32_t first = round - 1, stride = config_.steps_per_pass;
-  // A tile touches the layers (dense) and a few hash-grid entries: only
-  // those are quantised and cleared again, not every parameter per tile.
-  const size_t layers = layout().w1();
+  // A tile touches the hidden layers (dense), the output layer's entries
+  // of the outputs it trains and a few hash-grid entries: only those are
+  // quantised and cleared again, not every parameter per tile.
+  const size_t layers = layout().w1(), hidden_end = layout().w3();
   struct Local {
     std::vector<int64_t> sum;
     std::vector<float> grad;  // all zero between tiles
@@ -260,7 +269,7 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
     // (counted): the step goes on with the other tiles, the same on every
     // rank, as a tile's gradient does not depend on where it was computed.
     bool finite = std::isfinite(loss);
-    for (size_t k = layers; finite && k < P; ++k) finite = std::isfinite(local.grad[k]);
+    for (size_t k = layers; finite && k < hidden_end; ++k) finite = std::isfinite(local.grad[k]);
     for (size_t t = 0; finite && t < local.touched.size(); ++t) finite = std::isfinite(local.grad[local.touched[t]]);
     // Adds parameter k's gradient (then cleared: a repeated entry adds nothing more).
     auto take = [&](size_t k) {
@@ -275,7 +284,7 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
       // Half away from zero, as llround (exact: |g| <= 2^44), without its call.
       local.sum[k] += static_cast<int64_t>(g + (g >= 0.0 ? 0.5 : -0.5));
     };
-    for (size_t k = layers; k < P; ++k) take(k);
+    for (size_t k = layers; k < hidden_end; ++k) take(k);
     for (uint32_t k : local.touched) take(k);
     if (count == 0) return;
     if (!finite) {

@@ -132,8 +132,8 @@ class NeuralGuide final : public Guide {
   void build_bin_dirs();
   // Adds the loss gradient of the given targets of one tile (every
   // `stride`-th from `first`) to grad; returns the loss sum.
-  // Hash-grid entries it adds to are appended to *touched (when given;
-  // repeats possible); the layers' block is dense.
+  // The hash-grid and output-layer entries it adds to are appended to
+  // *touched (when given; repeats possible); the hidden layers' block is dense.
   double tile_gradient(const std::vector<NeuralTrainingSample>& samples, uint32_t first, uint32_t stride,
                        std::vector<float>* grad, uint64_t* count, std::vector<uint32_t>* touched = nullptr) const;
   void adam_step(uint64_t count);
