@@ -132,7 +132,8 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
   const NeuralLayout L = layout();
   const Eigen::Index W = config_.width, O = L.outputs();
   const size_t n = samples.size();
-  const Eigen::Index B = n > first ? static_cast<Eigen::Index>((n - first + stride - 1) / stride) : 0;
+  const size_t batch = n > first ? (n - first + stride - 1) / stride : 0;
+  const Eigen::Index B = static_cast<Eigen::Index>(batch);
   *count = static_cast<uint64_t>(B);
   if (B == 0) return 0.0;
   // Eigen blocks its products by the cache sizes it reads from the CPU, and
@@ -145,8 +146,11 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
   Mat X(kNeuralInputs, B);
   // Targets, their bootstrapped parts recomputed by the network as it is
   // now (NeuralTrainingSample): what the next vertex is predicted to send
-  // moves with every step, not only between passes.
-  std::vector<float> T(static_cast<size_t>(B));
+  // moves with every step, not only between passes. (Before the first step
+  // the network is still the one that recorded them: nothing to redo.) A
+  // refreshed target is kept within [0, max_target]: the recorded one was
+  // checked against it, and only the network's new prediction is added.
+  std::vector<float> T(batch);
   NeuralSite y;
   for (Eigen::Index b = 0; b < B; ++b) {
     const NeuralTrainingSample& s = samples[first + static_cast<size_t>(b) * stride];
@@ -198,18 +202,17 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
   const Mat dX = W1.transpose() * dH1;
   for (Eigen::Index b = 0; b < B; ++b) {
     const NeuralTrainingSample& s = samples[first + static_cast<size_t>(b) * stride];
-    const Vec3 u = neural_unit_position(v, Vec3(s.p[0], s.p[1], s.p[2]));
+    U8 entry[8];
+    F8 weight[8];
+    neural_corners8(L.table_size(), neural_unit_position(v, Vec3(s.p[0], s.p[1], s.p[2])), entry, weight);
     for (uint32_t l = 0; l < kNeuralLevels; ++l) {
-      uint32_t entry[8];
-      Float weight[8];
-      neural_level_corners(L.table_size(), l, u, entry, weight);
       const uint32_t level_base = L.grid() + l * L.table_size() * kNeuralFeatures;
       for (uint32_t c = 0; c < 8; ++c)
         for (uint32_t f = 0; f < kNeuralFeatures; ++f) {
-          const uint32_t k = level_base + entry[c] * kNeuralFeatures + f;
+          const uint32_t k = level_base + entry[c][l] * kNeuralFeatures + f;
           // An entry already non-zero in this tile is listed already.
           if (touched && G[k] == 0.f) touched->push_back(k);
-          G[k] += weight[c] * dX(l * kNeuralFeatures + f, b);
+          G[k] += weight[c][l] * dX(l * kNeuralFeatures + f, b);
         }
     }
   }

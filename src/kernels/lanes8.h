@@ -5,8 +5,10 @@
 // vectoriser does not find these loops by itself (they stayed scalar). On
 // the GPU, and for other compilers, it is a plain array with the same
 // operations lane by lane. Only IEEE +, -, *, comparisons, conversions and
-// integer arithmetic are offered, never fused: every lane computes the same
-// bits whichever representation or instruction set runs it.
+// integer arithmetic are offered. On the CPU nothing is fused
+// (-ffp-contract=off): the AVX2 and portable builds compute the same bits.
+// nvcc fuses a*b+c by default (--fmad), so device results may differ from
+// the CPU's in the last bits.
 #pragma once
 
 #include <cstdint>
@@ -22,7 +24,10 @@ constexpr uint32_t kLanes8 = 8;
 
 // Always inlined: the AVX2 and portable copies of the inference each get
 // their own, never a call across (the two pass vectors differently).
+// TESSERA_LANES_FN marks the kernels' own functions that take or return
+// lanes by value.
 #define TESSERA_LANES_INLINE inline __attribute__((always_inline))
+#define TESSERA_LANES_FN TESSERA_LANES_INLINE
 
 typedef float F8 __attribute__((vector_size(32)));
 typedef uint32_t U8 __attribute__((vector_size(32)));
@@ -34,7 +39,7 @@ TESSERA_LANES_INLINE F8 lanes_load(const float* p) {
   return v;
 }
 TESSERA_LANES_INLINE void lanes_store(float* p, const F8& v) { memcpy(p, &v, sizeof v); }
-TESSERA_LANES_INLINE F8 lanes_splat(float x) { return F8{} + x; }
+TESSERA_LANES_INLINE F8 lanes_splat(float x) { return x - F8{}; }  // x - (+0) keeps -0 (x + 0 would not)
 TESSERA_LANES_INLINE U8 lanes_splat_u(uint32_t x) { return U8{} + x; }
 TESSERA_LANES_INLINE F8 lanes_make(const float (&x)[kLanes8]) { return lanes_load(x); }
 TESSERA_LANES_INLINE U8 lanes_make_u(const uint32_t (&x)[kLanes8]) {
@@ -55,6 +60,8 @@ TESSERA_LANES_INLINE F8 lanes_bits_to_float(const U8& x) { return reinterpret_ca
 TESSERA_LANES_INLINE U8 lanes_u(const I8& x) { return reinterpret_cast<U8>(x); }
 
 #else
+
+#define TESSERA_LANES_FN TESSERA_HOST_DEVICE inline
 
 template <class T>
 struct Lanes8 {

@@ -169,7 +169,7 @@ TESSERA_HOST_DEVICE inline Float neural_exp(Float x) {
 }
 
 // neural_exp on eight lanes: the same operations, the same bits.
-TESSERA_HOST_DEVICE inline F8 neural_exp8(F8 x) {
+TESSERA_LANES_FN F8 neural_exp8(F8 x) {
   const F8 lo = lanes_splat(kNeuralMinLog), hi = lanes_splat(kNeuralMaxLog);
   x = lanes_select_gt(x, lo, x, lo);
   x = lanes_select_gt(hi, x, x, hi);
@@ -204,7 +204,8 @@ TESSERA_HOST_DEVICE inline Vec3 neural_unit_position(const NeuralGuideView& v, c
 }
 
 // The 8 grid vertices around unit position u at a level and their
-// trilinear weights (shared by inference and training).
+// trilinear weights: the plain definition of what neural_corners8 computes
+// for all levels at once (tested against it).
 TESSERA_HOST_DEVICE inline void neural_level_corners(uint32_t table_size, uint32_t level, const Vec3& u, uint32_t entry[8],
                                                      Float weight[8]) {
   const uint32_t res = neural_level_resolution(level);
@@ -222,14 +223,10 @@ TESSERA_HOST_DEVICE inline void neural_level_corners(uint32_t table_size, uint32
   }
 }
 
-// The network's input for a point and normal: kNeuralInputs floats. The
-// eight levels are computed side by side (lanes8.h), each lane as
-// neural_level_corners and a sum over its corners in their order.
-TESSERA_HOST_DEVICE inline void neural_encode(const NeuralGuideView& v, const Vec3& p, const Vec3& n, Float* in) {
+// neural_level_corners at every level side by side (lanes8.h): corner c's
+// entry in each level's table (lane l: level l) and its trilinear weight.
+TESSERA_HOST_DEVICE inline void neural_corners8(uint32_t table_size, const Vec3& u, U8 entry[8], F8 weight[8]) {
   static_assert(kNeuralLevels == kLanes8, "one lane per level");
-  static_assert(kNeuralFeatures == 2, "two features per level");
-  const Vec3 u = neural_unit_position(v, p);
-  const uint32_t table_size = 1u << v.table_log2;
   uint32_t res_list[kLanes8];
   for (uint32_t l = 0; l < kLanes8; ++l) res_list[l] = neural_level_resolution(l);
   const U8 res = lanes_make_u(res_list);
@@ -244,21 +241,33 @@ TESSERA_HOST_DEVICE inline void neural_encode(const NeuralGuideView& v, const Ve
     f[k] = x - lanes_float(i0[k]);
     g[k] = 1.f - f[k];
   }
-  F8 f0 = lanes_splat(0.f), f1 = lanes_splat(0.f);
   for (uint32_t c = 0; c < 8; ++c) {
     const uint32_t dx = c & 1u, dy = (c >> 1) & 1u, dz = (c >> 2) & 1u;
     const U8 x = i0[0] + dx, y = i0[1] + dy, z = i0[2] + dz;
-    const U8 entry = lanes_select_le_u(vertices, entries, (z * side + y) * side + x,
-                                       (x ^ (y * 2654435761u) ^ (z * 805459861u)) & (table_size - 1u));
-    const F8 weight = (dx ? f[0] : g[0]) * (dy ? f[1] : g[1]) * (dz ? f[2] : g[2]);
+    entry[c] = lanes_select_le_u(vertices, entries, (z * side + y) * side + x,
+                                 (x ^ (y * 2654435761u) ^ (z * 805459861u)) & (table_size - 1u));
+    weight[c] = (dx ? f[0] : g[0]) * (dy ? f[1] : g[1]) * (dz ? f[2] : g[2]);
+  }
+}
+
+// The network's input for a point and normal: kNeuralInputs floats, each
+// level's features summed over its corners in their order.
+TESSERA_HOST_DEVICE inline void neural_encode(const NeuralGuideView& v, const Vec3& p, const Vec3& n, Float* in) {
+  static_assert(kNeuralFeatures == 2, "two features per level");
+  const uint32_t table_size = 1u << v.table_log2;
+  U8 entry[8];
+  F8 weight[8];
+  neural_corners8(table_size, neural_unit_position(v, p), entry, weight);
+  F8 f0 = lanes_splat(0.f), f1 = lanes_splat(0.f);
+  for (uint32_t c = 0; c < 8; ++c) {
     F8 t0, t1;
     for (uint32_t l = 0; l < kLanes8; ++l) {
-      const float* e = v.params + (static_cast<size_t>(l) * table_size + entry[l]) * kNeuralFeatures;
+      const float* e = v.params + (static_cast<size_t>(l) * table_size + entry[c][l]) * kNeuralFeatures;
       t0[l] = e[0];
       t1[l] = e[1];
     }
-    f0 += weight * t0;
-    f1 += weight * t1;
+    f0 += weight[c] * t0;
+    f1 += weight[c] * t1;
   }
   for (uint32_t l = 0; l < kLanes8; ++l) {
     in[l * kNeuralFeatures] = f0[l];
@@ -271,8 +280,9 @@ TESSERA_HOST_DEVICE inline void neural_encode(const NeuralGuideView& v, const Ve
 
 // out[o] = max(b[o] + sum_i w[i * outs + o] in[i], 0): a hidden layer,
 // in blocks of 8 outputs where the width allows (each output's sum in the
-// same order either way). No test for zero inputs: ReLU zeros fall at
-// random, and the mispredicted branches cost more than the columns they skip.
+// same order either way; a NaN sum gives 0). No test for zero inputs:
+// ReLU zeros fall at random, and the mispredicted branches cost more than
+// the columns they skip.
 TESSERA_HOST_DEVICE inline void neural_hidden_layer(const float* w, const float* b, const Float* in, uint32_t ins,
                                                     uint32_t outs, Float* out) {
   const uint32_t blocked = outs - outs % kLanes8;

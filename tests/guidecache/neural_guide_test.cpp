@@ -434,7 +434,8 @@ TEST(NeuralGuide, AvxAndPortableInferenceAgreeBitForBit) {
 // The inference computes eight lanes at a time (kernels/lanes8.h); each
 // output is still the plain definition, bit for bit: the encoding summed
 // over corners in order, each layer's sums in input order, exp by
-// neural_exp. Widths that fill whole lanes and widths that leave a tail.
+// neural_exp, and the distribution built from them. Widths that fill whole
+// lanes and widths that leave a tail.
 TEST(NeuralGuide, LaneInferenceEqualsThePlainDefinition) {
   for (uint32_t width : {5u, 8u, 13u, 16u}) {
     NeuralGuide g = make(small_config(width), 3);
@@ -482,6 +483,51 @@ TEST(NeuralGuide, LaneInferenceEqualsThePlainDefinition) {
       for (uint32_t j = 0; j < L.outputs(); ++j) {
         const float expected = v.scale * neural_exp(o[j]);
         ASSERT_EQ(std::memcmp(&site.q[j], &expected, sizeof expected), 0) << "width " << width << " output " << j;
+      }
+      // The distribution: Q max(cos, 0) summed in eight lanes (bin j in
+      // lane j mod 8), the largest Q above the surface, the floor mixed in.
+      float lane_sum[8] = {}, lane_max[8] = {}, weighted[kNeuralBins];
+      for (uint32_t j = 0; j < kNeuralBins; ++j) {
+        const float c = v.bin_dir_soa[j] * n.x + v.bin_dir_soa[kNeuralBins + j] * n.y +
+                        v.bin_dir_soa[2 * kNeuralBins + j] * n.z;
+        weighted[j] = site.q[j] * (c > 0.f ? c : 0.f);
+        lane_sum[j % 8] += weighted[j];
+        lane_max[j % 8] = std::max(lane_max[j % 8], c > 0.f ? site.q[j] : 0.f);
+      }
+      float total = 0.f, qmax = 0.f;
+      for (int k = 0; k < 8; ++k) {
+        total += lane_sum[k];
+        qmax = std::max(qmax, lane_max[k]);
+      }
+      ASSERT_EQ(site.irradiance, total * (4.f * kPi / static_cast<float>(kNeuralBins)));
+      ASSERT_EQ(site.qmax, qmax);
+      const float uniform = v.floor / static_cast<float>(kNeuralBins), w = (1.f - v.floor) / total;
+      for (uint32_t j = 0; j < kNeuralBins; ++j) ASSERT_EQ(site.pmf[j], weighted[j] * w + uniform) << j;
+    }
+  }
+}
+
+// The levels' corners computed side by side are each level's corners,
+// dense and hashed, for every table size.
+TEST(NeuralGuide, LaneCornersEqualEachLevelsCorners) {
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (uint32_t log2 = kNeuralMinTableLog2; log2 <= kNeuralMaxTableLog2; ++log2) {
+    for (int t = 0; t < 100; ++t) {
+      Vec3 p(u(rng), u(rng), u(rng));
+      if (t == 0) p = Vec3(1.f, 0.f, 1.f);  // the cube's faces: the last cell, not one beyond
+      U8 entry[8];
+      F8 weight[8];
+      neural_corners8(1u << log2, p, entry, weight);
+      for (uint32_t l = 0; l < kNeuralLevels; ++l) {
+        uint32_t e[8];
+        Float w[8];
+        neural_level_corners(1u << log2, l, p, e, w);
+        for (uint32_t c = 0; c < 8; ++c) {
+          ASSERT_EQ(entry[c][l], e[c]) << log2 << " level " << l << " corner " << c;
+          const float wl = weight[c][l];
+          ASSERT_EQ(std::memcmp(&wl, &w[c], sizeof wl), 0) << log2 << " level " << l << " corner " << c;
+        }
       }
     }
   }
