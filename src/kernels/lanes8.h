@@ -8,7 +8,8 @@
 // integer arithmetic are offered. On the CPU nothing is fused
 // (-ffp-contract=off): the AVX2 and portable builds compute the same bits.
 // nvcc fuses a*b+c by default (--fmad), so device results may differ from
-// the CPU's in the last bits.
+// the CPU's in the last bits. TESSERA_LANES_PLAIN forces the plain arrays on
+// the CPU too (to check them against the vectors: the same bits).
 #pragma once
 
 #include <cstdint>
@@ -20,7 +21,7 @@ namespace tessera {
 
 constexpr uint32_t kLanes8 = 8;
 
-#if defined(__GNUC__) && !defined(__CUDACC__)
+#if defined(__GNUC__) && !defined(__CUDACC__) && !defined(TESSERA_LANES_PLAIN)
 
 // Always inlined: the AVX2 and portable copies of the inference each get
 // their own, never a call across (the two pass vectors differently).
@@ -145,35 +146,34 @@ TESSERA_HOST_DEVICE inline U8 lanes_min_u(const U8& a, const U8& b) {
   for (uint32_t k = 0; k < kLanes8; ++k) r.v[k] = a.v[k] < b.v[k] ? a.v[k] : b.v[k];
   return r;
 }
-TESSERA_HOST_DEVICE inline U8 lanes_trunc_u(const F8& x) {
-  U8 r;
-  for (uint32_t k = 0; k < kLanes8; ++k) r.v[k] = static_cast<uint32_t>(static_cast<int32_t>(x.v[k]));
+// Lane by lane: r[k] = f(a[k]).
+template <class R, class T, class F>
+TESSERA_HOST_DEVICE inline Lanes8<R> lanes_map(const Lanes8<T>& a, F f) {
+  Lanes8<R> r;
+  for (uint32_t k = 0; k < kLanes8; ++k) r.v[k] = f(a.v[k]);
   return r;
+}
+TESSERA_HOST_DEVICE inline U8 lanes_trunc_u(const F8& x) {
+  return lanes_map<uint32_t>(x, [](float v) { return static_cast<uint32_t>(static_cast<int32_t>(v)); });
 }
 TESSERA_HOST_DEVICE inline I8 lanes_trunc_i(const F8& x) {
-  I8 r;
-  for (uint32_t k = 0; k < kLanes8; ++k) r.v[k] = static_cast<int32_t>(x.v[k]);
-  return r;
+  return lanes_map<int32_t>(x, [](float v) { return static_cast<int32_t>(v); });
 }
 TESSERA_HOST_DEVICE inline F8 lanes_float(const U8& x) {
-  F8 r;
-  for (uint32_t k = 0; k < kLanes8; ++k) r.v[k] = static_cast<float>(static_cast<int32_t>(x.v[k]));
-  return r;
+  return lanes_map<float>(x, [](uint32_t v) { return static_cast<float>(static_cast<int32_t>(v)); });
 }
 TESSERA_HOST_DEVICE inline F8 lanes_float_i(const I8& x) {
-  F8 r;
-  for (uint32_t k = 0; k < kLanes8; ++k) r.v[k] = static_cast<float>(x.v[k]);
-  return r;
+  return lanes_map<float>(x, [](int32_t v) { return static_cast<float>(v); });
 }
 TESSERA_HOST_DEVICE inline F8 lanes_bits_to_float(const U8& x) {
-  F8 r;
-  for (uint32_t k = 0; k < kLanes8; ++k) memcpy(&r.v[k], &x.v[k], sizeof(float));
-  return r;
+  return lanes_map<float>(x, [](uint32_t v) {
+    float f;
+    memcpy(&f, &v, sizeof f);
+    return f;
+  });
 }
 TESSERA_HOST_DEVICE inline U8 lanes_u(const I8& x) {
-  U8 r;
-  for (uint32_t k = 0; k < kLanes8; ++k) r.v[k] = static_cast<uint32_t>(x.v[k]);
-  return r;
+  return lanes_map<uint32_t>(x, [](int32_t v) { return static_cast<uint32_t>(v); });
 }
 
 #endif
