@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Prepares, on a machine with the full build and nvcc, what a bare GPU
 # machine needs to check the CUDA backend: the device check program (linked
-# without the renderer's libraries; CUDA's runtime is static) and the
+# without the renderer's libraries but oneTBB's; CUDA's runtime is static) and the
 # fixtures it reads (packed scenes and their host-emulated images).
 # Usage: scripts/gpu_bundle.sh [BUNDLE_DIR] (default .gpu/bundle); then, on
 # the GPU machine (with .gpu carried there):
@@ -12,6 +12,8 @@ bundle=${1:-.gpu/bundle}
 cmake --build build -j "$(nproc)" --target device_backend_on_device make_gpu_fixtures
 mkdir -p "$bundle/fixtures"
 cp build/device_backend_on_device "$bundle/"
+# Its one shared library a bare GPU machine lacks: oneTBB (the network trains on the host).
+cp -L "$(ldd build/device_backend_on_device | awk '/libtbb\.so/ {print $3}')" "$bundle/"
 build/make_gpu_fixtures "$bundle/fixtures" "${SPP:-64}"
 # GLM for the checks gpu_check.sh builds there with nvcc (a bare GPU machine has none).
 mkdir -p .gpu/include && cp -r /usr/include/glm .gpu/include/

@@ -7,7 +7,8 @@
 #                                    rays per second on the device and on one host core
 #   device_backend_on_device         with GPU_BUNDLE (made by scripts/gpu_bundle.sh on a machine
 #                                    with the full build): the CUDA backend renders its fixtures,
-#                                    unguided and guided, against the host emulation, with figures
+#                                    unguided, table- and network-guided, against the host
+#                                    emulation, with figures
 # Usage: scripts/gpu_check.sh [OUT_DIR]   (GLM_INCLUDE: the folder holding glm/, default /usr/include;
 # NVCC: the compiler, default /usr/local/cuda/bin/nvcc; CUDA_ARCH: default sm_90)
 # Exit status: 0 all passed, 1 a check failed, 77 no device.
@@ -22,7 +23,7 @@ command -v nvidia-smi >/dev/null && nvidia-smi -L | tee "$out/device.txt"
 # The CUDA backend first (prebuilt: it needs nothing built here).
 status=0
 if [ -n "${GPU_BUNDLE:-}" ]; then
-  "$GPU_BUNDLE/device_backend_on_device" "$GPU_BUNDLE"/fixtures/*.fixture 2>&1 | tee "$out/device_backend_on_device.txt"
+  LD_LIBRARY_PATH="$GPU_BUNDLE${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" "$GPU_BUNDLE/device_backend_on_device" "$GPU_BUNDLE"/fixtures/*.fixture 2>&1 | tee "$out/device_backend_on_device.txt"
   rc=${PIPESTATUS[0]}
   echo "device_backend_on_device: exit $rc"
   if [ "$rc" -eq 77 ]; then status=77; elif [ "$rc" -ne 0 ]; then status=1; fi

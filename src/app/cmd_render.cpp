@@ -412,10 +412,7 @@ RenderResult render_and_write(const RenderArgs& a, MasterSetup& m, PassExecutor&
 // picked cannot take the scene (out of device memory, say).
 std::unique_ptr<TileBackend> backend_for(const RenderArgs& a, const MasterSetup& m, bool log) {
   std::string why;
-  const bool neural = m.guide && (m.guide->spec_bits() & kSpecNeural);
-  std::string name = resolve_backend(a.backend, m.scene.get(), m.opt.light_paths, &why, neural);
-  if (neural && name != "embree" && name != "bvh")
-    throw std::runtime_error("--backend " + name + " has no neural guide yet (--backend embree or bvh has)");
+  std::string name = resolve_backend(a.backend, m.scene.get(), m.opt.light_paths, &why);
   std::unique_ptr<TileBackend> backend;
   try {
     backend = make_tile_backend(name, *m.scene, render_threads(m.opt), m.opt.light_paths);

@@ -94,17 +94,24 @@ struct NeuralTrainingSample {
   float value = 0.f;
 };
 
-// Where a thread's learning targets go while it renders one tile. A target
-// is kept with probability keep_prob, decided by a hash of (tile, its
-// number in the tile): deterministic, whichever thread or rank renders the
-// tile. Beyond `capacity` kept targets the rest of the tile's are dropped
-// (counted): also deterministic.
+// Where learning targets go while a tile renders: on the CPU one sink per
+// thread and tile (data: the tile's buffer), on a device one per path (data:
+// the path's kNeuralPathTargets slots; worker/device_tiles.h). A target is
+// kept with probability keep_prob, decided by a hash of (tile, path, its
+// number in the path): deterministic, whichever thread, rank or device
+// renders the path. A path keeps at most kNeuralPathTargets (the rest are
+// dropped and counted), and beyond `capacity` the rest are dropped too:
+// both rules are the same on every backend, so a device's targets equal
+// the CPU's (the device applies the tile's capacity when it gathers them).
+constexpr uint32_t kNeuralPathTargets = 8;
 struct NeuralSampleSink {
   NeuralTrainingSample* data = nullptr;
   uint32_t capacity = 0;
   uint32_t count = 0;
   uint32_t tile = 0;
-  uint32_t seen = 0;            // targets offered in this tile (accepted by the checks below)
+  uint32_t path = 0;            // hash of (pixel, sample index) of the path being traced
+  uint32_t seen = 0;            // targets this path offered (accepted by the checks below)
+  uint32_t path_kept = 0;       // targets this path kept
   Float keep_prob = 1.f;
   uint64_t rejected_nonfinite = 0;  // NaN, Inf or negative targets
   uint64_t rejected_large = 0;      // targets beyond max_target
@@ -483,6 +490,19 @@ TESSERA_HOST_DEVICE inline Float neural_bootstrap_value(const NeuralSite& y, uin
   return y_bin == kNeuralIrradiance ? y.irradiance : y_bin < kNeuralBins ? y.q[y_bin] : 0.f;
 }
 
+// A path starts: its targets are numbered from 0, and the keep hash
+// follows its pixel (index in the image) and sample index, not the order
+// in which a thread or a device reaches it.
+TESSERA_HOST_DEVICE inline void neural_sink_start_path(NeuralSampleSink* sink, uint64_t pixel_index, uint32_t sample_index) {
+  uint64_t k = (pixel_index + 1) * 0x9E3779B97F4A7C15ull ^ (uint64_t{sample_index} * 0xC2B2AE3D27D4EB4Full);
+  k ^= k >> 31;
+  k *= 0xBF58476D1CE4E5B9ull;
+  k ^= k >> 29;
+  sink->path = static_cast<uint32_t>(k);
+  sink->seen = 0;
+  sink->path_kept = 0;
+}
+
 // Records a learning target for the site's bin into the calling thread's
 // sink. Returns false (and counts it) when the target is rejected.
 TESSERA_HOST_DEVICE inline bool neural_record(const NeuralGuideView& v, const NeuralSite& site, uint32_t bin, Float target,
@@ -497,16 +517,17 @@ TESSERA_HOST_DEVICE inline bool neural_record(const NeuralGuideView& v, const Ne
     ++sink->rejected_large;
     return false;
   }
-  // A hash of (tile, number in tile) in [0, 1): which targets are kept.
-  uint32_t h = sink->tile * 0x9E3779B1u ^ (sink->seen++ * 0x85EBCA77u);
+  // A hash of (tile, path, number in path) in [0, 1): which targets are kept.
+  uint32_t h = sink->tile * 0x9E3779B1u ^ (sink->seen++ * 0x85EBCA77u) ^ sink->path;
   h ^= h >> 15;
   h *= 0x2C1B3C6Du;
   h ^= h >> 12;
   if (static_cast<Float>(h >> 8) * (1.f / 16777216.f) >= sink->keep_prob) return true;
-  if (sink->count >= sink->capacity) {
+  if (sink->path_kept >= kNeuralPathTargets || sink->count >= sink->capacity) {
     ++sink->dropped;
     return true;
   }
+  ++sink->path_kept;
   NeuralTrainingSample& s = sink->data[sink->count++];
   for (int k = 0; k < 3; ++k) {
     s.p[k] = site.p[k];

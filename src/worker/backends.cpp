@@ -22,18 +22,13 @@ bool cuda_present(std::string* why) {
 
 }  // namespace
 
-std::string resolve_backend(const std::string& requested, const SceneData* scene, bool light_paths, std::string* why,
-                            bool neural_guide) {
+std::string resolve_backend(const std::string& requested, const SceneData* scene, bool light_paths, std::string* why) {
   if (why) why->clear();
   if (requested == "embree" || requested == "bvh" || requested == "emulated-device") return requested;
   if (requested != "cuda" && requested != "auto")
     throw std::runtime_error("--backend " + requested + ": unknown backend (auto, embree, bvh, cuda, emulated-device)");
   std::string reason;
   bool ok = cuda_present(&reason);
-  if (ok && neural_guide) {
-    reason = "the neural guide does not run on the device yet";
-    ok = false;
-  }
   if (ok && scene) {
     reason = device_backend_obstacle(*scene, light_paths, false);
     ok = reason.empty();

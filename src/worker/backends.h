@@ -15,11 +15,10 @@ namespace tessera {
 // The backend's name for `requested` (auto, embree, bvh, cuda) on this
 // process; *why says how auto decided (empty otherwise). With a scene (and
 // whether its caustics are traced from the lights), cuda is checked against
-// it too, and against the guide: the neural guide runs on the CPU only.
-// Throws a one-line error for an unknown name and for cuda where it cannot
-// render.
+// it too. Throws a one-line error for an unknown name and for cuda where it
+// cannot render.
 std::string resolve_backend(const std::string& requested, const SceneData* scene = nullptr, bool light_paths = false,
-                            std::string* why = nullptr, bool neural_guide = false);
+                            std::string* why = nullptr);
 
 // Builds backend `name` (as resolve_backend gives it) over `scene`, which
 // must outlive it (the device backends copy it and do not). host_threads:

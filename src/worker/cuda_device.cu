@@ -1,7 +1,7 @@
 // The device API on CUDA (worker/device_api.h): plain cudaMalloc'd memory,
 // synchronous copies, and per batch of tiles two launches queued on the
 // default stream: the trace (cuda_kernel_*.cu: the full surface integrator,
-// unguided and guided, in files of their own; ptxas reports their registers
+// unguided, table-guided and neural-guided, in files of their own; ptxas reports their registers
 // and stack in the build log, -Xptxas=-v), then the accumulation below. The
 // kernel bodies are worker/device_tiles.h's, which the host emulation runs too.
 #include <algorithm>
@@ -37,8 +37,8 @@ class CudaDevice : public DeviceApi {
     // Paths keep their state in local memory: the default 1 KiB stack per
     // thread is too small for the integrator. eval_texture recurses through
     // nested textures, which ptxas cannot bound: a margin for that.
-    const size_t stack =
-        std::max(render_tiles_stack_bytes<kServedSurface>(), render_tiles_stack_bytes<kServedSurface | kSpecGuiding>());
+    const size_t stack = std::max({render_tiles_stack_bytes<kServedSurface>(), render_tiles_stack_bytes<kServedSurface | kSpecGuiding>(),
+                                   render_tiles_stack_bytes<kServedSurface | kSpecGuiding | kSpecNeural>()});
     cuda_check_error(cudaDeviceSetLimit(cudaLimitStackSize, std::max<size_t>(stack + 4096, 8192)), "cudaDeviceSetLimit");
     cuda_check_error(cudaEventCreateWithFlags(&done_, cudaEventDisableTiming), "cudaEventCreate");
   }
@@ -63,6 +63,9 @@ class CudaDevice : public DeviceApi {
     if (launch.num_tiles == 0 || launch.max_samples == 0) return;
     switch (served_specialisation(spec)) {
       case kServedSurface | kSpecGuiding: launch_render_tiles<kServedSurface | kSpecGuiding>(launch); break;
+      case kServedSurface | kSpecGuiding | kSpecNeural:
+        launch_render_tiles<kServedSurface | kSpecGuiding | kSpecNeural>(launch);
+        break;
       case kServedSurface: launch_render_tiles<kServedSurface>(launch); break;
       default:
         throw std::runtime_error("the CUDA backend has no media kernels (device_backend_obstacle keeps such scenes off it)");

@@ -1,5 +1,5 @@
-// The device backend's CUDA kernels: the full surface integrator, unguided
-// and guided, each compiled in a file of its own (cuda_kernel_*.cu) so that
+// The device backend's CUDA kernels: the full surface integrator, unguided,
+// guided by the table and guided by the network, each compiled in a file of its own (cuda_kernel_*.cu) so that
 // a parallel build runs their ptxas side by side (each takes minutes: the
 // whole integrator is one kernel). Media kernels would double the build;
 // scenes with media stay on the CPU until they are worth it. CUDA code only.

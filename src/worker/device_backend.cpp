@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "guidecache/neural_training_log.h"
+#include "worker/neural_tile_targets.h"
 #include "worker/scene_pack.h"
 
 namespace tessera {
@@ -14,6 +16,13 @@ namespace {
 // A new field in the guide's view must be uploaded in upload_guide (or shown
 // not to need it): this fails the build until someone looks.
 static_assert(sizeof(GuideView) == 200, "GuideView changed: upload its new arrays in upload_guide, then update this size");
+static_assert(sizeof(NeuralGuideView) == 88,
+              "NeuralGuideView changed: upload its new arrays in upload_network, then update this size");
+
+// Device memory for the learning targets of one batch at most (tiles stop
+// joining a batch beyond it): 544 bytes per learning path, so a batch of
+// 256 16x16 tiles holds 7 learning samples per pixel.
+constexpr uint64_t kMaxTargetBytes = uint64_t{256} << 20;
 
 // Host arrays laid out back to back (16-byte aligned) for one upload.
 class Staging {
@@ -122,15 +131,37 @@ void DeviceBackend::upload_guide(const GuideView& g) {
   d.acc_private = false;  // shared by every device thread: atomic adds
 }
 
+// The network's weights and bin directions, frozen for the pass. Its
+// learning targets go to per-path sinks on the device (device_tiles.h).
+void DeviceBackend::upload_network(const NeuralGuideView& v) {
+  Staging st;
+  const NeuralLayout layout{v.width, v.table_log2, v.lights};
+  const size_t params = st.add(v.params, layout.size());
+  const size_t bin_dirs = st.add(v.bin_dirs, v.bin_dirs ? kNeuralBins : 0);
+  const size_t bin_dir_soa = st.add(v.bin_dir_soa, v.bin_dir_soa ? 3 * kNeuralBins : 0);
+  void* base = network_.reserve(st.bytes().size());
+  device_->upload(base, st.bytes().data(), st.bytes().size());
+  NeuralGuideView& d = device_settings_.path.neural;
+  d = v;
+  d.params = at_device(base, params, v.params);
+  d.bin_dirs = at_device(base, bin_dirs, v.bin_dirs);
+  d.bin_dir_soa = at_device(base, bin_dir_soa, v.bin_dir_soa);
+  d.sink = nullptr;  // each device thread has its own
+}
+
 void DeviceBackend::begin_pass(const TileSettings& settings) {
   if (settings.path.light_traced_caustics)
     throw std::runtime_error("the " + name() + " backend does not trace caustics from the lights yet");
-  if (settings.specialisation & kSpecNeural)
-    throw std::runtime_error("the " + name() + " backend has no neural guide yet (--backend embree or bvh has)");
   settings_ = settings;
   device_settings_ = settings;
+  device_settings_.neural_log = nullptr;  // a host object: the targets come back per batch
   const GuideView& g = settings.path.guide;
-  if (g.acc != nullptr && g.acc_words > 0) upload_guide(g);
+  const bool neural = (settings.specialisation & kSpecNeural) && (settings.specialisation & kSpecGuiding);
+  if (neural && settings.path.neural.params == nullptr)
+    throw std::logic_error("DeviceBackend: a neural-guided pass without the network's view");
+  if (neural) upload_network(settings.path.neural);
+  else if (g.acc != nullptr && g.acc_words > 0) upload_guide(g);
+  neural_learning_ = neural && settings.neural_log != nullptr;
   in_pass_ = true;
 }
 
@@ -146,10 +177,18 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
     tiles.clear();
     pixels.clear();
     uint32_t max_tile_pixels = 0, max_samples = 0;
+    uint64_t target_paths = 0;  // learning paths of the batch (neural guide)
     TileTask task;
-    while (tasks.size() < kBatchTiles && queue.take(&task)) {
+    while (tasks.size() < kBatchTiles && target_paths * kNeuralPathTargets * sizeof(NeuralTrainingSample) < kMaxTargetBytes &&
+           queue.take(&task)) {
       const TileJob& j = task.job;
       DeviceTile t{j, pixels.size()};
+      if (neural_learning_) {
+        t.first_target_path = target_paths;
+        t.learning_samples = job_learning_samples(settings_.learn, j);
+        t.keep_prob = neural_tile_keep_prob(settings_, j);
+        target_paths += uint64_t(j.x1 - j.x0) * uint64_t(j.y1 - j.y0) * t.learning_samples;
+      }
       for (int32_t y = j.y0; y < j.y1; ++y)
         for (int32_t x = j.x0; x < j.x1; ++x) pixels.push_back(task.pixels.at(j, x, y));
       max_tile_pixels = std::max(max_tile_pixels, static_cast<uint32_t>(pixels.size() - t.first_pixel));
@@ -176,6 +215,14 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
     launch.pixels = d_pixels;
     launch.values = d_values;
     launch.counters = d_counters;
+    if (target_paths > 0) {
+      launch.targets = static_cast<NeuralTrainingSample*>(
+          targets_.reserve(target_paths * kNeuralPathTargets * sizeof(NeuralTrainingSample)));
+      launch.target_counts = static_cast<uint32_t*>(target_counts_.reserve(target_paths * sizeof(uint32_t)));
+      launch.target_rejects = static_cast<uint64_t*>(target_rejects_.reserve(3 * sizeof(uint64_t)));
+      device_->zero(launch.target_counts, target_paths * sizeof(uint32_t));
+      device_->zero(launch.target_rejects, 3 * sizeof(uint64_t));
+    }
     device_->start(launch, served_specialisation(settings_.specialisation));
     // A farm master answers its workers while the device renders.
     while (!device_->finished()) {
@@ -187,6 +234,7 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
     TileCounters batch;
     device_->download(&batch, d_counters, sizeof(TileCounters));
     total.add(batch);
+    if (target_paths > 0) gather_targets(tasks, tiles, target_paths);
     for (size_t i = 0; i < tasks.size(); ++i) {
       const TileJob& j = tasks[i].job;
       size_t k = tiles[i].first_pixel;
@@ -200,9 +248,52 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
   return total;
 }
 
+// Each tile's targets in the order a CPU thread records them (pixels
+// row-major, then samples, then along the path), within the tile's capacity
+// as a CPU sink's: the log gets what a CPU backend would give it. The
+// batch's rejected and dropped counts go with its first tile.
+void DeviceBackend::gather_targets(const std::vector<TileTask>& tasks, const std::vector<DeviceTile>& tiles,
+                                   uint64_t paths) {
+  std::vector<uint32_t> counts(paths);
+  std::vector<NeuralTrainingSample> slots(paths * kNeuralPathTargets);
+  uint64_t rejects[3] = {0, 0, 0};
+  device_->download(counts.data(), target_counts_.get(), paths * sizeof(uint32_t));
+  device_->download(slots.data(), targets_.get(), slots.size() * sizeof(NeuralTrainingSample));
+  device_->download(rejects, target_rejects_.get(), sizeof(rejects));
+  const uint32_t capacity = neural_tile_capacity(settings_.path.neural);
+  std::vector<NeuralTrainingSample> kept;
+  for (size_t i = 0; i < tasks.size(); ++i) {
+    const DeviceTile& t = tiles[i];
+    const TileJob& j = tasks[i].job;
+    NeuralSampleSink sink;
+    sink.tile = j.index;
+    if (i == 0) {
+      sink.rejected_nonfinite = rejects[0];
+      sink.rejected_large = rejects[1];
+      sink.dropped = rejects[2];
+    }
+    kept.clear();
+    const uint64_t tile_paths = uint64_t(j.x1 - j.x0) * uint64_t(j.y1 - j.y0) * t.learning_samples;
+    for (uint64_t p = t.first_target_path; p < t.first_target_path + tile_paths; ++p) {
+      const uint32_t n = std::min(counts[p], kNeuralPathTargets);
+      for (uint32_t k = 0; k < n; ++k) {
+        if (kept.size() < capacity)
+          kept.push_back(slots[p * kNeuralPathTargets + k]);
+        else
+          ++sink.dropped;
+      }
+    }
+    sink.data = kept.data();
+    sink.count = static_cast<uint32_t>(kept.size());
+    sink.capacity = capacity;
+    settings_.neural_log->add_tile(sink);
+  }
+}
+
 void DeviceBackend::end_pass() {
   const GuideView& g = settings_.path.guide;
-  if (in_pass_ && g.acc != nullptr && g.acc_words > 0) {
+  const bool neural = (settings_.specialisation & kSpecNeural) && (settings_.specialisation & kSpecGuiding);
+  if (in_pass_ && !neural && g.acc != nullptr && g.acc_words > 0) {
     std::vector<uint64_t> learned(g.acc_words);
     device_->download(learned.data(), guide_acc_.get(), learned.size() * sizeof(uint64_t));
     for (size_t i = 0; i < learned.size(); ++i) g.acc[i] += learned[i];  // integers: order-free

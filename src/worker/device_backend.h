@@ -6,7 +6,11 @@
 // per pixel, adding in sample order; no float atomics), whose pixel
 // accumulators and counters come back to the host; end_pass
 // adds the device's integer accumulators into the pass's block, for the
-// fold and the farm's all-reduction.
+// fold and the farm's all-reduction. With the neural guide, every pass
+// uploads the network's weights instead (frozen for the pass), and each
+// batch's learning targets come back to the pass's training log, tile by
+// tile, the same targets a CPU backend keeps (the host trains between
+// passes; guidecache/neural_guide.h).
 //
 // Served by the full integrator (served_specialisation, as --backend bvh).
 // device_backend_obstacle says which scenes cannot go there yet; --backend
@@ -72,14 +76,19 @@ class DeviceBackend : public TileBackend {
     size_t bytes_ = 0;
   };
   void upload_guide(const GuideView& host);
+  void upload_network(const NeuralGuideView& host);
+  // Hands the batch's learning targets to the pass's training log, tile by tile.
+  void gather_targets(const std::vector<TileTask>& tasks, const std::vector<DeviceTile>& tiles, uint64_t paths);
 
   std::unique_ptr<DeviceApi> device_;  // declared first: the buffers are freed before it goes
   Buffer scene_bytes_{*device_}, scene_view_{*device_}, guide_bytes_{*device_}, guide_acc_{*device_};
   Buffer tiles_{*device_}, pixels_{*device_}, values_{*device_}, counters_{*device_};
+  Buffer network_{*device_}, targets_{*device_}, target_counts_{*device_}, target_rejects_{*device_};
   BvhView bvh_;
   TileSettings settings_;      // the pass's, as the host gave them
   TileSettings device_settings_;  // the same with the guide view in device memory
   bool in_pass_ = false;
+  bool neural_learning_ = false;  // this pass records the neural guide's learning targets
 };
 
 }  // namespace tessera

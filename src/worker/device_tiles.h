@@ -17,10 +17,16 @@
 namespace tessera {
 
 // A tile of a batch: its job, and where its accumulators start in the
-// batch's pixel array (row-major, x1 - x0 wide).
+// batch's pixel array (row-major, x1 - x0 wide). With the neural guide
+// learning: each learning path (pixel, learning sample) has
+// kNeuralPathTargets target slots, the tile's from path first_target_path
+// on, pixel-major (the order a CPU thread traces them in).
 struct DeviceTile {
   TileJob job;
   uint64_t first_pixel = 0;
+  uint64_t first_target_path = 0;
+  uint32_t learning_samples = 0;  // of the job's samples (0: the tile records no targets)
+  Float keep_prob = 1.f;          // NeuralSampleSink::keep_prob for the tile
 };
 
 // Samples per pixel of a tile in this pass.
@@ -38,15 +44,20 @@ struct DeviceLaunch {
   PixelAccum* pixels = nullptr;
   Rgb* values = nullptr;         // [batch pixel][sample < max_samples]: the samples' film values
   TileCounters* counters = nullptr;  // one, summed over the launch
+  // The neural guide's learning targets (null: not recorded): slots per
+  // learning path (DeviceTile), how many each path kept, and the launch's
+  // rejected (non-finite, too large) and dropped targets.
+  NeuralTrainingSample* targets = nullptr;
+  uint32_t* target_counts = nullptr;
+  uint64_t* target_rejects = nullptr;  // [3]
 };
 
 // The integrator a specialisation is served by on the portable BVH: the
 // full surface one, or the media one for scenes with media, guided or not.
-// Four instantiations instead of one per effects set keep the build short.
+// Four instantiations (six with the neural guide's, whose bit passes
+// through) instead of one per effects set keep the build short.
 constexpr uint32_t kServedSurface = kSpecSurfaceAll & ~kSpecGuiding;
 constexpr uint32_t kServedMedia = kSpecMedia | kServedSurface;
-// (The neural guide's bit passes through: the BVH backend serves it on the
-// CPU; the device backend refuses it in begin_pass.)
 TESSERA_HOST_DEVICE constexpr uint32_t served_specialisation(uint32_t spec) {
   const uint32_t guide = (spec & kSpecGuiding) ? spec & (kSpecGuiding | kSpecNeural) : 0u;
   return ((spec & kSpecMedia) ? kServedMedia : kServedSurface) | guide;
@@ -67,8 +78,34 @@ TESSERA_HOST_DEVICE inline void trace_device_sample(const DeviceLaunch& launch, 
   const int32_t y = t.job.y0 + static_cast<int32_t>(pixel / static_cast<uint32_t>(w));
   PathSettings path = launch.settings.path;
   TileCounters tc;
-  launch.values[(t.first_pixel + pixel) * launch.max_samples + sample] = camera_sample_value<Spec>(
-      s, tracer, launch.settings, path, s.camera.film_x0 + x, s.camera.film_y0 + y, t.job.sample_begin + sample, tc);
+  const uint32_t si = t.job.sample_begin + sample;
+  // The neural guide's learning targets: a sink of the path's own.
+  NeuralSampleSink sink;
+  uint64_t path_slot = 0;
+  if constexpr ((Spec & kSpecNeural) != 0) {
+    path.neural.sink = nullptr;
+    const GuideLearnSchedule& learn = launch.settings.learn;
+    if (launch.targets != nullptr && t.learning_samples > 0 && learn.learns(si)) {
+      uint32_t ordinal = 0;  // among the tile's learning samples
+      for (uint32_t k = t.job.sample_begin; k < si; ++k) ordinal += learn.learns(k) ? 1u : 0u;
+      path_slot = t.first_target_path + uint64_t{pixel} * t.learning_samples + ordinal;
+      sink.data = launch.targets + path_slot * kNeuralPathTargets;
+      sink.capacity = kNeuralPathTargets;
+      sink.tile = t.job.index;
+      sink.keep_prob = t.keep_prob;
+      path.neural.sink = &sink;
+    }
+  }
+  launch.values[(t.first_pixel + pixel) * launch.max_samples + sample] =
+      camera_sample_value<Spec>(s, tracer, launch.settings, path, s.camera.film_x0 + x, s.camera.film_y0 + y, si, tc);
+  if constexpr ((Spec & kSpecNeural) != 0) {
+    if (path.neural.sink != nullptr) {
+      launch.target_counts[path_slot] = sink.count;
+      if (sink.rejected_nonfinite) atomic_add_u64(launch.target_rejects + 0, sink.rejected_nonfinite);
+      if (sink.rejected_large) atomic_add_u64(launch.target_rejects + 1, sink.rejected_large);
+      if (sink.dropped) atomic_add_u64(launch.target_rejects + 2, sink.dropped);
+    }
+  }
   const uint64_t* mine = reinterpret_cast<const uint64_t*>(&tc);
   uint64_t* sum = reinterpret_cast<uint64_t*>(launch.counters);
   for (size_t i = 0; i < sizeof(TileCounters) / sizeof(uint64_t); ++i)

@@ -23,6 +23,8 @@ TESSERA_HOST_DEVICE inline Rgb camera_sample_value(const SceneView& s, const Tra
   PixelSampler rng = PixelSampler::start(settings.sampler, static_cast<uint32_t>(ix), static_cast<uint32_t>(iy), pixel_index, si);
   const CameraSample cs = sample_camera_ray(s, ix, iy, rng);
   path.learn = settings.learn.learns(si);
+  if constexpr ((Spec & kSpecNeural) != 0)
+    if (path.neural.sink) neural_sink_start_path(path.neural.sink, pixel_index, si);
   // Spectral transport: the path's three wavelengths (spectral.h).
   Wavelengths wl;
   if (s.spectral.enabled) wl = sample_wavelengths(rng.uniform());

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "guidecache/neural_training_log.h"
+#include "worker/neural_tile_targets.h"
 
 namespace tessera {
 
@@ -14,10 +15,7 @@ const TileSettings& ThreadGuideAccumulators::for_this_thread() {
     Local& local = locals_.local(exists);
     if (!exists) {
       local.settings = shared_;
-      // Room for four times the targets a tile keeps on average: a tile
-      // that keeps more drops the rest (counted, and the same on every run;
-      // the dropped are the tile's last pixels', so it should be rare).
-      local.targets.resize(4 * size_t(std::max(shared_.path.neural.tile_targets, 1u)) + 64);
+      local.targets.resize(neural_tile_capacity(shared_.path.neural));
       local.sink.data = local.targets.data();
       local.sink.capacity = static_cast<uint32_t>(local.targets.size());
       local.settings.path.neural.sink = &local.sink;
@@ -44,19 +42,9 @@ void ThreadGuideAccumulators::begin_tile(const TileSettings& mine, const TileJob
   NeuralSampleSink* sink = mine.path.neural.sink;
   if (!sink) return;
   sink->count = 0;
-  sink->seen = 0;
   sink->tile = job.index;
   sink->rejected_nonfinite = sink->rejected_large = sink->dropped = 0;
-  // A learning sample offers a direction target per path vertex (about
-  // five on the shipped scenes with guided roulette) and, where light
-  // selection is learned, a light target per next-event estimate too; the
-  // tile keeps tile_targets of them on average. Which samples learn follows
-  // the schedule (by index).
-  const double per_sample = mine.path.neural.lights > 0 ? 10.0 : 5.0;
-  uint64_t learning = 0;
-  for (uint32_t si = job.sample_begin; si < job.sample_end; ++si) learning += mine.learn.learns(si) ? 1 : 0;
-  const double offered = per_sample * double(job.x1 - job.x0) * double(job.y1 - job.y0) * double(learning);
-  sink->keep_prob = offered > 0.0 ? static_cast<Float>(std::min(1.0, mine.path.neural.tile_targets / offered)) : 1.f;
+  sink->keep_prob = neural_tile_keep_prob(mine, job);
 }
 
 void ThreadGuideAccumulators::end_tile(const TileSettings& mine) const {

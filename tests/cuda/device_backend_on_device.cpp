@@ -9,9 +9,14 @@
 //   - guided (passes of 1, 1, 2, 4, 8... spp, folded between): learning comes
 //     back from the device, the image agrees with the unguided one, and a
 //     second guided render is the same bit for bit with the same field;
+//   - neural guide (the network runs on the device, trains here between
+//     passes: 16 passes of 1 spp, then 2, 4, 8...): targets come back and
+//     train it, the image agrees with the unguided one, and a second render
+//     gives the same image and the same weights bit for bit;
 //   - figures: samples/s unguided and guided, time per path vertex guided /
-//     unguided; against Embree on the machine that made the fixture (the
-//     2-core CPU) and against the same kernels on this machine's own cores.
+//     unguided (and the network's training share); against Embree on the
+//     machine that made the fixture (the 2-core CPU) and against the same
+//     kernels on this machine's own cores.
 // Usage: device_backend_on_device FIXTURE...   (exit 0 pass, 1 fail, 77 no device;
 // --probe: 0 when a device is here; TESSERA_GPU_CHECK_DRY_RUN=1: host
 // threads stand in for the GPU, to check this program itself)
@@ -30,6 +35,8 @@
 #include "device_pass.h"
 #include "gpu_fixture.h"
 #include "guidecache/guide_field.h"
+#include "guidecache/neural_guide.h"
+#include "worker/guide_binding.h"
 #include "worker/device_backend.h"
 #include "worker/host_memory_device.h"
 
@@ -46,6 +53,7 @@ class HostThreadsDevice : public HostMemoryDevice {
   bool has_media_kernels() const override { return false; }
   void start(const DeviceLaunch& launch, uint32_t spec) override {
     switch (served_specialisation(spec)) {
+      case kServedSurface | kSpecGuiding | kSpecNeural: return run<kServedSurface | kSpecGuiding | kSpecNeural>(launch);
       case kServedSurface | kSpecGuiding: return run<kServedSurface | kSpecGuiding>(launch);
       case kServedSurface: return run<kServedSurface>(launch);
       default: throw std::runtime_error("host threads: no media kernels here");
@@ -91,6 +99,25 @@ Timed render(DeviceBackend& backend, const GpuFixture& f, GuideField* guide) {
     if (guide) s.path.guide = guide->view();
     t.counters.add(render_film_pass(backend, s, t.film, done, done + n));
     if (guide) guide->fold();
+    done += n;
+  }
+  t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return t;
+}
+
+// The network: passes of 1 spp while every sample learns (16), then 2, 4,
+// 8, 8...; trained here after each (every round as one process runs it).
+Timed render_neural(DeviceBackend& backend, const GpuFixture& f, NeuralGuide& guide) {
+  Timed t{Film(f.width, f.height), {}, 0.0};
+  TileSettings s = f.settings;
+  s.specialisation |= kSpecGuiding | kSpecNeural;
+  const auto t0 = std::chrono::steady_clock::now();
+  uint32_t done = 0;
+  for (uint32_t pass = 0; done < f.spp; ++pass) {
+    const uint32_t n = std::min(f.spp - done, pass < 16 ? 1u : std::min(8u, 2u << (pass - 16)));
+    bind_guide(guide, &s);
+    t.counters.add(render_film_pass(backend, s, t.film, done, done + n));
+    combine_guide_rounds(guide, [](std::vector<uint64_t>&) {});
     done += n;
   }
   t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -162,6 +189,19 @@ bool check(const std::string& path) {
   if (!finite(ga.film)) std::printf("  FAIL non-finite guided pixel sums\n"), ok = false;
   ok &= agree(a.film, ga.film, "guided vs unguided", f.name);
 
+  auto make_network = [&] {
+    return std::make_unique<NeuralGuide>(NeuralGuideConfig{}, f.lo, f.hi, f.max_emitted, f.lights);
+  };
+  auto n1 = make_network(), n2 = make_network();
+  const Timed na = render_neural(backend, f, *n1), nb = render_neural(backend, f, *n2);
+  const NeuralGuideStats ns = n1->stats();
+  if (ns.steps == 0 || ns.targets == 0) std::printf("  FAIL the network learned nothing from the device\n"), ok = false;
+  if (na.counters.path.guided_samples == 0) std::printf("  FAIL the network guided no sample\n"), ok = false;
+  if (!identical(na.film, nb.film) || !(*n1 == *n2))
+    std::printf("  FAIL neural renders or weights differ between runs\n"), ok = false;
+  if (!finite(na.film)) std::printf("  FAIL non-finite neural pixel sums\n"), ok = false;
+  ok &= agree(a.film, na.film, "neural vs unguided", f.name);
+
   const double unguided_rate = samples / a.seconds, guided_rate = samples / ga.seconds;
   const double unguided_vertex = a.seconds / double(a.counters.path.vertices);
   const double guided_vertex = ga.seconds / double(ga.counters.path.vertices);
@@ -170,6 +210,13 @@ bool check(const std::string& path) {
   std::printf("  guided:   %.2f s, %.2f Msamples/s, %.1f ns per path vertex (%.2fx unguided's), %llu guided samples\n",
               ga.seconds, guided_rate * 1e-6, guided_vertex * 1e9, guided_vertex / unguided_vertex,
               static_cast<unsigned long long>(ga.counters.path.guided_samples));
+  const double neural_vertex = na.seconds / double(na.counters.path.vertices);
+  std::printf("  neural:   %.2f s, %.2f Msamples/s, %.1f ns per path vertex (%.2fx unguided's, %.2fx the table's), "
+              "training %.2f s (%.0f %%), %llu targets, %llu steps, %llu guided samples\n",
+              na.seconds, samples / na.seconds * 1e-6, neural_vertex * 1e9, neural_vertex / unguided_vertex,
+              neural_vertex / guided_vertex, ns.train_seconds, 100.0 * ns.train_seconds / na.seconds,
+              static_cast<unsigned long long>(ns.targets), static_cast<unsigned long long>(ns.steps),
+              static_cast<unsigned long long>(na.counters.path.guided_samples));
   std::printf("  where the fixture was made (%d threads): Embree %.3f Msamples/s, the device kernels %.3f Msamples/s; "
               "GPU unguided is %.1fx Embree there\n",
               f.host_threads, samples / f.embree_seconds * 1e-6, samples / f.host_seconds * 1e-6,
@@ -180,10 +227,17 @@ bool check(const std::string& path) {
   const Timed h = render(host, f, nullptr);
   GuideField gh = make_guide();
   const Timed hg = render(host, f, &gh);
-  std::printf("  this machine's %d cores, the same kernels: %.3f Msamples/s unguided, %.3f guided; GPU is %.1fx, %.1fx\n",
-              cores, samples / h.seconds * 1e-6, samples / hg.seconds * 1e-6, h.seconds / a.seconds, hg.seconds / ga.seconds);
+  auto nh = make_network();
+  const Timed hn = render_neural(host, f, *nh);
+  std::printf("  this machine's %d cores, the same kernels: %.3f Msamples/s unguided, %.3f guided, %.3f neural; "
+              "GPU is %.1fx, %.1fx, %.1fx\n",
+              cores, samples / h.seconds * 1e-6, samples / hg.seconds * 1e-6, samples / hn.seconds * 1e-6,
+              h.seconds / a.seconds, hg.seconds / ga.seconds, hn.seconds / na.seconds);
   ok &= agree(a.film, h.film, "GPU vs this machine's cores", f.name);
+  ok &= agree(na.film, hn.film, "neural: GPU vs this machine's cores", f.name);
   if (dry_run && !identical(a.film, h.film)) std::printf("  FAIL the dry run's two host renders differ\n"), ok = false;
+  if (dry_run && (!identical(na.film, hn.film) || !(*n1 == *nh)))
+    std::printf("  FAIL the dry run's two host neural renders differ\n"), ok = false;
   return ok;
 }
 

@@ -4,7 +4,10 @@
 //     int-to-float scaling: the farm's determinism rests on it),
 //   - every BSDF's sample, eval and pdf to a relative 1e-4 (nvcc contracts
 //     multiply-adds, so bits may differ), with lobe choices that flip at a
-//     boundary counted and allowed to be rare.
+//     boundary counted and allowed to be rare;
+//   - the neural guide's inference (random weights, learned lights): every
+//     output's radiance, the guided distribution, the irradiance and the
+//     light distribution to a relative 1e-4.
 // It is not GoogleTest (gtest is host-only); it prints one line per check and
 // exits 0 when all pass, 1 on a failure, 77 (CTest's skip) without a device.
 #include <cuda_runtime.h>
@@ -15,6 +18,7 @@
 #include <vector>
 
 #include "kernels/bsdf.h"
+#include "kernels/neural_guide.h"
 #include "kernels/sampler.h"
 
 #include "cuda_check.h"
@@ -154,6 +158,84 @@ bool check_bsdf(const char* name, const BsdfParams& b) {
   return pass;
 }
 
+// What one inference gives, flattened: Q per output, pmf per bin,
+// irradiance, largest Q, light pmf per learned light.
+constexpr uint32_t kNeuralCheckLights = 5;
+constexpr uint32_t kNeuralValues = kNeuralBins + kNeuralCheckLights + kNeuralBins + 2 + kNeuralCheckLights;
+constexpr int kNeuralCases = 4096;
+
+TESSERA_HOST_DEVICE void run_neural_case(const NeuralGuideView& v, const Vec3& p, const Vec3& n, Float* out) {
+  NeuralSite site;
+  neural_infer(v, p, n, &site);
+  uint32_t k = 0;
+  for (uint32_t j = 0; j < kNeuralBins + kNeuralCheckLights; ++j) out[k++] = site.q[j];
+  for (uint32_t j = 0; j < kNeuralBins; ++j) out[k++] = site.pmf[j];
+  out[k++] = site.irradiance;
+  out[k++] = site.qmax;
+  for (uint32_t j = 0; j < kNeuralCheckLights; ++j) out[k++] = site.light_pmf[j];
+}
+
+__global__ void neural_kernel(NeuralGuideView v, const Vec3* p, const Vec3* n, int count, Float* out) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < count) run_neural_case(v, p[i], n[i], out + static_cast<size_t>(i) * kNeuralValues);
+}
+
+bool check_neural() {
+  NeuralGuideView v;
+  v.width = 8;
+  v.table_log2 = 11;
+  v.lights = kNeuralCheckLights;
+  v.lo = Vec3(-1.f);
+  v.extent = 2.f;
+  v.scale = 0.7f;
+  v.trained = true;
+  const NeuralLayout layout{v.width, v.table_log2, v.lights};
+  Rng rng = Rng::for_sample(0x4e4e, 0, 0);
+  std::vector<float> params(layout.size());
+  for (uint32_t i = 0; i < layout.size(); ++i)
+    params[i] = (rng.uniform() - 0.5f) * (i < layout.b1() ? 0.2f : 1.2f);  // hash-grid features small, weights larger
+  std::vector<Vec3> dirs(kNeuralBins);
+  std::vector<Float> soa(3 * kNeuralBins);
+  for (uint32_t b = 0; b < kNeuralBins; ++b) {
+    const Vec2 sq((static_cast<Float>(b % kNeuralGrid) + 0.5f) / kNeuralGrid,
+                  (static_cast<Float>(b / kNeuralGrid) + 0.5f) / kNeuralGrid);
+    dirs[b] = glm::normalize(equal_area_square_to_sphere(sq));
+    for (uint32_t k = 0; k < 3; ++k) soa[k * kNeuralBins + b] = dirs[b][k];
+  }
+  std::vector<Vec3> ps(kNeuralCases), ns(kNeuralCases);
+  for (int i = 0; i < kNeuralCases; ++i) {
+    ps[i] = Vec3(2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f);
+    const Float z = 2.f * rng.uniform() - 1.f, phi = 2.f * kPi * rng.uniform(), r = std::sqrt(std::fmax(0.f, 1.f - z * z));
+    ns[i] = Vec3(r * std::cos(phi), r * std::sin(phi), z);
+  }
+  std::vector<Float> host(static_cast<size_t>(kNeuralCases) * kNeuralValues), dev(host.size());
+  v.params = params.data();
+  v.bin_dirs = dirs.data();
+  v.bin_dir_soa = soa.data();
+  for (int i = 0; i < kNeuralCases; ++i) run_neural_case(v, ps[i], ns[i], host.data() + static_cast<size_t>(i) * kNeuralValues);
+  NeuralGuideView d = v;
+  d.params = cuda_check::to_device(params);
+  d.bin_dirs = cuda_check::to_device(dirs);
+  d.bin_dir_soa = cuda_check::to_device(soa);
+  Float* out = nullptr;
+  if (!cuda_check::ok(cudaMalloc(&out, dev.size() * sizeof(Float)), "cudaMalloc")) return false;
+  neural_kernel<<<(kNeuralCases + 63) / 64, 64>>>(d, cuda_check::to_device(ps), cuda_check::to_device(ns), kNeuralCases, out);
+  const bool launched = cuda_check::ok(cudaDeviceSynchronize(), "neural inference");
+  cudaMemcpy(dev.data(), out, dev.size() * sizeof(Float), cudaMemcpyDeviceToHost);
+  if (!launched) return false;
+  size_t differ = 0;
+  double worst = 0.0;
+  for (size_t i = 0; i < host.size(); ++i) {
+    const double a = host[i], b = dev[i], scale = std::fmax(std::fabs(a), std::fabs(b));
+    const double rel = scale > 0.0 ? std::fabs(a - b) / scale : 0.0;
+    worst = std::fmax(worst, rel);
+    differ += !(rel <= 1e-4) ? 1 : 0;  // NaN counts as a difference
+  }
+  std::printf("%s neural inference: %d points, %zu values, %zu differ by more than 1e-4 relative (largest %.2g)\n",
+              differ ? "FAIL" : "ok  ", kNeuralCases, host.size(), differ, worst);
+  return differ == 0;
+}
+
 }  // namespace
 
 int main() {
@@ -213,6 +295,7 @@ int main() {
   b.hair_beta_m = 0.25f;
   b.hair_beta_n = 0.4f;
   pass &= check_bsdf("hair", b);
+  pass &= check_neural();
   std::printf("%s\n", pass ? "all kernels agree with the host" : "FAILED");
   return pass ? 0 : 1;
 }

@@ -47,16 +47,12 @@ TEST(CudaBackend, AgreesWithEmbreeAndRepeatsBitForBit) {
   }
 }
 
-// auto takes the device, except for what cannot go there: the neural guide
-// stays on Embree, and cuda asked for with it is refused in one line.
-TEST(CudaBackend, AutoPicksTheDeviceButNotForTheNeuralGuide) {
+// auto takes the device.
+TEST(CudaBackend, AutoPicksTheDevice) {
   if (!cuda_device_here()) GTEST_SKIP() << "no CUDA device";
   std::string why;
   EXPECT_EQ(resolve_backend("auto", nullptr, false, &why), "cuda");
   EXPECT_EQ(why, "");
-  EXPECT_EQ(resolve_backend("auto", nullptr, false, &why, true), "embree");
-  EXPECT_NE(why.find("neural"), std::string::npos) << why;
-  EXPECT_THROW(resolve_backend("cuda", nullptr, false, nullptr, true), std::runtime_error);
 }
 
 TEST(CudaBackend, GuidedRenderLearnsOnTheDevice) {

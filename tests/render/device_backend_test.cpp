@@ -3,8 +3,9 @@
 // per pass, batches of tiles rendered by the CUDA kernel's body and the
 // learning returned as integers. Its images equal the portable BVH's on the
 // CPU bit for bit (the same per-sample code in the same order), guided or
-// not, with textures, images, measured spectra, media and motion, and with
-// the scene it was built from gone; so does a farm of device and BVH ranks.
+// not (the table or the network), with textures, images, measured spectra,
+// media and motion, and with the scene it was built from gone; so does a
+// farm of device and BVH ranks.
 // Backend choice: auto falls back to Embree without a device, cuda refuses
 // in one line, and scenes the device cannot hold say why.
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 #include <memory>
 
 #include "comm/inproc_transport.h"
+#include "guidecache/neural_guide.h"
 #include "guided_helpers.h"
 #include "master/farm_master.h"
 #include "master/image_output.h"
@@ -292,6 +294,87 @@ TEST(DeviceBackend, FarmOfDeviceAndBvhRanksEqualsTheLocalImage) {
     EXPECT_TRUE(*guides[r] == local_guide) << "rank " << r;
     EXPECT_GT(backends[r]->samples, 0u) << "rank " << r << " rendered nothing";
   }
+}
+
+std::unique_ptr<NeuralGuide> make_network(const SceneData& scene, uint32_t tile_targets = 128) {
+  NeuralGuideConfig c;
+  c.width = 16;
+  c.steps_per_pass = 4;
+  c.tile_targets = tile_targets;
+  return std::make_unique<NeuralGuide>(c, scene.bounds().lo, scene.bounds().hi, scene.max_emitted_radiance(),
+                                       scene.view().num_lights);
+}
+
+// The network on the device: each path records its learning targets in
+// slots of its own, and the backend hands them to the training log in the
+// order a CPU thread records them, within the same capacities. So the
+// emulated device learns exactly what the BVH backend learns: the same
+// weights and the same image, bit for bit, on shelter (whose lights' selection is
+// learned too) and door-ajar; also where every target is kept and long
+// paths meet the per-path limit (tile_targets beyond any tile's offer).
+TEST(DeviceBackend, NeuralGuidedEqualsTheBvh) {
+  for (const char* name : {"shelter", "door-ajar"})
+    for (const uint32_t tile_targets : {128u, 1000000u}) {
+      const std::string what = std::string(name) + ", tile_targets " + std::to_string(tile_targets);
+      const SceneData scene = shipped(name, 24, 20);
+      RenderOptions opt = small_options(scene, 20);  // 16 single-sample learning passes, then larger ones
+      opt.tile_size = 8;
+      BvhBackend bvh(scene);
+      std::unique_ptr<TileBackend> device = make_tile_backend("emulated-device", scene, 2);
+      auto gb = make_network(scene, tile_targets), gd = make_network(scene, tile_targets);
+      const RenderResult b = render(scene, bvh, opt, gb.get()), d = render(scene, *device, opt, gd.get());
+      EXPECT_EQ(d.stats.backend, "emulated-device") << what;
+      EXPECT_GT(d.stats.neural_guide.steps, 0u) << what;
+      EXPECT_GT(d.stats.neural_guide.targets, 0u) << what;
+      EXPECT_GT(d.stats.counters.path.guided_samples, 0u) << what;
+      expect_same_render(b, d, what);
+      EXPECT_TRUE(*gb == *gd) << what << ": the device's targets trained another network";
+      EXPECT_EQ(b.stats.neural_guide.targets, d.stats.neural_guide.targets) << what;
+      EXPECT_EQ(b.stats.neural_guide.dropped, d.stats.neural_guide.dropped) << what;
+      EXPECT_EQ(b.stats.neural_guide.rejected_nonfinite, d.stats.neural_guide.rejected_nonfinite) << what;
+      if (tile_targets > 1000) {
+        EXPECT_GT(d.stats.neural_guide.dropped, 0u) << what << ": no path met its limit";
+      }
+      for (const PixelAccum& p : d.film.pixels)
+        for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(p.sum[c])) << what;
+    }
+}
+
+// A farm of a BVH master and device workers with the network: the local
+// image and weights, bit for bit (the gradients summed across ranks are
+// the same whichever rank rendered which tile).
+TEST(DeviceBackend, NeuralFarmOfDeviceAndBvhRanksEqualsTheLocalImage) {
+  const SceneData scene = shipped("shelter", 48, 36);
+  RenderOptions opt = small_options(scene, 18);
+  opt.threads = 1;
+  auto local_guide = make_network(scene);
+  BvhBackend local_backend(scene);
+  const RenderResult local = render(scene, local_backend, opt, local_guide.get());
+
+  const int32_t ranks = 3;
+  InProcessHub hub(ranks);
+  std::vector<std::unique_ptr<Transport>> ends;
+  std::vector<std::unique_ptr<NeuralGuide>> guides;
+  std::vector<std::unique_ptr<TileBackend>> backends;
+  for (int32_t r = 0; r < ranks; ++r) {
+    ends.push_back(hub.endpoint(r));
+    guides.push_back(make_network(scene));
+    backends.push_back(make_tile_backend(r == 0 ? "bvh" : "emulated-device", scene, 1));
+  }
+  const uint32_t spec = effective_specialisation(scene, opt, guides[0].get());
+  ASSERT_TRUE(spec & kSpecNeural);
+  std::vector<std::thread> workers;
+  for (int32_t r = 1; r < ranks; ++r)
+    workers.emplace_back([&, r] {
+      run_farm_worker(*ends[r], *backends[r], make_tile_settings(opt, spec, true), guides[r].get(), true, 1);
+    });
+  FarmMaster master(*ends[0], *backends[0], 1, true);
+  const RenderResult farm = render(scene, master, opt, guides[0].get());
+  master.stop();
+  for (auto& w : workers) w.join();
+  EXPECT_EQ(farm.stats.backend, "bvh+emulated-device");
+  expect_same_render(local, farm, "neural farm");
+  for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(*guides[r] == *local_guide) << "rank " << r;
 }
 
 // A device that takes a while: finished() says no a few times per launch.
