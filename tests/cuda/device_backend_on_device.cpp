@@ -16,7 +16,9 @@
 //   - figures: samples/s unguided and guided, time per path vertex guided /
 //     unguided (and the network's training share); against Embree on the
 //     machine that made the fixture (the 2-core CPU) and against the same
-//     kernels on this machine's own cores.
+//     kernels on this machine's own cores; relMSE of none, the table and the
+//     network at equal time (0.5 s and 2 s) against a 64x longer unguided
+//     render.
 // Usage: device_backend_on_device FIXTURE...   (exit 0 pass, 1 fail, 77 no device;
 // --probe: 0 when a device is here; TESSERA_GPU_CHECK_DRY_RUN=1: host
 // threads stand in for the GPU, to check this program itself)
@@ -26,6 +28,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <initializer_list>
 #include <new>
 #include <stdexcept>
 #include <thread>
@@ -86,16 +89,23 @@ struct Timed {
   double seconds = 0.0;
 };
 
-// Passes of 1, 1, 2, 4, 8, ... spp up to `spp` (guided or not, the same
-// passes), the guide folded after each.
-Timed render(DeviceBackend& backend, const GpuFixture& f, GuideField* guide) {
+// Whether a render goes on: below `spp` samples per pixel and, with
+// seconds > 0, within that many seconds (checked between passes).
+bool goes_on(uint32_t done, uint32_t spp, double seconds, std::chrono::steady_clock::time_point t0) {
+  return done < spp && !(seconds > 0.0 && std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >= seconds);
+}
+
+// Passes of 1, 1, 2, 4, 8, ... spp (at most max_pass) up to `spp` (guided or
+// not, the same passes), or for `seconds`; the guide folded after each.
+Timed render(DeviceBackend& backend, const GpuFixture& f, GuideField* guide, uint32_t spp, double seconds = 0.0,
+             uint32_t max_pass = 8) {
   Timed t{Film(f.width, f.height), {}, 0.0};
   TileSettings s = f.settings;
   if (guide) s.specialisation |= kSpecGuiding;
   const auto t0 = std::chrono::steady_clock::now();
   uint32_t done = 0;
-  for (uint32_t pass = 0; done < f.spp; ++pass) {
-    const uint32_t n = std::min(f.spp - done, pass == 0 ? 1u : std::min(8u, 1u << (pass - 1)));
+  for (uint32_t pass = 0; goes_on(done, spp, seconds, t0); ++pass) {
+    const uint32_t n = std::min(spp - done, pass == 0 ? 1u : std::min(max_pass, 1u << std::min(pass - 1, 20u)));
     if (guide) s.path.guide = guide->view();
     t.counters.add(render_film_pass(backend, s, t.film, done, done + n));
     if (guide) guide->fold();
@@ -107,14 +117,14 @@ Timed render(DeviceBackend& backend, const GpuFixture& f, GuideField* guide) {
 
 // The network: passes of 1 spp while every sample learns (16), then 2, 4,
 // 8, 8...; trained here after each (every round as one process runs it).
-Timed render_neural(DeviceBackend& backend, const GpuFixture& f, NeuralGuide& guide) {
+Timed render_neural(DeviceBackend& backend, const GpuFixture& f, NeuralGuide& guide, uint32_t spp, double seconds = 0.0) {
   Timed t{Film(f.width, f.height), {}, 0.0};
   TileSettings s = f.settings;
   s.specialisation |= kSpecGuiding | kSpecNeural;
   const auto t0 = std::chrono::steady_clock::now();
   uint32_t done = 0;
-  for (uint32_t pass = 0; done < f.spp; ++pass) {
-    const uint32_t n = std::min(f.spp - done, pass < 16 ? 1u : std::min(8u, 2u << (pass - 16)));
+  for (uint32_t pass = 0; goes_on(done, spp, seconds, t0); ++pass) {
+    const uint32_t n = std::min(spp - done, pass < 16 ? 1u : std::min(8u, 2u << std::min(pass - 16, 20u)));
     bind_guide(guide, &s);
     t.counters.add(render_film_pass(backend, s, t.film, done, done + n));
     combine_guide_rounds(guide, [](std::vector<uint64_t>&) {});
@@ -122,6 +132,40 @@ Timed render_neural(DeviceBackend& backend, const GpuFixture& f, NeuralGuide& gu
   }
   t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return t;
+}
+
+// Relative MSE against a reference, as tessera's image metrics define it:
+// the mean over pixels and channels of (A - F)^2 / (F^2 + 0.01).
+double rel_mse(const Film& a, const Film& reference) {
+  double sum = 0.0;
+  for (size_t i = 0; i < a.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const PixelAccum& p = a.pixels[i];
+      const PixelAccum& r = reference.pixels[i];
+      const double va = p.n ? p.sum[c] / double(p.n) : 0.0, vr = r.n ? r.sum[c] / double(r.n) : 0.0;
+      sum += (va - vr) * (va - vr) / (vr * vr + 1e-2);
+    }
+  return sum / (3.0 * double(a.pixels.size()));
+}
+
+// Equal time on the device: unguided, the table and the network (training
+// included) for the same seconds, each against a long unguided reference.
+void equal_time(DeviceBackend& backend, const GpuFixture& f, uint32_t ref_spp, std::initializer_list<double> budgets) {
+  const Timed ref = render(backend, f, nullptr, ref_spp, 0.0, 256);
+  std::printf("  equal time on the device, against %u spp unguided (%.1f s):\n", ref_spp, ref.seconds);
+  for (const double seconds : budgets) {
+    const Timed u = render(backend, f, nullptr, ~0u, seconds);
+    GuideField table(GuideConfig{}, f.lo, f.hi, f.lights, f.max_emitted);
+    const Timed g = render(backend, f, &table, ~0u, seconds);
+    NeuralGuide network(NeuralGuideConfig{}, f.lo, f.hi, f.max_emitted, f.lights);
+    const Timed n = render_neural(backend, f, network, ~0u, seconds);
+    const double eu = rel_mse(u.film, ref.film), eg = rel_mse(g.film, ref.film), en = rel_mse(n.film, ref.film);
+    std::printf("    %.2f s: relMSE none %.3g (%u spp), qtable %.3g (%u spp, %.2fx none's), neural %.3g (%u spp, %.2fx none's, "
+                "%.2fx the table's; training %.0f %% of its time)\n",
+                seconds, eu, static_cast<unsigned>(u.film.pixels[0].n), eg, static_cast<unsigned>(g.film.pixels[0].n), eg / eu,
+                en, static_cast<unsigned>(n.film.pixels[0].n), en / eu, en / eg,
+                100.0 * network.stats().train_seconds / n.seconds);
+  }
 }
 
 bool identical(const Film& a, const Film& b) {
@@ -167,8 +211,8 @@ bool check(const std::string& path) {
   reference.pixels = f.reference;
   bool ok = true;
 
-  render(backend, f, nullptr);  // warm-up: first launches, allocations
-  const Timed a = render(backend, f, nullptr), b = render(backend, f, nullptr);
+  render(backend, f, nullptr, f.spp);  // warm-up: first launches, allocations
+  const Timed a = render(backend, f, nullptr, f.spp), b = render(backend, f, nullptr, f.spp);
   const double samples = double(f.width) * f.height * f.spp;
   std::printf("%s on %s: %dx%d, %u spp\n", f.name.c_str(), description.c_str(), f.width, f.height, f.spp);
   if (!identical(a.film, b.film)) std::printf("  FAIL unguided renders differ between runs\n"), ok = false;
@@ -181,7 +225,7 @@ bool check(const std::string& path) {
 
   auto make_guide = [&] { return GuideField(GuideConfig{}, f.lo, f.hi, f.lights, f.max_emitted); };
   GuideField g1 = make_guide(), g2 = make_guide();
-  const Timed ga = render(backend, f, &g1), gb = render(backend, f, &g2);
+  const Timed ga = render(backend, f, &g1, f.spp), gb = render(backend, f, &g2, f.spp);
   if (ga.counters.path.guide_updates == 0 || g1.stats().updates == 0)
     std::printf("  FAIL no learning came back from the device\n"), ok = false;
   if (!identical(ga.film, gb.film) || !(g1 == g2))
@@ -193,7 +237,7 @@ bool check(const std::string& path) {
     return std::make_unique<NeuralGuide>(NeuralGuideConfig{}, f.lo, f.hi, f.max_emitted, f.lights);
   };
   auto n1 = make_network(), n2 = make_network();
-  const Timed na = render_neural(backend, f, *n1), nb = render_neural(backend, f, *n2);
+  const Timed na = render_neural(backend, f, *n1, f.spp), nb = render_neural(backend, f, *n2, f.spp);
   const NeuralGuideStats ns = n1->stats();
   if (ns.steps == 0 || ns.targets == 0) std::printf("  FAIL the network learned nothing from the device\n"), ok = false;
   if (na.counters.path.guided_samples == 0) std::printf("  FAIL the network guided no sample\n"), ok = false;
@@ -224,11 +268,11 @@ bool check(const std::string& path) {
   // The same kernels on this machine's cores.
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   DeviceBackend host(packed, std::make_unique<HostThreadsDevice>(cores));
-  const Timed h = render(host, f, nullptr);
+  const Timed h = render(host, f, nullptr, f.spp);
   GuideField gh = make_guide();
-  const Timed hg = render(host, f, &gh);
+  const Timed hg = render(host, f, &gh, f.spp);
   auto nh = make_network();
-  const Timed hn = render_neural(host, f, *nh);
+  const Timed hn = render_neural(host, f, *nh, f.spp);
   std::printf("  this machine's %d cores, the same kernels: %.3f Msamples/s unguided, %.3f guided, %.3f neural; "
               "GPU is %.1fx, %.1fx, %.1fx\n",
               cores, samples / h.seconds * 1e-6, samples / hg.seconds * 1e-6, samples / hn.seconds * 1e-6,
@@ -238,6 +282,11 @@ bool check(const std::string& path) {
   if (dry_run && !identical(a.film, h.film)) std::printf("  FAIL the dry run's two host renders differ\n"), ok = false;
   if (dry_run && (!identical(na.film, hn.film) || !(*n1 == *nh)))
     std::printf("  FAIL the dry run's two host neural renders differ\n"), ok = false;
+  // Figures only (the dry run: briefly, to run the code).
+  if (dry_run)
+    equal_time(backend, f, 4 * f.spp, {0.05, 0.1});
+  else
+    equal_time(backend, f, 64 * f.spp, {0.5, 2.0});
   return ok;
 }
 
