@@ -46,6 +46,20 @@ int64_t from_word(uint64_t w) { return static_cast<int64_t>(w); }
 
 }  // namespace
 
+// A training thread's sums: the fixed-point gradient (P words; zero outside
+// the dense hidden-layer block and `dirty`), the float gradient of the tile
+// it is on (all zero between tiles), and the round's statistics.
+struct NeuralGuide::TrainScratch {
+  struct Local {
+    std::vector<int64_t> sum;
+    std::vector<float> grad;
+    std::vector<uint32_t> touched;  // this tile's hash-grid and output-layer entries
+    std::vector<uint32_t> dirty;    // entries of `sum` outside the dense block made non-zero this round
+    uint64_t loss = 0, count = 0, clamped = 0, nonfinite = 0;
+  };
+  tbb::enumerable_thread_specific<Local> locals;
+};
+
 NeuralGuide::NeuralGuide(const NeuralGuideConfig& config, const Vec3& lo, const Vec3& hi, Float radiance_scale,
                          uint32_t num_lights)
     : config_(config),
@@ -252,16 +266,11 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
   // of the outputs it trains and a few hash-grid entries: only those are
   // quantised and cleared again, not every parameter per tile.
   const size_t layers = layout().w1(), hidden_end = layout().w3();
-  struct Local {
-    std::vector<int64_t> sum;
-    std::vector<float> grad;  // all zero between tiles
-    std::vector<uint32_t> touched;
-    uint64_t loss = 0, count = 0, clamped = 0, nonfinite = 0;
-  };
-  tbb::enumerable_thread_specific<Local> locals;
+  using Local = TrainScratch::Local;
+  if (!scratch_) scratch_ = std::make_shared<TrainScratch>();
   tbb::parallel_for(size_t(0), pass_tiles_.size(), [&](size_t i) {
-    Local& local = locals.local();
-    if (local.sum.empty()) {
+    Local& local = scratch_->locals.local();
+    if (local.sum.size() != P) {
       local.sum.assign(P, 0);
       local.grad.assign(P, 0.f);
     }
@@ -285,7 +294,9 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
         g = g > 0.0 ? kGradLimit : -kGradLimit;
       }
       // Half away from zero, as llround (exact: |g| <= 2^44), without its call.
-      local.sum[k] += static_cast<int64_t>(g + (g >= 0.0 ? 0.5 : -0.5));
+      const int64_t q = static_cast<int64_t>(g + (g >= 0.0 ? 0.5 : -0.5));
+      if (local.sum[k] == 0 && q != 0 && (k < layers || k >= hidden_end)) local.dirty.push_back(static_cast<uint32_t>(k));
+      local.sum[k] += q;
     };
     for (size_t k = layers; k < hidden_end; ++k) take(k);
     for (uint32_t k : local.touched) take(k);
@@ -297,14 +308,23 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
     local.loss += static_cast<uint64_t>(std::llround(loss * kLossScale));
     local.count += count;
   });
+  // Integer sums: the same whichever thread added which tile. Each thread's
+  // buffers are left zero for the next round.
   acc_.assign(P + 4, 0);
-  for (const Local& local : locals) {
+  for (Local& local : scratch_->locals) {
     if (local.sum.empty()) continue;
-    for (size_t k = 0; k < P; ++k) acc_[k] += to_word(local.sum[k]);
+    auto move = [&](size_t k) {
+      acc_[k] += to_word(local.sum[k]);
+      local.sum[k] = 0;
+    };
+    for (size_t k = layers; k < hidden_end; ++k) move(k);
+    for (uint32_t k : local.dirty) move(k);
+    local.dirty.clear();
     acc_[P] += local.loss;
     acc_[P + 1] += local.count;
     acc_[P + 2] += local.clamped;
     acc_[P + 3] += local.nonfinite;
+    local.loss = local.count = local.clamped = local.nonfinite = 0;
   }
   totals_.train_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return acc_;
@@ -319,21 +339,30 @@ static double adam_power(double beta, uint64_t steps) {
 }
 
 // The step from the summed fixed-point gradients (acc_[0..P), over `count`
-// targets). Parameter by parameter, so threads change no result.
+// targets). Parameter by parameter, so threads change no result. The
+// gradients are converted first (int64 to double has no SSE2 vector form),
+// so that the update itself, a division and a square root per parameter,
+// runs on vector lanes: it is every parameter's, every step.
 void NeuralGuide::adam_step(uint64_t count) {
   ++steps_;
-  const double lr = config_.learning_rate;
-  const double c1 = 1.0 - adam_power(kAdamBeta1, steps_);
-  const double c2 = 1.0 - adam_power(kAdamBeta2, steps_);
-  const double n = static_cast<double>(count);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, params_.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+  const size_t P = params_.size();
+  const double lr1 = config_.learning_rate / (1.0 - adam_power(kAdamBeta1, steps_));  // bias corrections folded in
+  const double ic2 = 1.0 / (1.0 - adam_power(kAdamBeta2, steps_));
+  const double unit = 1.0 / (kGradScale * static_cast<double>(count));
+  adam_grad_.resize(P);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, P, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    double* grad = adam_grad_.data();
+    for (size_t k = r.begin(); k < r.end(); ++k) grad[k] = static_cast<double>(from_word(acc_[k])) * unit;
+    float* m = adam_m_.data();
+    float* v = adam_v_.data();
+    float* w = params_.data();
     for (size_t k = r.begin(); k < r.end(); ++k) {
-      const double g = static_cast<double>(from_word(acc_[k])) / kGradScale / n;
-      const double m = kAdamBeta1 * adam_m_[k] + (1.0 - kAdamBeta1) * g;
-      const double v = kAdamBeta2 * adam_v_[k] + (1.0 - kAdamBeta2) * g * g;
-      adam_m_[k] = static_cast<float>(m);
-      adam_v_[k] = static_cast<float>(v);
-      params_[k] = static_cast<float>(params_[k] - lr * (m / c1) / (std::sqrt(v / c2) + kAdamEps));
+      const double g = grad[k];
+      const double mk = kAdamBeta1 * m[k] + (1.0 - kAdamBeta1) * g;
+      const double vk = kAdamBeta2 * v[k] + (1.0 - kAdamBeta2) * g * g;
+      m[k] = static_cast<float>(mk);
+      v[k] = static_cast<float>(vk);
+      w[k] = static_cast<float>(w[k] - lr1 * mk / (std::sqrt(vk * ic2) + kAdamEps));
     }
   });
 }

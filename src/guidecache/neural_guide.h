@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <iosfwd>
+#include <memory>
 #include <vector>
 
 #include "guidecache/guide.h"
@@ -159,6 +160,12 @@ class NeuralGuide final : public Guide {
   double pass_loss_sum_ = 0.0;
   uint64_t pass_loss_count_ = 0;
   std::vector<uint64_t> acc_;
+  // Each training thread's gradient buffers, kept from round to round (a
+  // round used to allocate and add up P-sized buffers per thread; with small
+  // minibatches that was most of a step). Defined in neural_guide.cpp.
+  struct TrainScratch;
+  std::shared_ptr<TrainScratch> scratch_;
+  std::vector<double> adam_grad_;  // adam_step's converted gradients
 };
 
 }  // namespace tessera
