@@ -13,7 +13,9 @@ cmake --build build -j "$(nproc)" --target device_backend_on_device make_gpu_fix
 mkdir -p "$bundle/fixtures"
 cp build/device_backend_on_device "$bundle/"
 # Its one shared library a bare GPU machine lacks: oneTBB (the network trains on the host).
-cp -L "$(ldd build/device_backend_on_device | awk '/libtbb\.so/ {print $3}')" "$bundle/"
+tbb=$(ldd build/device_backend_on_device | awk '/libtbb\.so/ && $3 ~ /^\// {print $3; exit}')
+[ -n "$tbb" ] || { echo "gpu_bundle: device_backend_on_device links no libtbb found by ldd" >&2; exit 1; }
+cp -L "$tbb" "$bundle/"
 build/make_gpu_fixtures "$bundle/fixtures" "${SPP:-64}"
 # GLM for the checks gpu_check.sh builds there with nvcc (a bare GPU machine has none).
 mkdir -p .gpu/include && cp -r /usr/include/glm .gpu/include/

@@ -268,6 +268,14 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
   const size_t layers = layout().w1(), hidden_end = layout().w3();
   using Local = TrainScratch::Local;
   if (!scratch_) scratch_ = std::make_shared<TrainScratch>();
+  // A round that throws (out of memory) leaves the buffers dirty: they go.
+  struct DropOnThrow {
+    std::shared_ptr<TrainScratch>& scratch;
+    bool done = false;
+    ~DropOnThrow() {
+      if (!done) scratch.reset();
+    }
+  } drop_on_throw{scratch_};
   tbb::parallel_for(size_t(0), pass_tiles_.size(), [&](size_t i) {
     Local& local = scratch_->locals.local();
     if (local.sum.size() != P) {
@@ -326,6 +334,7 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
     acc_[P + 3] += local.nonfinite;
     local.loss = local.count = local.clamped = local.nonfinite = 0;
   }
+  drop_on_throw.done = true;
   totals_.train_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return acc_;
 }

@@ -17,6 +17,7 @@ namespace {
 
 __global__ void __launch_bounds__(kCudaThreadsPerBlock) accumulate_kernel(DeviceLaunch launch) {
   for (uint32_t p = threadIdx.x; p < launch.max_tile_pixels; p += blockDim.x) accumulate_device_pixel(launch, blockIdx.x, p);
+  if (threadIdx.x == 0) gather_device_targets(launch, blockIdx.x);  // reads only what the trace wrote
 }
 
 // This process's place among the ranks on its machine (Open MPI, MPICH,

@@ -31,7 +31,7 @@ class DeviceApi {
   virtual void download(void* host_dst, const void* device_src, size_t bytes) = 0;
   virtual void zero(void* device_dst, size_t bytes) = 0;
   // Starts rendering every sample of every tile of the launch (trace, then
-  // accumulate) with the integrator served_specialisation(spec) names. The
+  // accumulate and gather_device_targets per tile) with the integrator served_specialisation(spec) names. The
   // caller polls finished() (the farm master answers its workers meanwhile)
   // and then calls wait(), which reports the launch's errors.
   virtual void start(const DeviceLaunch& launch, uint32_t spec) = 0;

@@ -19,9 +19,10 @@ static_assert(sizeof(GuideView) == 200, "GuideView changed: upload its new array
 static_assert(sizeof(NeuralGuideView) == 88,
               "NeuralGuideView changed: upload its new arrays in upload_network, then update this size");
 
-// Device memory for the learning targets of one batch at most (tiles stop
-// joining a batch beyond it): 544 bytes per learning path, so a batch of
-// 256 16x16 tiles holds 7 learning samples per pixel.
+// Device memory for the learning targets of one batch (tiles stop joining a
+// batch beyond it; the first tile always joins): 544 bytes per learning
+// path and each tile's room (neural_tile_capacity, or less), so a batch of
+// 256 16x16 tiles holds about 7 learning samples per pixel.
 constexpr uint64_t kMaxTargetBytes = uint64_t{256} << 20;
 
 // Host arrays laid out back to back (16-byte aligned) for one upload.
@@ -177,9 +178,11 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
     tiles.clear();
     pixels.clear();
     uint32_t max_tile_pixels = 0, max_samples = 0;
-    uint64_t target_paths = 0;  // learning paths of the batch (neural guide)
+    uint64_t target_paths = 0, target_rooms = 0;  // learning paths and rooms of the batch (neural guide)
+    const uint32_t capacity = neural_tile_capacity(settings_.path.neural);
     TileTask task;
-    while (tasks.size() < kBatchTiles && target_paths * kNeuralPathTargets * sizeof(NeuralTrainingSample) < kMaxTargetBytes &&
+    while (tasks.size() < kBatchTiles &&
+           (target_paths * kNeuralPathTargets + target_rooms) * sizeof(NeuralTrainingSample) < kMaxTargetBytes &&
            queue.take(&task)) {
       const TileJob& j = task.job;
       DeviceTile t{j, pixels.size()};
@@ -187,7 +190,11 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
         t.first_target_path = target_paths;
         t.learning_samples = job_learning_samples(settings_.learn, j);
         t.keep_prob = neural_tile_keep_prob(settings_, j);
-        target_paths += uint64_t(j.x1 - j.x0) * uint64_t(j.y1 - j.y0) * t.learning_samples;
+        const uint64_t paths = uint64_t(j.x1 - j.x0) * uint64_t(j.y1 - j.y0) * t.learning_samples;
+        t.first_room = target_rooms;
+        t.room = static_cast<uint32_t>(std::min<uint64_t>(capacity, paths * kNeuralPathTargets));
+        target_paths += paths;
+        target_rooms += t.room;
       }
       for (int32_t y = j.y0; y < j.y1; ++y)
         for (int32_t x = j.x0; x < j.x1; ++x) pixels.push_back(task.pixels.at(j, x, y));
@@ -220,6 +227,9 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
           targets_.reserve(target_paths * kNeuralPathTargets * sizeof(NeuralTrainingSample)));
       launch.target_counts = static_cast<uint32_t*>(target_counts_.reserve(target_paths * sizeof(uint32_t)));
       launch.target_rejects = static_cast<uint64_t*>(target_rejects_.reserve(3 * sizeof(uint64_t)));
+      launch.tile_targets =
+          static_cast<NeuralTrainingSample*>(tile_targets_.reserve(target_rooms * sizeof(NeuralTrainingSample)));
+      launch.tile_target_counts = static_cast<uint32_t*>(tile_target_counts_.reserve(2 * tiles.size() * sizeof(uint32_t)));
       device_->zero(launch.target_counts, target_paths * sizeof(uint32_t));
       device_->zero(launch.target_rejects, 3 * sizeof(uint64_t));
     }
@@ -234,7 +244,7 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
     TileCounters batch;
     device_->download(&batch, d_counters, sizeof(TileCounters));
     total.add(batch);
-    if (target_paths > 0) gather_targets(tasks, tiles, target_paths);
+    if (target_paths > 0) gather_targets(tasks, tiles, target_rooms);
     for (size_t i = 0; i < tasks.size(); ++i) {
       const TileJob& j = tasks[i].job;
       size_t k = tiles[i].first_pixel;
@@ -248,44 +258,34 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
   return total;
 }
 
-// Each tile's targets in the order a CPU thread records them (pixels
-// row-major, then samples, then along the path), within the tile's capacity
-// as a CPU sink's: the log gets what a CPU backend would give it. The
+// Each tile's targets, as the device gathered them (gather_device_targets:
+// a CPU thread's order and capacity), to the pass's training log. The
 // batch's rejected and dropped counts go with its first tile.
 void DeviceBackend::gather_targets(const std::vector<TileTask>& tasks, const std::vector<DeviceTile>& tiles,
-                                   uint64_t paths) {
-  std::vector<uint32_t> counts(paths);
-  std::vector<NeuralTrainingSample> slots(paths * kNeuralPathTargets);
+                                   uint64_t rooms) {
+  const size_t n = tasks.size();
+  std::vector<uint32_t> counts(2 * n);
   uint64_t rejects[3] = {0, 0, 0};
-  device_->download(counts.data(), target_counts_.get(), paths * sizeof(uint32_t));
-  device_->download(slots.data(), targets_.get(), slots.size() * sizeof(NeuralTrainingSample));
+  device_->download(counts.data(), tile_target_counts_.get(), counts.size() * sizeof(uint32_t));
   device_->download(rejects, target_rejects_.get(), sizeof(rejects));
-  const uint32_t capacity = neural_tile_capacity(settings_.path.neural);
-  std::vector<NeuralTrainingSample> kept;
-  for (size_t i = 0; i < tasks.size(); ++i) {
-    const DeviceTile& t = tiles[i];
-    const TileJob& j = tasks[i].job;
+  // Up to the last tile's kept targets (one copy; the rooms' unused ends come too).
+  uint64_t used = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (counts[i] > 0) used = tiles[i].first_room + std::min(counts[i], tiles[i].room);
+  gathered_.resize(rooms);
+  if (used > 0) device_->download(gathered_.data(), tile_targets_.get(), used * sizeof(NeuralTrainingSample));
+  for (size_t i = 0; i < n; ++i) {
     NeuralSampleSink sink;
-    sink.tile = j.index;
+    sink.tile = tasks[i].job.index;
+    sink.data = gathered_.data() + tiles[i].first_room;
+    sink.count = std::min(counts[i], tiles[i].room);
+    sink.capacity = tiles[i].room;
+    sink.dropped = counts[n + i];
     if (i == 0) {
       sink.rejected_nonfinite = rejects[0];
       sink.rejected_large = rejects[1];
-      sink.dropped = rejects[2];
+      sink.dropped += rejects[2];
     }
-    kept.clear();
-    const uint64_t tile_paths = uint64_t(j.x1 - j.x0) * uint64_t(j.y1 - j.y0) * t.learning_samples;
-    for (uint64_t p = t.first_target_path; p < t.first_target_path + tile_paths; ++p) {
-      const uint32_t n = std::min(counts[p], kNeuralPathTargets);
-      for (uint32_t k = 0; k < n; ++k) {
-        if (kept.size() < capacity)
-          kept.push_back(slots[p * kNeuralPathTargets + k]);
-        else
-          ++sink.dropped;
-      }
-    }
-    sink.data = kept.data();
-    sink.count = static_cast<uint32_t>(kept.size());
-    sink.capacity = capacity;
     settings_.neural_log->add_tile(sink);
   }
 }

@@ -78,17 +78,19 @@ class DeviceBackend : public TileBackend {
   void upload_guide(const GuideView& host);
   void upload_network(const NeuralGuideView& host);
   // Hands the batch's learning targets to the pass's training log, tile by tile.
-  void gather_targets(const std::vector<TileTask>& tasks, const std::vector<DeviceTile>& tiles, uint64_t paths);
+  void gather_targets(const std::vector<TileTask>& tasks, const std::vector<DeviceTile>& tiles, uint64_t rooms);
 
   std::unique_ptr<DeviceApi> device_;  // declared first: the buffers are freed before it goes
   Buffer scene_bytes_{*device_}, scene_view_{*device_}, guide_bytes_{*device_}, guide_acc_{*device_};
   Buffer tiles_{*device_}, pixels_{*device_}, values_{*device_}, counters_{*device_};
   Buffer network_{*device_}, targets_{*device_}, target_counts_{*device_}, target_rejects_{*device_};
+  Buffer tile_targets_{*device_}, tile_target_counts_{*device_};
   BvhView bvh_;
   TileSettings settings_;      // the pass's, as the host gave them
   TileSettings device_settings_;  // the same with the guide view in device memory
   bool in_pass_ = false;
   bool neural_learning_ = false;  // this pass records the neural guide's learning targets
+  std::vector<NeuralTrainingSample> gathered_;  // a batch's tiles' targets, back from the device
 };
 
 }  // namespace tessera

@@ -6,7 +6,8 @@
 //               its spp: small images still fill a GPU);
 //   accumulate: one thread per pixel adds its values in sample order, so a
 //               pixel's sums do not depend on the launch's shape or timing.
-// Counters and guide targets are added with integer atomics (order-free).
+// Counters and guide targets are added with integer atomics (order-free);
+// the neural guide's targets are gathered per tile after the trace.
 #pragma once
 
 #include "kernels/bvh.h"
@@ -20,11 +21,15 @@ namespace tessera {
 // batch's pixel array (row-major, x1 - x0 wide). With the neural guide
 // learning: each learning path (pixel, learning sample) has
 // kNeuralPathTargets target slots, the tile's from path first_target_path
-// on, pixel-major (the order a CPU thread traces them in).
+// on, pixel-major (the order a CPU thread traces them in), and room for
+// what the tile can keep (its capacity, or 8 per learning path if fewer)
+// from first_room on.
 struct DeviceTile {
   TileJob job;
   uint64_t first_pixel = 0;
   uint64_t first_target_path = 0;
+  uint64_t first_room = 0;
+  uint32_t room = 0;
   uint32_t learning_samples = 0;  // of the job's samples (0: the tile records no targets)
   Float keep_prob = 1.f;          // NeuralSampleSink::keep_prob for the tile
 };
@@ -46,10 +51,14 @@ struct DeviceLaunch {
   TileCounters* counters = nullptr;  // one, summed over the launch
   // The neural guide's learning targets (null: not recorded): slots per
   // learning path (DeviceTile), how many each path kept, and the launch's
-  // rejected (non-finite, too large) and dropped targets.
+  // rejected (non-finite, too large) and dropped targets; then each tile's
+  // gathered (gather_device_targets) into its room (DeviceTile), how many
+  // ([tile]) and how many were dropped beyond it ([num_tiles + tile]).
   NeuralTrainingSample* targets = nullptr;
   uint32_t* target_counts = nullptr;
   uint64_t* target_rejects = nullptr;  // [3]
+  NeuralTrainingSample* tile_targets = nullptr;
+  uint32_t* tile_target_counts = nullptr;
 };
 
 // The integrator a specialisation is served by on the portable BVH: the
@@ -122,6 +131,30 @@ TESSERA_HOST_DEVICE inline void accumulate_device_pixel(const DeviceLaunch& laun
   const Rgb* values = launch.values + (t.first_pixel + pixel) * launch.max_samples;
   for (uint32_t i = 0; i < tile_samples(t); ++i) accumulate_sample(acc, values[i]);
   out = acc;
+}
+
+// After the trace: tile `tile`'s learning targets in the order a CPU thread
+// records them (pixels row-major, then samples, then along the path),
+// within the tile's capacity as a CPU sink's (the rest counted as
+// dropped), packed at the tile's place in tile_targets: what comes back to
+// the host is a tile's kept targets, not every path's slots.
+TESSERA_HOST_DEVICE inline void gather_device_targets(const DeviceLaunch& launch, uint32_t tile) {
+  if (launch.targets == nullptr) return;
+  const DeviceTile& t = launch.tiles[tile];
+  const uint64_t paths = uint64_t(t.job.x1 - t.job.x0) * uint64_t(t.job.y1 - t.job.y0) * t.learning_samples;
+  NeuralTrainingSample* out = launch.tile_targets + t.first_room;
+  uint32_t kept = 0, dropped = 0;
+  for (uint64_t p = t.first_target_path; p < t.first_target_path + paths; ++p) {
+    const uint32_t n = launch.target_counts[p] < kNeuralPathTargets ? launch.target_counts[p] : kNeuralPathTargets;
+    for (uint32_t k = 0; k < n; ++k) {
+      if (kept < t.room)  // the tile's capacity (a room smaller than it is never outgrown)
+        out[kept++] = launch.targets[p * kNeuralPathTargets + k];
+      else
+        ++dropped;
+    }
+  }
+  launch.tile_target_counts[tile] = kept;
+  launch.tile_target_counts[launch.num_tiles + tile] = dropped;
 }
 
 }  // namespace tessera

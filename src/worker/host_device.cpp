@@ -23,6 +23,7 @@ void run_launch(const DeviceLaunch& launch, tbb::task_arena& arena) {
     });
     tbb::parallel_for(uint32_t{0}, launch.num_tiles, [&](uint32_t tile) {
       for (uint32_t p = 0; p < launch.max_tile_pixels; ++p) accumulate_device_pixel(launch, tile, p);
+      gather_device_targets(launch, tile);
     });
   });
 }

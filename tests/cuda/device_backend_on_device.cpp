@@ -77,8 +77,10 @@ class HostThreadsDevice : public HostMemoryDevice {
                                       static_cast<uint32_t>(i % launch.max_samples));
       });
     for (std::thread& t : pool) t.join();
-    for (uint32_t tile = 0; tile < launch.num_tiles; ++tile)
+    for (uint32_t tile = 0; tile < launch.num_tiles; ++tile) {
       for (uint32_t p = 0; p < launch.max_tile_pixels; ++p) accumulate_device_pixel(launch, tile, p);
+      gather_device_targets(launch, tile);
+    }
   }
   int threads_;
 };

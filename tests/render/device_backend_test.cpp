@@ -311,17 +311,21 @@ std::unique_ptr<NeuralGuide> make_network(const SceneData& scene, uint32_t tile_
 // emulated device learns exactly what the BVH backend learns: the same
 // weights and the same image, bit for bit, on shelter (whose lights' selection is
 // learned too) and door-ajar; also where every target is kept and long
-// paths meet the per-path limit (tile_targets beyond any tile's offer).
+// paths meet the per-path limit (tile_targets beyond any tile's offer), and
+// where every sample learns, so that passes hold several learning samples
+// per pixel (the device's slots interleave them as a CPU thread does).
 TEST(DeviceBackend, NeuralGuidedEqualsTheBvh) {
   for (const char* name : {"shelter", "door-ajar"})
-    for (const uint32_t tile_targets : {128u, 1000000u}) {
-      const std::string what = std::string(name) + ", tile_targets " + std::to_string(tile_targets);
+    for (const uint32_t tile_targets : {128u, 100000u, 0u}) {
+      const bool every_sample = tile_targets == 0;
+      const std::string what = std::string(name) + (every_sample ? ", every sample learns" : ", tile_targets " + std::to_string(tile_targets));
       const SceneData scene = shipped(name, 24, 20);
       RenderOptions opt = small_options(scene, 20);  // 16 single-sample learning passes, then larger ones
       opt.tile_size = 8;
+      if (every_sample) opt.guide_learn = GuideLearnSchedule{2, 1, false};  // passes of 1, 1, 2, 4, 8 learning samples
       BvhBackend bvh(scene);
       std::unique_ptr<TileBackend> device = make_tile_backend("emulated-device", scene, 2);
-      auto gb = make_network(scene, tile_targets), gd = make_network(scene, tile_targets);
+      auto gb = make_network(scene, every_sample ? 128u : tile_targets), gd = make_network(scene, every_sample ? 128u : tile_targets);
       const RenderResult b = render(scene, bvh, opt, gb.get()), d = render(scene, *device, opt, gd.get());
       EXPECT_EQ(d.stats.backend, "emulated-device") << what;
       EXPECT_GT(d.stats.neural_guide.steps, 0u) << what;
