@@ -257,6 +257,27 @@ class CountingBackend : public TileBackend {
   std::unique_ptr<TileBackend> inner_;
 };
 
+// A farm over the in-process transport: rank 0 (the master) renders on
+// backends[0], the others are workers; each rank has its own guide.
+RenderResult render_farm(const SceneData& scene, const RenderOptions& opt, const std::vector<Guide*>& guides,
+                         const std::vector<TileBackend*>& backends) {
+  const int32_t ranks = static_cast<int32_t>(guides.size());
+  InProcessHub hub(ranks);
+  std::vector<std::unique_ptr<Transport>> ends;
+  for (int32_t r = 0; r < ranks; ++r) ends.push_back(hub.endpoint(r));
+  const uint32_t spec = effective_specialisation(scene, opt, guides[0]);
+  std::vector<std::thread> workers;
+  for (int32_t r = 1; r < ranks; ++r)
+    workers.emplace_back([&, r] {
+      run_farm_worker(*ends[r], *backends[r], make_tile_settings(opt, spec, true), guides[r], true, 1);
+    });
+  FarmMaster master(*ends[0], *backends[0], 1, true);
+  RenderResult farm = render(scene, master, opt, guides[0]);
+  master.stop();
+  for (auto& w : workers) w.join();
+  return farm;
+}
+
 // Device ranks take batches of tiles: a farm of a BVH master (one tile at a
 // time, answering the workers between tiles) and device workers gives the
 // local BVH image and field, bit for bit, and names both backends.
@@ -269,25 +290,14 @@ TEST(DeviceBackend, FarmOfDeviceAndBvhRanksEqualsTheLocalImage) {
   const RenderResult local = render(scene, local_backend, opt, &local_guide);
 
   const int32_t ranks = 3;
-  InProcessHub hub(ranks);
-  std::vector<std::unique_ptr<Transport>> ends;
   std::vector<std::unique_ptr<GuideField>> guides;
   std::vector<std::unique_ptr<CountingBackend>> backends;
   for (int32_t r = 0; r < ranks; ++r) {
-    ends.push_back(hub.endpoint(r));
     guides.push_back(std::make_unique<GuideField>(make_guide(scene)));
     backends.push_back(std::make_unique<CountingBackend>(make_tile_backend(r == 0 ? "bvh" : "emulated-device", scene, 1)));
   }
-  const uint32_t spec = effective_specialisation(scene, opt, guides[0].get());
-  std::vector<std::thread> workers;
-  for (int32_t r = 1; r < ranks; ++r)
-    workers.emplace_back([&, r] {
-      run_farm_worker(*ends[r], *backends[r], make_tile_settings(opt, spec, true), guides[r].get(), true, 1);
-    });
-  FarmMaster master(*ends[0], *backends[0], 1, true);
-  const RenderResult farm = render(scene, master, opt, guides[0].get());
-  master.stop();
-  for (auto& w : workers) w.join();
+  const RenderResult farm = render_farm(scene, opt, {guides[0].get(), guides[1].get(), guides[2].get()},
+                                        {backends[0].get(), backends[1].get(), backends[2].get()});
   EXPECT_EQ(farm.stats.backend, "bvh+emulated-device");
   expect_same_render(local, farm, "farm");
   for (int32_t r = 0; r < ranks; ++r) {
@@ -356,26 +366,15 @@ TEST(DeviceBackend, NeuralFarmOfDeviceAndBvhRanksEqualsTheLocalImage) {
   const RenderResult local = render(scene, local_backend, opt, local_guide.get());
 
   const int32_t ranks = 3;
-  InProcessHub hub(ranks);
-  std::vector<std::unique_ptr<Transport>> ends;
   std::vector<std::unique_ptr<NeuralGuide>> guides;
   std::vector<std::unique_ptr<TileBackend>> backends;
   for (int32_t r = 0; r < ranks; ++r) {
-    ends.push_back(hub.endpoint(r));
     guides.push_back(make_network(scene));
     backends.push_back(make_tile_backend(r == 0 ? "bvh" : "emulated-device", scene, 1));
   }
-  const uint32_t spec = effective_specialisation(scene, opt, guides[0].get());
-  ASSERT_TRUE(spec & kSpecNeural);
-  std::vector<std::thread> workers;
-  for (int32_t r = 1; r < ranks; ++r)
-    workers.emplace_back([&, r] {
-      run_farm_worker(*ends[r], *backends[r], make_tile_settings(opt, spec, true), guides[r].get(), true, 1);
-    });
-  FarmMaster master(*ends[0], *backends[0], 1, true);
-  const RenderResult farm = render(scene, master, opt, guides[0].get());
-  master.stop();
-  for (auto& w : workers) w.join();
+  ASSERT_TRUE(effective_specialisation(scene, opt, guides[0].get()) & kSpecNeural);
+  const RenderResult farm = render_farm(scene, opt, {guides[0].get(), guides[1].get(), guides[2].get()},
+                                        {backends[0].get(), backends[1].get(), backends[2].get()});
   EXPECT_EQ(farm.stats.backend, "bvh+emulated-device");
   expect_same_render(local, farm, "neural farm");
   for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(*guides[r] == *local_guide) << "rank " << r;
