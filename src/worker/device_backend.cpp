@@ -157,7 +157,7 @@ void DeviceBackend::begin_pass(const TileSettings& settings) {
   device_settings_ = settings;
   device_settings_.neural_log = nullptr;  // a host object: the targets come back per batch
   const GuideView& g = settings.path.guide;
-  const bool neural = (settings.specialisation & kSpecNeural) && (settings.specialisation & kSpecGuiding);
+  const bool neural = (served_specialisation(settings.specialisation) & kSpecNeural) != 0;
   if (neural && settings.path.neural.params == nullptr)
     throw std::logic_error("DeviceBackend: a neural-guided pass without the network's view");
   if (neural) upload_network(settings.path.neural);
@@ -292,7 +292,7 @@ void DeviceBackend::gather_targets(const std::vector<TileTask>& tasks, const std
 
 void DeviceBackend::end_pass() {
   const GuideView& g = settings_.path.guide;
-  const bool neural = (settings_.specialisation & kSpecNeural) && (settings_.specialisation & kSpecGuiding);
+  const bool neural = (served_specialisation(settings_.specialisation) & kSpecNeural) != 0;
   if (in_pass_ && !neural && g.acc != nullptr && g.acc_words > 0) {
     std::vector<uint64_t> learned(g.acc_words);
     device_->download(learned.data(), guide_acc_.get(), learned.size() * sizeof(uint64_t));
