@@ -8,7 +8,6 @@ PACKAGES=(
   libembree-dev embree-tools      # ray tracing kernels; embree-tools = reference path tracer for benchmarks
   libopenexr-dev                  # EXR output and input
   libglm-dev                      # vector math shared by CPU and CUDA
-  libeigen3-dev                   # dense math for the neural guide's batched training
   libcereal-dev                   # serialisation
   libopenmpi-dev openmpi-bin      # the render farm
   libtbb-dev                      # CPU parallelism

@@ -44,7 +44,9 @@ std::vector<Float> guide_values_at(Guide& guide, const Vec3& p, const Vec3& n, s
   const int32_t s = pg.locate(p, n);
   *grid = kNeuralGrid;
   *where = "network";
-  return std::vector<Float>(pg.site[s].q, pg.site[s].q + kNeuralBins);
+  std::vector<Float> q(kNeuralBins);
+  for (uint32_t j = 0; j < kNeuralBins; ++j) q[j] = neural_site_q(view, pg.site[s], j);
+  return q;
 }
 
 void write_distribution(const VizArgs& a, Guide& guide, const glm::dvec3& render_origin) {

@@ -1,12 +1,12 @@
 #include "guidecache/neural_guide.h"
 
-#include <Eigen/Dense>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include "guidecache/guide_field.h"
@@ -43,6 +43,16 @@ float uniform_pm(uint64_t* state, float a) {  // uniform in [-a, a)
 
 uint64_t to_word(int64_t v) { return static_cast<uint64_t>(v); }
 int64_t from_word(uint64_t w) { return static_cast<int64_t>(w); }
+
+// The nearest integer (ties to even) of |x| <= 2^51, from the bits of
+// x + 1.5 * 2^52: plain arithmetic, so a loop of it runs on vector lanes
+// (a conversion of double to int64 has no SSE2 or AVX2 form).
+inline int64_t to_fixed(double x) {
+  const double shifted = x + 6755399441055744.0;
+  int64_t bits;
+  std::memcpy(&bits, &shifted, sizeof bits);
+  return bits - 0x4338000000000000ll;
+}
 
 }  // namespace
 
@@ -141,84 +151,92 @@ uint32_t NeuralGuide::rounds() const { return 1 + (pass_targets_ > 0 ? config_.s
 
 double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& samples, uint32_t first, uint32_t stride,
                                   std::vector<float>* grad, uint64_t* count, std::vector<uint32_t>* touched) const {
-  using Mat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
-  using Vec = Eigen::Matrix<float, Eigen::Dynamic, 1>;
   const NeuralLayout L = layout();
-  const Eigen::Index W = config_.width, O = L.outputs();
+  const uint32_t W = config_.width, O = L.outputs();
   const size_t n = samples.size();
   const size_t batch = n > first ? (n - first + stride - 1) / stride : 0;
-  const Eigen::Index B = static_cast<Eigen::Index>(batch);
-  *count = static_cast<uint64_t>(B);
-  if (B == 0) return 0.0;
-  // Eigen blocks its products by the cache sizes it reads from the CPU, and
-  // the blocking decides the order of float sums: fixed sizes give every
-  // machine of a farm the same gradients.
-  static const bool fixed_blocking = (Eigen::setCpuCacheSizes(32 * 1024, 256 * 1024, 2 * 1024 * 1024), true);
-  (void)fixed_blocking;
+  *count = static_cast<uint64_t>(batch);
+  if (batch == 0) return 0.0;
   const NeuralGuideView v = view();
   const float scale = v.scale;
-  Mat X(kNeuralInputs, B);
-  // Targets, their bootstrapped parts recomputed by the network as it is
-  // now (NeuralTrainingSample): what the next vertex is predicted to send
-  // moves with every step, not only between passes. (Before the first step
-  // the network is still the one that recorded them: nothing to redo.) A
-  // refreshed target is kept within [0, max_target]: the recorded one was
-  // checked against it, and only the network's new prediction is added.
-  std::vector<float> T(batch);
-  NeuralSite y;
-  for (Eigen::Index b = 0; b < B; ++b) {
-    const NeuralTrainingSample& s = samples[first + static_cast<size_t>(b) * stride];
-    neural_encode(v, Vec3(s.p[0], s.p[1], s.p[2]), Vec3(s.n[0], s.n[1], s.n[2]), X.col(b).data());
-    float t = s.target;
-    if (s.coef > 0.f && v.trained) {
-      neural_infer_cpu(v, Vec3(s.y_p[0], s.y_p[1], s.y_p[2]), Vec3(s.y_n[0], s.y_n[1], s.y_n[2]), &y);
-      const float refreshed = s.target + s.coef * (neural_bootstrap_value(y, s.y_bin) - s.value);
-      if (std::isfinite(refreshed)) t = std::min(std::max(refreshed, 0.f), max_target_);
-    }
-    T[static_cast<size_t>(b)] = t;
-  }
   const float* P = params_.data();
-  Eigen::Map<const Mat> W1(P + L.w1(), W, kNeuralInputs), W2(P + L.w2(), W, W), W3(P + L.w3(), O, W);
-  Eigen::Map<const Vec> b1(P + L.b1(), W), b2(P + L.b2(), W), b3(P + L.b3(), O);
-  const Mat H1 = ((W1 * X).colwise() + b1).cwiseMax(0.f);
-  const Mat H2 = ((W2 * H1).colwise() + b2).cwiseMax(0.f);
-
+  const float *w1 = P + L.w1(), *b1 = P + L.b1(), *w2 = P + L.w2(), *b2 = P + L.b2(), *w3 = P + L.w3(),
+              *b3 = P + L.b3();
   float* G = grad->data();
-  Eigen::Map<Mat> gW1(G + L.w1(), W, kNeuralInputs), gW2(G + L.w2(), W, W), gW3(G + L.w3(), O, W);
-  Eigen::Map<Vec> gb1(G + L.b1(), W), gb2(G + L.b2(), W), gb3(G + L.b3(), O);
-  Mat dH2(W, B);
+  float *gw1 = G + L.w1(), *gb1 = G + L.b1(), *gw2 = G + L.w2(), *gb2 = G + L.b2(), *gw3 = G + L.w3(),
+        *gb3 = G + L.b3();
+  // One target at a time, forward and backward, every sum in a fixed order
+  // (weights input-major: w[i * out + o]); the tile's gradient is the sum
+  // over its targets in their order. Per-tile minibatches are a few targets
+  // (128 per tile over 32 steps: 4), too small for a matrix library's
+  // products to pay their packing (docs/neural-guide.md).
+  Float x[kNeuralInputs], h1[kNeuralMaxWidth], h2[kNeuralMaxWidth], dh1[kNeuralMaxWidth], dh2[kNeuralMaxWidth];
+  float dx[kNeuralEncoded];
   double loss = 0.0;
   bool output_seen[kNeuralMaxOutputs] = {};
-  for (Eigen::Index b = 0; b < B; ++b) {
-    const NeuralTrainingSample& s = samples[first + static_cast<size_t>(b) * stride];
-    const uint32_t bin = s.bin < L.outputs() ? s.bin : 0u;  // a direction bin or a light
+  for (size_t b = 0; b < batch; ++b) {
+    const NeuralTrainingSample& s = samples[first + b * stride];
+    // The target, its bootstrapped part recomputed by the network as it is
+    // now (NeuralTrainingSample): what the next vertex is predicted to send
+    // moves with every step, not only between passes. (Before the first step
+    // the network is still the one that recorded it: nothing to redo.) A
+    // refreshed target is kept within [0, max_target]: the recorded one was
+    // checked against it, and only the network's new prediction is added.
+    float t = s.target;
+    if (s.coef > 0.f && v.trained) {
+      const Float now = neural_value_cpu(v, Vec3(s.y_p[0], s.y_p[1], s.y_p[2]), Vec3(s.y_n[0], s.y_n[1], s.y_n[2]), s.y_bin);
+      const float refreshed = s.target + s.coef * (now - s.value);
+      if (std::isfinite(refreshed)) t = std::min(std::max(refreshed, 0.f), max_target_);
+    }
+    const Vec3 p(s.p[0], s.p[1], s.p[2]);
+    neural_encode(v, p, Vec3(s.n[0], s.n[1], s.n[2]), x);
+    neural_hidden_layer(w1, b1, x, kNeuralInputs, W, h1);
+    neural_hidden_layer(w2, b2, h1, W, W, h2);
+    const uint32_t bin = s.bin < O ? s.bin : 0u;  // a direction bin or a light
     // The output layer's gradient is non-zero only in the outputs trained.
     if (touched && !output_seen[bin]) {
       output_seen[bin] = true;
-      for (Eigen::Index i = 0; i < W; ++i) touched->push_back(L.w3() + static_cast<uint32_t>(i) * L.outputs() + bin);
+      for (uint32_t i = 0; i < W; ++i) touched->push_back(L.w3() + i * O + bin);
       touched->push_back(L.b3() + bin);
     }
-    const float o = W3.row(bin).dot(H2.col(b)) + b3[bin];
+    float o = b3[bin];
+    for (uint32_t i = 0; i < W; ++i) o += w3[static_cast<size_t>(i) * O + bin] * h2[i];
     const float q = neural_exp(o);
-    const float t = T[static_cast<size_t>(b)] / scale;
+    const float ts = t / scale;
     const float denom = q * q + kNeuralLossEps;
-    loss += std::min(static_cast<double>((q - t) * (q - t) / denom), kLossLimit);
-    const float go = std::clamp(2.f * (q - t) * q / denom, -kGradClip, kGradClip);
-    gW3.row(bin) += go * H2.col(b).transpose();
+    loss += std::min(static_cast<double>((q - ts) * (q - ts) / denom), kLossLimit);
+    const float go = std::clamp(2.f * (q - ts) * q / denom, -kGradClip, kGradClip);
+    for (uint32_t i = 0; i < W; ++i) {
+      gw3[static_cast<size_t>(i) * O + bin] += go * h2[i];
+      dh2[i] = h2[i] > 0.f ? w3[static_cast<size_t>(i) * O + bin] * go : 0.f;
+    }
     gb3[bin] += go;
-    dH2.col(b) = (W3.row(bin).transpose() * go).cwiseProduct((H2.col(b).array() > 0.f).cast<float>().matrix());
-  }
-  gW2.noalias() += dH2 * H1.transpose();
-  gb2 += dH2.rowwise().sum();
-  const Mat dH1 = (W2.transpose() * dH2).cwiseProduct((H1.array() > 0.f).cast<float>().matrix());
-  gW1.noalias() += dH1 * X.transpose();
-  gb1 += dH1.rowwise().sum();
-  const Mat dX = W1.transpose() * dH1;
-  for (Eigen::Index b = 0; b < B; ++b) {
-    const NeuralTrainingSample& s = samples[first + static_cast<size_t>(b) * stride];
+    for (uint32_t i = 0; i < W; ++i) {
+      float* row = gw2 + static_cast<size_t>(i) * W;
+      for (uint32_t o2 = 0; o2 < W; ++o2) row[o2] += dh2[o2] * h1[i];
+    }
+    for (uint32_t o2 = 0; o2 < W; ++o2) gb2[o2] += dh2[o2];
+    for (uint32_t i = 0; i < W; ++i) {
+      const float* col = w2 + static_cast<size_t>(i) * W;
+      float acc = 0.f;
+      for (uint32_t o2 = 0; o2 < W; ++o2) acc += col[o2] * dh2[o2];
+      dh1[i] = h1[i] > 0.f ? acc : 0.f;
+    }
+    for (uint32_t i = 0; i < kNeuralInputs; ++i) {
+      float* row = gw1 + static_cast<size_t>(i) * W;
+      for (uint32_t o1 = 0; o1 < W; ++o1) row[o1] += dh1[o1] * x[i];
+    }
+    for (uint32_t o1 = 0; o1 < W; ++o1) gb1[o1] += dh1[o1];
+    for (uint32_t j = 0; j < kNeuralEncoded; ++j) {
+      const float* col = w1 + static_cast<size_t>(j) * W;
+      float acc = 0.f;
+      for (uint32_t o1 = 0; o1 < W; ++o1) acc += col[o1] * dh1[o1];
+      dx[j] = acc;
+    }
+    // The encoding's gradient, scattered to the corners of each level.
     U8 entry[8];
     F8 weight[8];
-    neural_corners8(L.table_size(), neural_unit_position(v, Vec3(s.p[0], s.p[1], s.p[2])), entry, weight);
+    neural_corners8(L.table_size(), neural_unit_position(v, p), entry, weight);
     for (uint32_t l = 0; l < kNeuralLevels; ++l) {
       const uint32_t level_base = L.grid() + l * L.table_size() * kNeuralFeatures;
       for (uint32_t c = 0; c < 8; ++c)
@@ -226,7 +244,7 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
           const uint32_t k = level_base + entry[c][l] * kNeuralFeatures + f;
           // An entry already non-zero in this tile is listed already.
           if (touched && G[k] == 0.f) touched->push_back(k);
-          G[k] += weight[c][l] * dX(l * kNeuralFeatures + f, b);
+          G[k] += weight[c][l] * dx[l * kNeuralFeatures + f];
         }
     }
   }
@@ -288,26 +306,41 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
     // A tile whose gradient has a NaN or Inf adds nothing but a flag
     // (counted): the step goes on with the other tiles, the same on every
     // rank, as a tile's gradient does not depend on where it was computed.
+    float* grad = local.grad.data();
+    int64_t* sum = local.sum.data();
     bool finite = std::isfinite(loss);
-    for (size_t k = layers; finite && k < hidden_end; ++k) finite = std::isfinite(local.grad[k]);
-    for (size_t t = 0; finite && t < local.touched.size(); ++t) finite = std::isfinite(local.grad[local.touched[t]]);
-    // Adds parameter k's gradient (then cleared: a repeated entry adds nothing more).
-    auto take = [&](size_t k) {
-      const float gk = local.grad[k];
-      local.grad[k] = 0.f;
-      if (!finite || gk == 0.f) return;
+    uint32_t bad = 0;
+    for (size_t k = layers; k < hidden_end; ++k) bad += !(std::fabs(grad[k]) <= 3.4e38f);
+    finite = finite && bad == 0;
+    for (size_t t = 0; finite && t < local.touched.size(); ++t) finite = std::isfinite(grad[local.touched[t]]);
+    // The hidden layers' dense block: a loop without branches, on vector lanes.
+    if (finite) {
+      uint64_t clamped = 0;
+      for (size_t k = layers; k < hidden_end; ++k) {
+        const double g = static_cast<double>(grad[k]) * kGradScale;
+        clamped += std::fabs(g) > kGradLimit;
+        sum[k] += to_fixed(std::min(std::max(g, -kGradLimit), kGradLimit));
+        grad[k] = 0.f;
+      }
+      local.clamped += clamped;
+    } else {
+      std::fill(grad + layers, grad + hidden_end, 0.f);
+    }
+    // The listed hash-grid and output-layer entries (each then cleared: a
+    // repeated entry adds nothing more).
+    for (uint32_t k : local.touched) {
+      const float gk = grad[k];
+      grad[k] = 0.f;
+      if (!finite || gk == 0.f) continue;
       double g = static_cast<double>(gk) * kGradScale;
       if (!(std::fabs(g) <= kGradLimit)) {
         ++local.clamped;
         g = g > 0.0 ? kGradLimit : -kGradLimit;
       }
-      // Half away from zero, as llround (exact: |g| <= 2^44), without its call.
-      const int64_t q = static_cast<int64_t>(g + (g >= 0.0 ? 0.5 : -0.5));
-      if (local.sum[k] == 0 && q != 0 && (k < layers || k >= hidden_end)) local.dirty.push_back(static_cast<uint32_t>(k));
-      local.sum[k] += q;
-    };
-    for (size_t k = layers; k < hidden_end; ++k) take(k);
-    for (uint32_t k : local.touched) take(k);
+      const int64_t q = to_fixed(g);
+      if (sum[k] == 0 && q != 0) local.dirty.push_back(k);
+      sum[k] += q;
+    }
     if (count == 0) return;
     if (!finite) {
       ++local.nonfinite;

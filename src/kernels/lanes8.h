@@ -51,6 +51,13 @@ TESSERA_LANES_INLINE U8 lanes_make_u(const uint32_t (&x)[kLanes8]) {
 // a > b ? x : y, lane by lane (false for NaN).
 TESSERA_LANES_INLINE F8 lanes_select_gt(const F8& a, const F8& b, const F8& x, const F8& y) { return a > b ? x : y; }
 TESSERA_LANES_INLINE U8 lanes_select_le_u(const U8& a, const U8& b, const U8& x, const U8& y) { return a <= b ? x : y; }
+// Whether a > b in any lane (false for NaN): the lane masks ORed in four
+// 64-bit words, not eight lanes taken out one by one.
+TESSERA_LANES_INLINE bool lanes_any_gt(const F8& a, const F8& b) {
+  typedef int64_t W4 __attribute__((vector_size(32)));
+  const W4 m = reinterpret_cast<W4>(a > b);
+  return ((m[0] | m[1]) | (m[2] | m[3])) != 0;
+}
 TESSERA_LANES_INLINE U8 lanes_min_u(const U8& a, const U8& b) { return a < b ? a : b; }
 // Truncation of non-negative floats below 2^31 to integers, and back.
 TESSERA_LANES_INLINE U8 lanes_trunc_u(const F8& x) { return reinterpret_cast<U8>(__builtin_convertvector(x, I8)); }
@@ -140,6 +147,11 @@ TESSERA_HOST_DEVICE inline U8 lanes_select_le_u(const U8& a, const U8& b, const 
   U8 r;
   for (uint32_t k = 0; k < kLanes8; ++k) r.v[k] = a.v[k] <= b.v[k] ? x.v[k] : y.v[k];
   return r;
+}
+TESSERA_HOST_DEVICE inline bool lanes_any_gt(const F8& a, const F8& b) {
+  bool any = false;
+  for (uint32_t k = 0; k < kLanes8; ++k) any = any || a.v[k] > b.v[k];
+  return any;
 }
 TESSERA_HOST_DEVICE inline U8 lanes_min_u(const U8& a, const U8& b) {
   U8 r;

@@ -139,7 +139,11 @@ struct NeuralGuideView {
 // The network's answer at one vertex.
 struct NeuralSite {
   Vec3 p{0.f}, n{0.f, 0.f, 1.f};
-  Float q[kNeuralMaxOutputs];  // incident radiance per bin, then each learned light's contribution
+  // Incident radiance per bin, then each learned light's contribution. Not
+  // set in the blocks of kLanes8 bins that lie wholly below the surface
+  // (bit b of `skipped`: bins 8b..8b+7): read Q through neural_site_q.
+  Float q[kNeuralMaxOutputs];
+  uint32_t skipped = 0;
   Float pmf[kNeuralBins];    // guided distribution per bin (floor included)
   // Inclusive running sum of the rows' pmf (kNeuralGrid bins each), the
   // last 1: built by the first sample (neural_build_cdf).
@@ -354,8 +358,14 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   site->has_cdf = false;
   // The output layer, exp, Q x max(cos, 0), its sum and the largest Q above
   // the surface in one pass over blocks of 8 bins, each block in registers
-  // (lanes8.h; each bin's sums in a fixed order).
+  // (lanes8.h; each bin's sums in a fixed order). A block whose bins all lie
+  // below the surface adds exactly 0 to the sums and the maximum, and gives
+  // each of its bins the floor's share: it is skipped (its Q is computed when
+  // read, neural_site_q). On a floor or ceiling of a y-up scene half the
+  // blocks are skipped, on walls facing z two or three of 18, facing x none.
   static_assert(kNeuralBins % kLanes8 == 0, "bins in whole lanes");
+  static_assert(kNeuralBins / kLanes8 <= 32, "a bit per block");
+  constexpr uint32_t kBlocks = kNeuralBins / kLanes8;
   const uint32_t outs = L.outputs(), width = v.width;
   const float* w3 = v.params + L.w3();
   const float* b3 = v.params + L.b3();
@@ -366,31 +376,55 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   const Float* dz = dy + kNeuralBins;
   const Float nx = n.x, ny = n.y, nz = n.z;
   const F8 scale = lanes_splat(v.scale), zero = lanes_splat(0.f);
+  // max(cos, 0) per bin into pmf (the weights overwrite it), and the blocks to compute.
+  uint32_t active[kBlocks], count = 0, skipped = 0;
+  for (uint32_t b = 0; b < kBlocks; ++b) {
+    const uint32_t j = b * kLanes8;
+    const F8 c = lanes_load(dx + j) * nx + lanes_load(dy + j) * ny + lanes_load(dz + j) * nz;
+    const F8 cosine = lanes_select_gt(c, zero, c, zero);
+    lanes_store(pmf + j, cosine);
+    const bool above = lanes_any_gt(cosine, zero);
+    active[count] = b;
+    count += above ? 1u : 0u;
+    skipped |= above ? 0u : 1u << b;
+  }
+  site->skipped = skipped;
   F8 lane_sum = zero, lane_max = zero;
+  auto finish = [&](uint32_t j, F8 acc) {
+    const F8 qj = scale * neural_exp8(acc);
+    const F8 cosine = lanes_load(pmf + j);
+    const F8 above = lanes_select_gt(cosine, zero, qj, zero);  // Q of the bins above the surface, 0 below
+    const F8 weighted = qj * cosine;
+    lanes_store(q + j, qj);
+    lanes_store(pmf + j, weighted);
+    lane_sum += weighted;
+    lane_max = lanes_select_gt(lane_max, above, lane_max, above);
+  };
   // Six blocks at a time: their sums are independent chains of additions
-  // (one block's chain alone waits on each addition's latency).
+  // (one block's chain alone waits on each addition's latency); the rest
+  // one by one. Blocks in increasing order: the sums' order is the bins'.
   constexpr uint32_t kGroup = 6;
-  static_assert(kNeuralBins % (kGroup * kLanes8) == 0, "bins in whole groups");
-  for (uint32_t j0 = 0; j0 < kNeuralBins; j0 += kGroup * kLanes8) {
+  uint32_t a = 0;
+  for (; a + kGroup <= count; a += kGroup) {
     F8 acc[kGroup];
-    for (uint32_t g = 0; g < kGroup; ++g) acc[g] = lanes_load(b3 + j0 + g * kLanes8);
-    const float* col = w3 + j0;
+    uint32_t j[kGroup];
+    for (uint32_t g = 0; g < kGroup; ++g) {
+      j[g] = active[a + g] * kLanes8;
+      acc[g] = lanes_load(b3 + j[g]);
+    }
+    const float* col = w3;
     for (uint32_t i = 0; i < width; ++i, col += outs) {
       const F8 x = lanes_splat(h2[i]);
-      for (uint32_t g = 0; g < kGroup; ++g) acc[g] += lanes_load(col + g * kLanes8) * x;
+      for (uint32_t g = 0; g < kGroup; ++g) acc[g] += lanes_load(col + j[g]) * x;
     }
-    for (uint32_t g = 0; g < kGroup; ++g) {
-      const uint32_t j = j0 + g * kLanes8;
-      const F8 qj = scale * neural_exp8(acc[g]);
-      const F8 c = lanes_load(dx + j) * nx + lanes_load(dy + j) * ny + lanes_load(dz + j) * nz;
-      const F8 cosine = lanes_select_gt(c, zero, c, zero);
-      const F8 above = lanes_select_gt(c, zero, qj, zero);  // Q of the bins above the surface, 0 below
-      const F8 weighted = qj * cosine;
-      lanes_store(q + j, qj);
-      lanes_store(pmf + j, weighted);
-      lane_sum += weighted;
-      lane_max = lanes_select_gt(lane_max, above, lane_max, above);
-    }
+    for (uint32_t g = 0; g < kGroup; ++g) finish(j[g], acc[g]);
+  }
+  for (; a < count; ++a) {
+    const uint32_t j = active[a] * kLanes8;
+    F8 acc = lanes_load(b3 + j);
+    const float* col = w3 + j;
+    for (uint32_t i = 0; i < width; ++i, col += outs) acc += lanes_load(col) * lanes_splat(h2[i]);
+    finish(j, acc);
   }
   // The light outputs (raw: neural_light_distribution takes their exp).
   for (uint32_t o = kNeuralBins; o < outs; ++o) {
@@ -430,6 +464,53 @@ TESSERA_HOST_DEVICE inline void neural_build_cdf(NeuralSite* site) {
   site->has_cdf = true;
 }
 
+// One value of the network at a point, computed alone: the irradiance
+// (y_bin == kNeuralIrradiance) or one bin's Q (y_bin < kNeuralBins; 0 for
+// anything else), the same bits as neural_infer's site->irradiance and
+// site->q[y_bin]. A bin's Q needs one output, not 144, and the irradiance
+// the blocks above the surface only, without the site's distributions: the
+// bootstrapped parts of training targets are refreshed with it.
+TESSERA_HOST_DEVICE inline Float neural_value(const NeuralGuideView& v, const Vec3& p, const Vec3& n, uint32_t y_bin) {
+  if (y_bin != kNeuralIrradiance && y_bin >= kNeuralBins) return 0.f;
+  const NeuralLayout L{v.width, v.table_log2, v.lights};
+  Float in[kNeuralInputs], h1[kNeuralMaxWidth], h2[kNeuralMaxWidth];
+  neural_encode(v, p, n, in);
+  neural_hidden_layer(v.params + L.w1(), v.params + L.b1(), in, kNeuralInputs, v.width, h1);
+  neural_hidden_layer(v.params + L.w2(), v.params + L.b2(), h1, v.width, v.width, h2);
+  const uint32_t outs = L.outputs(), width = v.width;
+  const float* w3 = v.params + L.w3();
+  const float* b3 = v.params + L.b3();
+  if (y_bin != kNeuralIrradiance) {
+    Float acc = b3[y_bin];
+    for (uint32_t i = 0; i < width; ++i) acc += w3[static_cast<size_t>(i) * outs + y_bin] * h2[i];
+    return v.scale * neural_exp(acc);
+  }
+  const Float* dx = v.bin_dir_soa;
+  const Float* dy = dx + kNeuralBins;
+  const Float* dz = dy + kNeuralBins;
+  const F8 scale = lanes_splat(v.scale), zero = lanes_splat(0.f);
+  F8 lane_sum = zero;
+  for (uint32_t j = 0; j < kNeuralBins; j += kLanes8) {
+    const F8 c = lanes_load(dx + j) * n.x + lanes_load(dy + j) * n.y + lanes_load(dz + j) * n.z;
+    const F8 cosine = lanes_select_gt(c, zero, c, zero);
+    if (!lanes_any_gt(cosine, zero)) continue;  // adds exactly 0 in neural_infer
+    F8 acc = lanes_load(b3 + j);
+    const float* col = w3 + j;
+    for (uint32_t i = 0; i < width; ++i, col += outs) acc += lanes_load(col) * lanes_splat(h2[i]);
+    lane_sum += (scale * neural_exp8(acc)) * cosine;
+  }
+  Float total = 0.f;
+  for (uint32_t k = 0; k < kLanes8; ++k) total += lane_sum[k];
+  return total * (4.f * kPi / static_cast<Float>(kNeuralBins));
+}
+
+// Output j at the site as neural_infer gives it (a bin's Q, or a learned
+// light's contribution): computed again where neural_infer skipped its block.
+TESSERA_HOST_DEVICE inline Float neural_site_q(const NeuralGuideView& v, const NeuralSite& site, uint32_t j) {
+  if (j >= kNeuralBins || !((site.skipped >> (j / kLanes8)) & 1u)) return site.q[j];
+  return neural_value(v, site.p, site.n, j);  // rare: a bin below the surface was read
+}
+
 #if !TESSERA_IS_GPU_CODE
 // neural_infer for the CPU, compiled for AVX2 where the processor has it
 // (guidecache/neural_infer_cpu.cpp; bit-identical either way).
@@ -438,6 +519,8 @@ void neural_infer_cpu(const NeuralGuideView& v, const Vec3& p, const Vec3& n, Ne
 void neural_infer_avx2(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site);
 void neural_infer_portable(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site);
 bool neural_infer_has_avx2();
+// neural_value, compiled the same two ways.
+Float neural_value_cpu(const NeuralGuideView& v, const Vec3& p, const Vec3& n, uint32_t y_bin);
 #endif
 
 TESSERA_HOST_DEVICE inline uint32_t neural_bin_of(const Vec3& dir) {
@@ -484,11 +567,6 @@ struct NeuralBootstrap {
   Float coef = 0.f;
   Float value = 0.f;
 };
-
-// The value a bootstrap reads at a site.
-TESSERA_HOST_DEVICE inline Float neural_bootstrap_value(const NeuralSite& y, uint32_t y_bin) {
-  return y_bin == kNeuralIrradiance ? y.irradiance : y_bin < kNeuralBins ? y.q[y_bin] : 0.f;
-}
 
 // A path starts: its targets are numbered from 0, and the keep hash
 // follows its pixel (index in the image) and sample index, not the order

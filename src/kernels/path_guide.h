@@ -146,9 +146,9 @@ struct NeuralPathGuide {
   }
   TESSERA_HOST_DEVICE uint32_t bin_of(const Vec3& dir) const { return neural_bin_of(dir); }
   TESSERA_HOST_DEVICE Float bin_pdf(int32_t s, uint32_t bin) const { return neural_bin_pdf(site[s], bin); }
-  TESSERA_HOST_DEVICE Float value(int32_t s, uint32_t bin) const { return site[s].q[bin]; }
+  TESSERA_HOST_DEVICE Float value(int32_t s, uint32_t bin) const { return neural_site_q(v, site[s], bin); }
   TESSERA_HOST_DEVICE Float survival(int32_t s, uint32_t bin, Float throughput, Float path_expected, Float window) const {
-    return glm::min(window * throughput * site[s].q[bin] / path_expected, 1.f);
+    return glm::min(window * throughput * neural_site_q(v, site[s], bin) / path_expected, 1.f);
   }
   // Expected SARSA's integral of Q f |cos| over y's bins (guide_bins_integral).
   // It is coef x one value of y's, which *boot records.
@@ -170,7 +170,7 @@ struct NeuralPathGuide {
     const Float pmf = y.pmf[j];
     *boot = GuideBootstrap{
         s, j, luminance(bsdf_eval(b, wo_local, wi)) * fabsf(wi.z) * (4.f * kPi / static_cast<Float>(kNeuralBins)) / pmf,
-        y.q[j]};
+        neural_site_q(v, y, j)};
     return boot->value * boot->coef;
   }
   TESSERA_HOST_DEVICE bool record(int32_t s, uint32_t bin, Float target, const GuideBootstrap& boot) const {

@@ -168,7 +168,7 @@ TESSERA_HOST_DEVICE void run_neural_case(const NeuralGuideView& v, const Vec3& p
   NeuralSite site;
   neural_infer(v, p, n, &site);
   uint32_t k = 0;
-  for (uint32_t j = 0; j < kNeuralBins + kNeuralCheckLights; ++j) out[k++] = site.q[j];
+  for (uint32_t j = 0; j < kNeuralBins + kNeuralCheckLights; ++j) out[k++] = neural_site_q(v, site, j);
   for (uint32_t j = 0; j < kNeuralBins; ++j) out[k++] = site.pmf[j];
   out[k++] = site.irradiance;
   out[k++] = site.qmax;

@@ -57,7 +57,7 @@ double predicted(const NeuralGuide& g, const NeuralTrainingSample& s) {
   const NeuralGuideView v = g.view();
   NeuralSite site;
   neural_infer(v, Vec3(s.p[0], s.p[1], s.p[2]), Vec3(s.n[0], s.n[1], s.n[2]), &site);
-  return site.q[s.bin];
+  return neural_site_q(v, site, s.bin);
 }
 
 // The loss with its denominators frozen at q0 (what the gradient is of:
@@ -144,12 +144,12 @@ TEST(NeuralGuide, LearnsASingleBrightDirection) {
     NeuralSite site;
     neural_infer(v, Vec3(u(rng), u(rng), u(rng)), Vec3(0.f, 0.f, 1.f), &site);
     double dark = 0.0;
-    for (uint32_t j = 0; j < kNeuralBins; ++j) dark += j != kBright ? site.q[j] : 0.f;
+    for (uint32_t j = 0; j < kNeuralBins; ++j) dark += j != kBright ? neural_site_q(v, site, j) : 0.f;
     EXPECT_NEAR(dark / (kNeuralBins - 1), 0.01, 0.005);
-    EXPECT_NEAR(site.q[kBright], 1.0, 0.1);
+    EXPECT_NEAR(neural_site_q(v, site, kBright), 1.0, 0.1);
     for (uint32_t j = 0; j < kNeuralBins; j += 13) {
       if (j != kBright) {
-        EXPECT_LT(site.q[j], 0.05) << "bin " << j;
+        EXPECT_LT(neural_site_q(v, site, j), 0.05) << "bin " << j;
       }
     }
     EXPECT_GT(site.pmf[kBright], 0.5f);
@@ -421,7 +421,11 @@ TEST(NeuralGuide, AvxAndPortableInferenceAgreeBitForBit) {
     NeuralSite a, b;
     neural_infer_avx2(v, p, n, &a);
     neural_infer_portable(v, p, n, &b);
-    ASSERT_EQ(std::memcmp(a.q, b.q, sizeof(Float) * (kNeuralBins + 4)), 0) << i;
+    ASSERT_EQ(a.skipped, b.skipped) << i;
+    for (uint32_t j = 0; j < kNeuralBins + 4; ++j) {
+      const Float qa = neural_site_q(v, a, j), qb = neural_site_q(v, b, j);
+      ASSERT_EQ(std::memcmp(&qa, &qb, sizeof qa), 0) << i << " output " << j;
+    }
     ASSERT_EQ(std::memcmp(a.pmf, b.pmf, sizeof a.pmf), 0) << i;
     ASSERT_EQ(a.light_prob, b.light_prob);
     ASSERT_GT(a.light_prob, 0.f);
@@ -437,6 +441,7 @@ TEST(NeuralGuide, AvxAndPortableInferenceAgreeBitForBit) {
 // neural_exp, and the distribution built from them. Widths that fill whole
 // lanes and widths that leave a tail.
 TEST(NeuralGuide, LaneInferenceEqualsThePlainDefinition) {
+  int skipped_blocks = 0, cases = 0;
   for (uint32_t width : {5u, 8u, 13u, 16u}) {
     NeuralGuide g = make(small_config(width), 3);
     std::vector<NeuralTrainingSample> samples = random_samples(200, 7, 1.f);
@@ -482,17 +487,27 @@ TEST(NeuralGuide, LaneInferenceEqualsThePlainDefinition) {
       neural_infer_cpu(v, p, n, &site);
       for (uint32_t j = 0; j < L.outputs(); ++j) {
         const float expected = v.scale * neural_exp(o[j]);
-        ASSERT_EQ(std::memcmp(&site.q[j], &expected, sizeof expected), 0) << "width " << width << " output " << j;
+        const float got = neural_site_q(v, site, j);
+        ASSERT_EQ(std::memcmp(&got, &expected, sizeof expected), 0) << "width " << width << " output " << j;
+        if (j < kNeuralBins) {
+          const float alone = neural_value(v, p, n, j);  // the value computed alone, as training refreshes it
+          ASSERT_EQ(std::memcmp(&alone, &expected, sizeof expected), 0) << "width " << width << " output " << j;
+        }
       }
       // The distribution: Q max(cos, 0) summed in eight lanes (bin j in
       // lane j mod 8), the largest Q above the surface, the floor mixed in.
       float lane_sum[8] = {}, lane_max[8] = {}, weighted[kNeuralBins];
+      int below[kNeuralBins / 8] = {};
       for (uint32_t j = 0; j < kNeuralBins; ++j) {
         const float c = v.bin_dir_soa[j] * n.x + v.bin_dir_soa[kNeuralBins + j] * n.y +
                         v.bin_dir_soa[2 * kNeuralBins + j] * n.z;
-        weighted[j] = site.q[j] * (c > 0.f ? c : 0.f);
+        const float qj = v.scale * neural_exp(o[j]);
+        weighted[j] = qj * (c > 0.f ? c : 0.f);
         lane_sum[j % 8] += weighted[j];
-        lane_max[j % 8] = std::max(lane_max[j % 8], c > 0.f ? site.q[j] : 0.f);
+        lane_max[j % 8] = std::max(lane_max[j % 8], c > 0.f ? qj : 0.f);
+        // A block is skipped exactly where all its bins lie below the surface.
+        if (c > 0.f) EXPECT_FALSE((site.skipped >> (j / 8)) & 1u) << j;
+        below[j / 8] += c > 0.f ? 0 : 1;
       }
       float total = 0.f, qmax = 0.f;
       for (int k = 0; k < 8; ++k) {
@@ -500,11 +515,20 @@ TEST(NeuralGuide, LaneInferenceEqualsThePlainDefinition) {
         qmax = std::max(qmax, lane_max[k]);
       }
       ASSERT_EQ(site.irradiance, total * (4.f * kPi / static_cast<float>(kNeuralBins)));
+      ASSERT_EQ(neural_value(v, p, n, kNeuralIrradiance), site.irradiance);
+      ++cases;
+      for (uint32_t b = 0; b < kNeuralBins / 8; ++b) {
+        ASSERT_EQ((site.skipped >> b) & 1u, below[b] == 8 ? 1u : 0u) << "block " << b;
+        skipped_blocks += below[b] == 8 ? 1 : 0;
+      }
       ASSERT_EQ(site.qmax, qmax);
       const float uniform = v.floor / static_cast<float>(kNeuralBins), w = (1.f - v.floor) / total;
       for (uint32_t j = 0; j < kNeuralBins; ++j) ASSERT_EQ(site.pmf[j], weighted[j] * w + uniform) << j;
     }
   }
+  // Random normals leave some blocks wholly below the surface: the skipping was exercised.
+  EXPECT_GT(skipped_blocks, cases / 4);
+  EXPECT_LT(skipped_blocks, cases * static_cast<int>(kNeuralBins / 8) / 2);
 }
 
 // The levels' corners computed side by side are each level's corners,
