@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 
 #include "guidecache/guide_field.h"
@@ -310,7 +311,7 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
     int64_t* sum = local.sum.data();
     bool finite = std::isfinite(loss);
     uint32_t bad = 0;
-    for (size_t k = layers; k < hidden_end; ++k) bad += !(std::fabs(grad[k]) <= 3.4e38f);
+    for (size_t k = layers; k < hidden_end; ++k) bad += !(std::fabs(grad[k]) <= std::numeric_limits<float>::max());
     finite = finite && bad == 0;
     for (size_t t = 0; finite && t < local.touched.size(); ++t) finite = std::isfinite(grad[local.touched[t]]);
     // The hidden layers' dense block: a loop without branches, on vector lanes.

@@ -47,7 +47,9 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, PathGuide& g, cons
     Float best = 0.f;
     uint32_t best_bin = 0;
     for (uint32_t j = 0; j < g.bins(); ++j) {
-      Float v = g.value(cell, j) * glm::max(0.f, glm::dot(g.bin_dir(j), n_side));
+      const Float c = glm::dot(g.bin_dir(j), n_side);
+      if (!(c > 0.f)) continue;  // adds nothing (and a network's Q below the surface need not be computed)
+      const Float v = g.value(cell, j) * c;
       if (v > best) {
         best = v;
         best_bin = j;

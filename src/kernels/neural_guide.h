@@ -144,6 +144,7 @@ struct NeuralSite {
   // (bit b of `skipped`: bins 8b..8b+7): read Q through neural_site_q.
   Float q[kNeuralMaxOutputs];
   uint32_t skipped = 0;
+  Float h2[kNeuralMaxWidth];  // the last hidden layer: a skipped bin's Q is one output from it
   Float pmf[kNeuralBins];    // guided distribution per bin (floor included)
   // Inclusive running sum of the rows' pmf (kNeuralGrid bins each), the
   // last 1: built by the first sample (neural_build_cdf).
@@ -349,7 +350,8 @@ TESSERA_HOST_DEVICE inline uint32_t neural_sample_light(const NeuralGuideView& v
 // side is n) and builds the site's distributions.
 TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site) {
   const NeuralLayout L{v.width, v.table_log2, v.lights};
-  Float in[kNeuralInputs], h1[kNeuralMaxWidth], h2[kNeuralMaxWidth];
+  Float in[kNeuralInputs], h1[kNeuralMaxWidth];
+  Float* h2 = site->h2;
   neural_encode(v, p, n, in);
   neural_hidden_layer(v.params + L.w1(), v.params + L.b1(), in, kNeuralInputs, v.width, h1);
   neural_hidden_layer(v.params + L.w2(), v.params + L.b2(), h1, v.width, v.width, h2);
@@ -360,8 +362,8 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   // the surface in one pass over blocks of 8 bins, each block in registers
   // (lanes8.h; each bin's sums in a fixed order). A block whose bins all lie
   // below the surface adds exactly 0 to the sums and the maximum, and gives
-  // each of its bins the floor's share: it is skipped (its Q is computed when
-  // read, neural_site_q). On a floor or ceiling of a y-up scene half the
+  // each of its bins the floor's share: it is skipped (a bin's Q is computed
+  // from h2 when read, neural_site_q: a bin the floor or a transmission drew). On a floor or ceiling of a y-up scene half the
   // blocks are skipped, on walls facing z two or three of 18, facing x none.
   static_assert(kNeuralBins % kLanes8 == 0, "bins in whole lanes");
   static_assert(kNeuralBins / kLanes8 <= 32, "a bit per block");
@@ -505,10 +507,17 @@ TESSERA_HOST_DEVICE inline Float neural_value(const NeuralGuideView& v, const Ve
 }
 
 // Output j at the site as neural_infer gives it (a bin's Q, or a learned
-// light's contribution): computed again where neural_infer skipped its block.
+// light's contribution). Where neural_infer skipped the bin's block it is
+// one output from the site's last hidden layer: the same operations in the
+// same order as in the block, the same bits.
 TESSERA_HOST_DEVICE inline Float neural_site_q(const NeuralGuideView& v, const NeuralSite& site, uint32_t j) {
   if (j >= kNeuralBins || !((site.skipped >> (j / kLanes8)) & 1u)) return site.q[j];
-  return neural_value(v, site.p, site.n, j);  // rare: a bin below the surface was read
+  const NeuralLayout L{v.width, v.table_log2, v.lights};
+  const uint32_t outs = L.outputs();
+  const float* w3 = v.params + L.w3();
+  Float acc = v.params[L.b3() + j];
+  for (uint32_t i = 0; i < v.width; ++i) acc += w3[static_cast<size_t>(i) * outs + j] * site.h2[i];
+  return v.scale * neural_exp(acc);
 }
 
 #if !TESSERA_IS_GPU_CODE

@@ -168,9 +168,10 @@ struct NeuralPathGuide {
     if (!neural_sample(y, u, Vec2(0.5f), &dir, &pdf, &j)) return 0.f;
     const Vec3 wi = to_local(v.bin_dirs[j]);
     const Float pmf = y.pmf[j];
-    *boot = GuideBootstrap{
-        s, j, luminance(bsdf_eval(b, wo_local, wi)) * fabsf(wi.z) * (4.f * kPi / static_cast<Float>(kNeuralBins)) / pmf,
-        neural_site_q(v, y, j)};
+    const Float coef =
+        luminance(bsdf_eval(b, wo_local, wi)) * fabsf(wi.z) * (4.f * kPi / static_cast<Float>(kNeuralBins)) / pmf;
+    // Q is read only where it counts (a bin the BSDF does not reach need not be computed).
+    *boot = GuideBootstrap{s, j, coef, coef > 0.f ? neural_site_q(v, y, j) : 0.f};
     return boot->value * boot->coef;
   }
   TESSERA_HOST_DEVICE bool record(int32_t s, uint32_t bin, Float target, const GuideBootstrap& boot) const {

@@ -393,8 +393,8 @@ TEST(NeuralGuide, NonFiniteAndHugeTargetsAreRejectedAndCounted) {
   g.train_on({{0, wild}});
   EXPECT_EQ(g.stats().steps, 8u);
   for (float p : g.params()) ASSERT_TRUE(std::isfinite(p));
-  // A NaN that got past the sink (a NaN weight would do the same) poisons
-  // its tile's gradient in one round: that tile is left out of that step
+  // A NaN that got past the sink (or a NaN weight of the first two
+  // layers; a NaN bias is zeroed by the ReLU) poisons its tile's gradient in one round: that tile is left out of that step
   // (counted), the other tile still trains.
   std::vector<NeuralTrainingSample> poisoned = random_samples(64, 10, 1.f);
   poisoned[5].target = std::nanf("");
