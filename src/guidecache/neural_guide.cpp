@@ -55,6 +55,25 @@ inline int64_t to_fixed(double x) {
   return bits - 0x4338000000000000ll;
 }
 
+// Back through one hidden layer (weights input-major, w[i * outs + o]) for
+// one target: adds d_out x in to the weight gradient and d_out to the bias
+// gradient, and gives the gradient at its first d_ins inputs (W^T d_out),
+// zero where a ReLU input was not positive (relu) or as it is.
+void dense_backward(const float* w, const float* in, uint32_t ins, uint32_t outs, const float* d_out, float* gw,
+                    float* gb, uint32_t d_ins, bool relu, float* d_in) {
+  for (uint32_t i = 0; i < ins; ++i) {
+    float* row = gw + static_cast<size_t>(i) * outs;
+    for (uint32_t o = 0; o < outs; ++o) row[o] += d_out[o] * in[i];
+  }
+  for (uint32_t o = 0; o < outs; ++o) gb[o] += d_out[o];
+  for (uint32_t i = 0; i < d_ins; ++i) {
+    const float* col = w + static_cast<size_t>(i) * outs;
+    float acc = 0.f;
+    for (uint32_t o = 0; o < outs; ++o) acc += col[o] * d_out[o];
+    d_in[i] = !relu || in[i] > 0.f ? acc : 0.f;
+  }
+}
+
 }  // namespace
 
 // A training thread's sums: the fixed-point gradient (P words; zero outside
@@ -212,28 +231,8 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
       dh2[i] = h2[i] > 0.f ? w3[static_cast<size_t>(i) * O + bin] * go : 0.f;
     }
     gb3[bin] += go;
-    for (uint32_t i = 0; i < W; ++i) {
-      float* row = gw2 + static_cast<size_t>(i) * W;
-      for (uint32_t o2 = 0; o2 < W; ++o2) row[o2] += dh2[o2] * h1[i];
-    }
-    for (uint32_t o2 = 0; o2 < W; ++o2) gb2[o2] += dh2[o2];
-    for (uint32_t i = 0; i < W; ++i) {
-      const float* col = w2 + static_cast<size_t>(i) * W;
-      float acc = 0.f;
-      for (uint32_t o2 = 0; o2 < W; ++o2) acc += col[o2] * dh2[o2];
-      dh1[i] = h1[i] > 0.f ? acc : 0.f;
-    }
-    for (uint32_t i = 0; i < kNeuralInputs; ++i) {
-      float* row = gw1 + static_cast<size_t>(i) * W;
-      for (uint32_t o1 = 0; o1 < W; ++o1) row[o1] += dh1[o1] * x[i];
-    }
-    for (uint32_t o1 = 0; o1 < W; ++o1) gb1[o1] += dh1[o1];
-    for (uint32_t j = 0; j < kNeuralEncoded; ++j) {
-      const float* col = w1 + static_cast<size_t>(j) * W;
-      float acc = 0.f;
-      for (uint32_t o1 = 0; o1 < W; ++o1) acc += col[o1] * dh1[o1];
-      dx[j] = acc;
-    }
+    dense_backward(w2, h1, W, W, dh2, gw2, gb2, W, true, dh1);
+    dense_backward(w1, x, kNeuralInputs, W, dh1, gw1, gb1, kNeuralEncoded, false, dx);  // to the encoding only
     // The encoding's gradient, scattered to the corners of each level.
     U8 entry[8];
     F8 weight[8];
