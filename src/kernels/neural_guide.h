@@ -362,9 +362,10 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   // the surface in one pass over blocks of 8 bins, each block in registers
   // (lanes8.h; each bin's sums in a fixed order). A block whose bins all lie
   // below the surface adds exactly 0 to the sums and the maximum, and gives
-  // each of its bins the floor's share: it is skipped (a bin's Q is computed
-  // from h2 when read, neural_site_q: a bin the floor or a transmission drew). On a floor or ceiling of a y-up scene half the
-  // blocks are skipped, on walls facing z two or three of 18, facing x none.
+  // each of its bins the floor's share: it is skipped (a bin's Q there is
+  // computed from h2 when read, neural_site_q: a bin the floor or a
+  // transmission drew). On a floor or ceiling of a y-up scene half the
+  // blocks are skipped, on walls facing z two to four of 18, facing x none.
   static_assert(kNeuralBins % kLanes8 == 0, "bins in whole lanes");
   static_assert(kNeuralBins / kLanes8 <= 32, "a bit per block");
   constexpr uint32_t kBlocks = kNeuralBins / kLanes8;
@@ -466,6 +467,17 @@ TESSERA_HOST_DEVICE inline void neural_build_cdf(NeuralSite* site) {
   site->has_cdf = true;
 }
 
+// Bin j's Q from the last hidden layer h2: one output, the operations of
+// neural_infer's block of 8 bins in the same order (the same bits).
+TESSERA_HOST_DEVICE inline Float neural_bin_q(const NeuralGuideView& v, const Float* h2, uint32_t j) {
+  const NeuralLayout L{v.width, v.table_log2, v.lights};
+  const uint32_t outs = L.outputs();
+  const float* w3 = v.params + L.w3();
+  Float acc = v.params[L.b3() + j];
+  for (uint32_t i = 0; i < v.width; ++i) acc += w3[static_cast<size_t>(i) * outs + j] * h2[i];
+  return v.scale * neural_exp(acc);
+}
+
 // One value of the network at a point, computed alone: the irradiance
 // (y_bin == kNeuralIrradiance) or one bin's Q (y_bin < kNeuralBins; 0 for
 // anything else), the same bits as neural_infer's site->irradiance and
@@ -482,11 +494,7 @@ TESSERA_HOST_DEVICE inline Float neural_value(const NeuralGuideView& v, const Ve
   const uint32_t outs = L.outputs(), width = v.width;
   const float* w3 = v.params + L.w3();
   const float* b3 = v.params + L.b3();
-  if (y_bin != kNeuralIrradiance) {
-    Float acc = b3[y_bin];
-    for (uint32_t i = 0; i < width; ++i) acc += w3[static_cast<size_t>(i) * outs + y_bin] * h2[i];
-    return v.scale * neural_exp(acc);
-  }
+  if (y_bin != kNeuralIrradiance) return neural_bin_q(v, h2, y_bin);
   const Float* dx = v.bin_dir_soa;
   const Float* dy = dx + kNeuralBins;
   const Float* dz = dy + kNeuralBins;
@@ -507,17 +515,11 @@ TESSERA_HOST_DEVICE inline Float neural_value(const NeuralGuideView& v, const Ve
 }
 
 // Output j at the site as neural_infer gives it (a bin's Q, or a learned
-// light's contribution). Where neural_infer skipped the bin's block it is
-// one output from the site's last hidden layer: the same operations in the
-// same order as in the block, the same bits.
+// light's contribution); where neural_infer skipped the bin's block, from
+// the last hidden layer the site keeps.
 TESSERA_HOST_DEVICE inline Float neural_site_q(const NeuralGuideView& v, const NeuralSite& site, uint32_t j) {
   if (j >= kNeuralBins || !((site.skipped >> (j / kLanes8)) & 1u)) return site.q[j];
-  const NeuralLayout L{v.width, v.table_log2, v.lights};
-  const uint32_t outs = L.outputs();
-  const float* w3 = v.params + L.w3();
-  Float acc = v.params[L.b3() + j];
-  for (uint32_t i = 0; i < v.width; ++i) acc += w3[static_cast<size_t>(i) * outs + j] * site.h2[i];
-  return v.scale * neural_exp(acc);
+  return neural_bin_q(v, site.h2, j);
 }
 
 #if !TESSERA_IS_GPU_CODE
