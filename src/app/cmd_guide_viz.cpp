@@ -44,8 +44,9 @@ std::vector<Float> guide_values_at(Guide& guide, const Vec3& p, const Vec3& n, s
   const int32_t s = pg.locate(p, n);
   *grid = kNeuralGrid;
   *where = "network";
-  std::vector<Float> q(kNeuralBins);
-  for (uint32_t j = 0; j < kNeuralBins; ++j) q[j] = neural_site_q(view, pg.site[s], j);
+  std::vector<Float> q(kNeuralBins);  // row-major, as the table's (the network numbers its bins by tiles)
+  for (uint32_t r = 0; r < kNeuralGrid; ++r)
+    for (uint32_t c = 0; c < kNeuralGrid; ++c) q[r * kNeuralGrid + c] = neural_site_q(view, pg.site[s], neural_bin_at(r, c));
   return q;
 }
 

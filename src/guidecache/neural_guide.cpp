@@ -132,8 +132,8 @@ void NeuralGuide::init_params() {
 void NeuralGuide::build_bin_dirs() {
   bin_dirs_.resize(kNeuralBins);
   for (uint32_t b = 0; b < kNeuralBins; ++b) {
-    const Vec2 sq((static_cast<Float>(b % kNeuralGrid) + 0.5f) / kNeuralGrid,
-                  (static_cast<Float>(b / kNeuralGrid) + 0.5f) / kNeuralGrid);
+    const Vec2 sq((static_cast<Float>(neural_bin_col(b)) + 0.5f) / kNeuralGrid,
+                  (static_cast<Float>(neural_bin_row(b)) + 0.5f) / kNeuralGrid);  // the network's numbering
     bin_dirs_[b] = glm::normalize(equal_area_square_to_sphere(sq));
   }
   bin_dir_soa_.resize(3 * kNeuralBins);

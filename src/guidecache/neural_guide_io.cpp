@@ -30,7 +30,10 @@ void NeuralGuide::serialize(Archive& ar) {
 namespace {
 constexpr char kNeuralMagic[] = "tessera-neural-guide";
 constexpr char kTableMagic[] = "tessera-guide-cache";
-constexpr uint32_t kNeuralVersion = 3;  // 2: the hash table's size is a setting; 3: learned light selection
+// 2: the hash table's size is a setting; 3: learned light selection; 4: bins
+// numbered by tiles (version 3's, numbered row-major, are read and renumbered).
+constexpr uint32_t kNeuralVersion = 4;
+constexpr uint32_t kNeuralRowMajorVersion = 3;
 }  // namespace
 
 void NeuralGuide::save(std::ostream& out, uint64_t scene_fingerprint) const {
@@ -46,12 +49,12 @@ std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_
   char magic[sizeof kNeuralMagic] = {};
   if (!in.read(magic, sizeof magic) || std::memcmp(magic, kNeuralMagic, sizeof kNeuralMagic) != 0)
     throw std::runtime_error("not a Tessera neural guide");
+  uint32_t version = 0;
   try {
     cereal::PortableBinaryInputArchive ar(in);
-    uint32_t version = 0;
     uint64_t fingerprint = 0;
     ar(version, fingerprint);
-    if (version != kNeuralVersion)
+    if (version != kNeuralVersion && version != kNeuralRowMajorVersion)
       throw std::runtime_error("neural guide version " + std::to_string(version) + ", this build reads version " +
                                std::to_string(kNeuralVersion));
     if (fingerprint != scene_fingerprint) throw std::runtime_error("neural guide was learned on another scene");
@@ -81,6 +84,19 @@ std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_
   for (size_t i = 0; ok && i < L.size(); ++i)
     ok = std::isfinite(g->params_[i]) && std::isfinite(g->adam_m_[i]) && std::isfinite(g->adam_v_[i]) && g->adam_v_[i] >= 0.f;
   if (!ok) throw std::runtime_error("corrupt neural guide (inconsistent or non-finite fields)");
+  // A file that numbered the bins row-major: each bin's output (its weights,
+  // bias and both Adam moments) moves to the bin's number in tiles.
+  if (version == kNeuralRowMajorVersion) {
+    const uint32_t outs = L.outputs();
+    for (std::vector<float>* a : {&g->params_, &g->adam_m_, &g->adam_v_}) {
+      const std::vector<float> row_major = *a;
+      for (uint32_t j = 0; j < kNeuralBins; ++j) {
+        const uint32_t to = neural_bin_at(j / kNeuralGrid, j % kNeuralGrid);
+        for (uint32_t i = 0; i < c.width; ++i) (*a)[L.w3() + i * outs + to] = row_major[L.w3() + i * outs + j];
+        (*a)[L.b3() + to] = row_major[L.b3() + j];
+      }
+    }
+  }
   g->build_bin_dirs();
   return g;
 }

@@ -27,6 +27,29 @@ namespace tessera {
 
 constexpr uint32_t kNeuralGrid = 12;                       // bins per side, as the table's default
 constexpr uint32_t kNeuralBins = kNeuralGrid * kNeuralGrid;  // 144
+// The network numbers its bins tile by tile: the 12x12 equal-area square is
+// cut into 18 tiles of 2 rows x 4 columns, numbered row-major, each tile's
+// bins row-major. A tile is one block of kLanes8 outputs in an inference,
+// and it is compact on the sphere, so that more tiles than rows of 8 lie
+// wholly below a surface and are skipped (neural_infer): on axis-aligned
+// normals 4 to 9 of 18 instead of 0 to 9, and twice as many on average over
+// all normals. (The table numbers its bins row-major: guide_view.h.)
+constexpr uint32_t kNeuralTileRows = 2, kNeuralTileCols = 4;
+constexpr uint32_t kNeuralTile = kNeuralTileRows * kNeuralTileCols;       // bins per tile
+constexpr uint32_t kNeuralTiles = kNeuralBins / kNeuralTile;               // 18
+constexpr uint32_t kNeuralTilesPerRow = kNeuralGrid / kNeuralTileCols;     // 3
+static_assert(kNeuralGrid % kNeuralTileRows == 0 && kNeuralGrid % kNeuralTileCols == 0, "whole tiles");
+// The network's number of the bin in row `row`, column `col` of the square.
+TESSERA_HOST_DEVICE constexpr uint32_t neural_bin_at(uint32_t row, uint32_t col) {
+  return ((row / kNeuralTileRows) * kNeuralTilesPerRow + col / kNeuralTileCols) * kNeuralTile +
+         (row % kNeuralTileRows) * kNeuralTileCols + col % kNeuralTileCols;
+}
+TESSERA_HOST_DEVICE constexpr uint32_t neural_bin_row(uint32_t bin) {
+  return bin / kNeuralTile / kNeuralTilesPerRow * kNeuralTileRows + bin % kNeuralTile / kNeuralTileCols;
+}
+TESSERA_HOST_DEVICE constexpr uint32_t neural_bin_col(uint32_t bin) {
+  return bin / kNeuralTile % kNeuralTilesPerRow * kNeuralTileCols + bin % kNeuralTileCols;
+}
 constexpr uint32_t kNeuralLevels = 8;                      // hash-grid levels
 constexpr uint32_t kNeuralFeatures = 2;                    // features per level
 // Entries per level: 2^table_log2 (NeuralGuideConfig::table_log2), within
@@ -140,15 +163,15 @@ struct NeuralGuideView {
 struct NeuralSite {
   Vec3 p{0.f}, n{0.f, 0.f, 1.f};
   // Incident radiance per bin, then each learned light's contribution. Not
-  // set in the blocks of kLanes8 bins that lie wholly below the surface
-  // (bit b of `skipped`: bins 8b..8b+7): read Q through neural_site_q.
+  // set in the tiles of bins that lie wholly below the surface (bit t of
+  // `skipped`: bins 8t..8t+7): read Q through neural_site_q.
   Float q[kNeuralMaxOutputs];
   uint32_t skipped = 0;
   Float h2[kNeuralMaxWidth];  // the last hidden layer: a skipped bin's Q is one output from it
   Float pmf[kNeuralBins];    // guided distribution per bin (floor included)
-  // Inclusive running sum of the rows' pmf (kNeuralGrid bins each), the
+  // Inclusive running sum of the tiles' pmf (kNeuralTile bins each), the
   // last 1: built by the first sample (neural_build_cdf).
-  Float row_cdf[kNeuralGrid];
+  Float tile_cdf[kNeuralTiles];
   bool has_cdf = false;
   Float irradiance = 0.f;    // sum over bins of Q max(cos, 0) dOmega about n
   Float qmax = 0.f;          // largest Q over bins above the surface
@@ -321,11 +344,15 @@ TESSERA_HOST_DEVICE inline void neural_light_distribution(const NeuralGuideView&
   site->light_prob = 0.f;
   const uint32_t lights = v.lights <= kNeuralMaxLights ? v.lights : 0u;
   Float* c = site->q + kNeuralBins;
-  Float total = 0.f;
-  for (uint32_t i = 0; i < lights; ++i) {
-    c[i] = v.scale * neural_exp(c[i]);
-    total += c[i];
+  // exp on lanes, eight lights at a time (neural_exp8: the bits of neural_exp).
+  for (uint32_t i = 0; i < lights; i += kLanes8) {
+    F8 x = lanes_splat(0.f);
+    for (uint32_t k = 0; k < kLanes8 && i + k < lights; ++k) x[k] = c[i + k];
+    const F8 e = neural_exp8(x);
+    for (uint32_t k = 0; k < kLanes8 && i + k < lights; ++k) c[i + k] = v.scale * e[k];
   }
+  Float total = 0.f;
+  for (uint32_t i = 0; i < lights; ++i) total += c[i];
   if (lights == 0 || !v.trained || !(total > 0.f) || !(total <= 3.4e38f)) return;
   const Float floor = glm::clamp(v.floor, 0.f, 1.f);
   const Float w = (1.f - floor) / total, uniform = floor / static_cast<Float>(lights);
@@ -346,6 +373,27 @@ TESSERA_HOST_DEVICE inline uint32_t neural_sample_light(const NeuralGuideView& v
   return i;
 }
 
+// G blocks of kLanes8 outputs (blocks[0..G), in increasing order) side by
+// side: their sums are independent chains of additions (one block's chain
+// alone waits on each addition's latency); finish(j, sum) takes each
+// block's sum, block by block.
+template <uint32_t G, class Finish>
+TESSERA_LANES_FN void neural_output_blocks(const float* w3, const float* b3, uint32_t outs, uint32_t width, const Float* h2,
+                                           const uint32_t* blocks, Finish& finish) {
+  F8 acc[G];
+  uint32_t j[G];
+  for (uint32_t g = 0; g < G; ++g) {
+    j[g] = blocks[g] * kLanes8;
+    acc[g] = lanes_load(b3 + j[g]);
+  }
+  const float* col = w3;
+  for (uint32_t i = 0; i < width; ++i, col += outs) {
+    const F8 x = lanes_splat(h2[i]);
+    for (uint32_t g = 0; g < G; ++g) acc[g] += lanes_load(col + j[g]) * x;
+  }
+  for (uint32_t g = 0; g < G; ++g) finish(j[g], acc[g]);
+}
+
 // Runs the network at a vertex (p on a surface whose normal on the path's
 // side is n) and builds the site's distributions.
 TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site) {
@@ -359,16 +407,16 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   site->n = n;
   site->has_cdf = false;
   // The output layer, exp, Q x max(cos, 0), its sum and the largest Q above
-  // the surface in one pass over blocks of 8 bins, each block in registers
-  // (lanes8.h; each bin's sums in a fixed order). A block whose bins all lie
-  // below the surface adds exactly 0 to the sums and the maximum, and gives
-  // each of its bins the floor's share: it is skipped (a bin's Q there is
-  // computed from h2 when read, neural_site_q: a bin the floor or a
-  // transmission drew). On a floor or ceiling of a y-up scene half the
-  // blocks are skipped, on walls facing z two to four of 18, facing x none.
-  static_assert(kNeuralBins % kLanes8 == 0, "bins in whole lanes");
-  static_assert(kNeuralBins / kLanes8 <= 32, "a bit per block");
-  constexpr uint32_t kBlocks = kNeuralBins / kLanes8;
+  // the surface in one pass over the tiles of 8 bins, each tile a block in
+  // registers (lanes8.h; each bin's sums in a fixed order). A tile whose
+  // bins all lie below the surface adds exactly 0 to the sums and the
+  // maximum, and gives each of its bins the floor's share: it is skipped (a
+  // bin's Q there is computed from h2 when read, neural_site_q: a bin the
+  // floor or a transmission drew). Half the tiles are skipped on floors and
+  // ceilings of a y-up scene, a third on walls facing x, 4 of 18 facing z.
+  static_assert(kNeuralTile == kLanes8, "a tile is a block of lanes");
+  static_assert(kNeuralTiles <= 32, "a bit per tile");
+  constexpr uint32_t kBlocks = kNeuralTiles;
   const uint32_t outs = L.outputs(), width = v.width;
   const float* w3 = v.params + L.w3();
   const float* b3 = v.params + L.b3();
@@ -403,32 +451,19 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
     lane_sum += weighted;
     lane_max = lanes_select_gt(lane_max, above, lane_max, above);
   };
-  // Six blocks at a time: their sums are independent chains of additions
-  // (one block's chain alone waits on each addition's latency); the rest
-  // one by one. Blocks in increasing order: the sums' order is the bins'.
-  constexpr uint32_t kGroup = 6;
+  // Six blocks at a time, the rest in groups of three, two and one. Blocks
+  // in increasing order: the sums' order is the bins'.
   uint32_t a = 0;
-  for (; a + kGroup <= count; a += kGroup) {
-    F8 acc[kGroup];
-    uint32_t j[kGroup];
-    for (uint32_t g = 0; g < kGroup; ++g) {
-      j[g] = active[a + g] * kLanes8;
-      acc[g] = lanes_load(b3 + j[g]);
-    }
-    const float* col = w3;
-    for (uint32_t i = 0; i < width; ++i, col += outs) {
-      const F8 x = lanes_splat(h2[i]);
-      for (uint32_t g = 0; g < kGroup; ++g) acc[g] += lanes_load(col + j[g]) * x;
-    }
-    for (uint32_t g = 0; g < kGroup; ++g) finish(j[g], acc[g]);
+  for (; a + 6 <= count; a += 6) neural_output_blocks<6>(w3, b3, outs, width, h2, active + a, finish);
+  if (a + 3 <= count) {
+    neural_output_blocks<3>(w3, b3, outs, width, h2, active + a, finish);
+    a += 3;
   }
-  for (; a < count; ++a) {
-    const uint32_t j = active[a] * kLanes8;
-    F8 acc = lanes_load(b3 + j);
-    const float* col = w3 + j;
-    for (uint32_t i = 0; i < width; ++i, col += outs) acc += lanes_load(col) * lanes_splat(h2[i]);
-    finish(j, acc);
+  if (a + 2 <= count) {
+    neural_output_blocks<2>(w3, b3, outs, width, h2, active + a, finish);
+    a += 2;
   }
+  if (a < count) neural_output_blocks<1>(w3, b3, outs, width, h2, active + a, finish);
   // The light outputs (raw: neural_light_distribution takes their exp).
   for (uint32_t o = kNeuralBins; o < outs; ++o) {
     Float acc = b3[o];
@@ -449,21 +484,21 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   neural_light_distribution(v, site);
 }
 
-// The site's cdf over rows of bins, built once per vertex by the first
-// sample that needs it. Sampling takes two levels (a row, then a bin in
-// it): the rows' sums are independent chains of additions, where one
+// The site's cdf over tiles of bins, built once per vertex by the first
+// sample that needs it. Sampling takes two levels (a tile, then a bin in
+// it): the tiles' sums are independent chains of additions, where one
 // running sum over the 144 bins is a single long one.
 TESSERA_HOST_DEVICE inline void neural_build_cdf(NeuralSite* site) {
-  Float row[kNeuralGrid] = {};
-  for (uint32_t c = 0; c < kNeuralGrid; ++c)
-    for (uint32_t r = 0; r < kNeuralGrid; ++r) row[r] += site->pmf[r * kNeuralGrid + c];
+  Float tile[kNeuralTiles] = {};
+  for (uint32_t k = 0; k < kNeuralTile; ++k)
+    for (uint32_t t = 0; t < kNeuralTiles; ++t) tile[t] += site->pmf[t * kNeuralTile + k];
   Float acc = 0.f;
-  for (uint32_t r = 0; r < kNeuralGrid; ++r) {
-    acc += row[r];
-    site->row_cdf[r] = acc;
+  for (uint32_t t = 0; t < kNeuralTiles; ++t) {
+    acc += tile[t];
+    site->tile_cdf[t] = acc;
   }
-  // The last row takes the rounding: u < 1 always finds a row.
-  site->row_cdf[kNeuralGrid - 1] = 1.f;
+  // The last tile takes the rounding: u < 1 always finds a tile.
+  site->tile_cdf[kNeuralTiles - 1] = 1.f;
   site->has_cdf = true;
 }
 
@@ -540,7 +575,7 @@ TESSERA_HOST_DEVICE inline uint32_t neural_bin_of(const Vec3& dir) {
     const Float last = static_cast<Float>(kNeuralGrid - 1);
     return x > 0.f ? static_cast<uint32_t>(glm::min(x * static_cast<Float>(kNeuralGrid), last)) : 0u;
   };
-  return index(uv.y) * kNeuralGrid + index(uv.x);
+  return neural_bin_at(index(uv.y), index(uv.x));
 }
 
 TESSERA_HOST_DEVICE inline Float neural_bin_pdf(const NeuralSite& site, uint32_t bin) {
@@ -551,20 +586,20 @@ TESSERA_HOST_DEVICE inline Float neural_bin_pdf(const NeuralSite& site, uint32_t
 TESSERA_HOST_DEVICE inline bool neural_sample(NeuralSite& site, Float u_bin, Vec2 u, Vec3* dir, Float* pdf,
                                               uint32_t* bin_out) {
   if (!site.has_cdf) neural_build_cdf(&site);
-  uint32_t row = 0;  // the first row whose cdf exceeds u_bin
-  while (row + 1 < kNeuralGrid && !(site.row_cdf[row] > u_bin)) ++row;
-  // Then the bin where the running sum within the row passes what is left
-  // of u_bin (the row's last bin takes the rounding).
-  const Float t = u_bin - (row > 0 ? site.row_cdf[row - 1] : 0.f);
-  const Float* p = site.pmf + row * kNeuralGrid;
-  uint32_t col = 0;
+  uint32_t tile = 0;  // the first tile whose cdf exceeds u_bin
+  while (tile + 1 < kNeuralTiles && !(site.tile_cdf[tile] > u_bin)) ++tile;
+  // Then the bin where the running sum within the tile passes what is left
+  // of u_bin (the tile's last bin takes the rounding).
+  const Float t = u_bin - (tile > 0 ? site.tile_cdf[tile - 1] : 0.f);
+  const Float* p = site.pmf + tile * kNeuralTile;
+  uint32_t k = 0;
   Float acc = p[0];
-  while (col + 1 < kNeuralGrid && !(acc > t)) acc += p[++col];
-  const uint32_t bin = row * kNeuralGrid + col;
+  while (k + 1 < kNeuralTile && !(acc > t)) acc += p[++k];
+  const uint32_t bin = tile * kNeuralTile + k;
   if (!(site.pmf[bin] > 0.f)) return false;
   const Float inv_grid = 1.f / static_cast<Float>(kNeuralGrid);
-  *dir = equal_area_square_to_sphere(Vec2((static_cast<Float>(col) + u.x) * inv_grid,
-                                          (static_cast<Float>(row) + u.y) * inv_grid));
+  *dir = equal_area_square_to_sphere(Vec2((static_cast<Float>(neural_bin_col(bin)) + u.x) * inv_grid,
+                                          (static_cast<Float>(neural_bin_row(bin)) + u.y) * inv_grid));
   *pdf = neural_bin_pdf(site, bin);
   *bin_out = bin;
   return true;

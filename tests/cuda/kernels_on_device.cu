@@ -197,8 +197,8 @@ bool check_neural() {
   std::vector<Vec3> dirs(kNeuralBins);
   std::vector<Float> soa(3 * kNeuralBins);
   for (uint32_t b = 0; b < kNeuralBins; ++b) {
-    const Vec2 sq((static_cast<Float>(b % kNeuralGrid) + 0.5f) / kNeuralGrid,
-                  (static_cast<Float>(b / kNeuralGrid) + 0.5f) / kNeuralGrid);
+    const Vec2 sq((static_cast<Float>(neural_bin_col(b)) + 0.5f) / kNeuralGrid,
+                  (static_cast<Float>(neural_bin_row(b)) + 0.5f) / kNeuralGrid);
     dirs[b] = glm::normalize(equal_area_square_to_sphere(sq));
     for (uint32_t k = 0; k < 3; ++k) soa[k * kNeuralBins + b] = dirs[b][k];
   }

@@ -126,7 +126,7 @@ TEST(NeuralGuide, GradientMatchesFiniteDifferences) {
 // and each below 0.05, and its guided distribution puts most of its mass
 // there (above a +z surface: 0.7 here).
 TEST(NeuralGuide, LearnsASingleBrightDirection) {
-  constexpr uint32_t kBright = 77;  // a bin above a +z surface
+  constexpr uint32_t kBright = neural_bin_at(6, 5);  // a bin above a +z surface
   NeuralGuideConfig c = small_config(16);
   NeuralGuide g = make(c);
   const NeuralGuideView v0 = g.view();
@@ -367,6 +367,53 @@ TEST(NeuralGuide, LoadRejectsOtherScenesAndDamage) {
   EXPECT_THROW(load_guide(junk, 7), std::runtime_error);
 }
 
+// Version 3 numbered the bins row-major, this version by tiles: a version-3
+// file is read with each bin's output moved to its new number (a file saved
+// now and relabelled version 3 answers, at bin neural_bin_at(r, c), what the
+// saved network answers at bin 12 r + c), and the same network's Adam
+// state moves with it. Versions before 3 are refused.
+TEST(NeuralGuide, AVersion3FileIsReadWithItsBinsRenumbered) {
+  NeuralGuide g = make(small_config());
+  g.train_on({{0, random_samples(200, 1, 2.f)}});
+  std::stringstream bytes;
+  g.save(bytes, 5);
+  std::string file = bytes.str();
+  const size_t at = sizeof "tessera-neural-guide" + 1;  // after the magic and cereal's endianness byte
+  uint32_t version = 0;
+  std::memcpy(&version, file.data() + at, 4);
+  ASSERT_EQ(version, 4u) << "the file's layout changed: update the offset";
+  version = 3;
+  std::memcpy(file.data() + at, &version, 4);
+  std::stringstream v3(file);
+  std::unique_ptr<NeuralGuide> loaded = NeuralGuide::load(v3, 5);
+  EXPECT_FALSE(*loaded == g);
+  const NeuralGuideView a = g.view(), b = loaded->view();
+  NeuralSite sa, sb;
+  for (const Vec3& n : {Vec3(0.f, 0.f, 1.f), Vec3(0.f, -1.f, 0.f), glm::normalize(Vec3(0.3f, -0.5f, 0.8f))}) {
+    neural_infer(a, Vec3(0.3f, 0.6f, 0.2f), n, &sa);
+    neural_infer(b, Vec3(0.3f, 0.6f, 0.2f), n, &sb);
+    for (uint32_t r = 0; r < kNeuralGrid; ++r) {
+      for (uint32_t c = 0; c < kNeuralGrid; ++c) {
+        ASSERT_EQ(neural_site_q(b, sb, neural_bin_at(r, c)), neural_site_q(a, sa, r * kNeuralGrid + c)) << r << ',' << c;
+      }
+    }
+  }
+  // Training on moves the renumbered copy's bins as it moves the original's.
+  const NeuralLayout L = g.layout();
+  std::vector<NeuralTrainingSample> more = random_samples(64, 3, 1.f);
+  std::vector<NeuralTrainingSample> renumbered = more;
+  for (NeuralTrainingSample& s : renumbered) s.bin = neural_bin_at(s.bin / kNeuralGrid, s.bin % kNeuralGrid);
+  g.train_on({{0, more}});
+  loaded->train_on({{0, renumbered}});
+  for (uint32_t j = 0; j < kNeuralBins; ++j)
+    ASSERT_EQ(loaded->params()[L.b3() + neural_bin_at(j / kNeuralGrid, j % kNeuralGrid)], g.params()[L.b3() + j]) << j;
+  for (uint32_t old : {1u, 2u, 5u}) {
+    std::memcpy(file.data() + at, &old, 4);
+    std::stringstream refused(file);
+    EXPECT_THROW(NeuralGuide::load(refused, 5), std::runtime_error) << old;
+  }
+}
+
 TEST(NeuralGuide, NonFiniteAndHugeTargetsAreRejectedAndCounted) {
   NeuralGuide g = make(small_config());
   NeuralGuideView v = g.view();
@@ -506,7 +553,9 @@ TEST(NeuralGuide, LaneInferenceEqualsThePlainDefinition) {
         lane_sum[j % 8] += weighted[j];
         lane_max[j % 8] = std::max(lane_max[j % 8], c > 0.f ? qj : 0.f);
         // A block is skipped exactly where all its bins lie below the surface.
-        if (c > 0.f) EXPECT_FALSE((site.skipped >> (j / 8)) & 1u) << j;
+        if (c > 0.f) {
+          EXPECT_FALSE((site.skipped >> (j / 8)) & 1u) << j;
+        }
         below[j / 8] += c > 0.f ? 0 : 1;
       }
       float total = 0.f, qmax = 0.f;
