@@ -55,8 +55,8 @@ std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_
     uint64_t fingerprint = 0;
     ar(version, fingerprint);
     if (version != kNeuralVersion && version != kNeuralRowMajorVersion)
-      throw std::runtime_error("neural guide version " + std::to_string(version) + ", this build reads version " +
-                               std::to_string(kNeuralVersion));
+      throw std::runtime_error("neural guide version " + std::to_string(version) + ", this build reads versions " +
+                               std::to_string(kNeuralRowMajorVersion) + " and " + std::to_string(kNeuralVersion));
     if (fingerprint != scene_fingerprint) throw std::runtime_error("neural guide was learned on another scene");
     g->serialize(ar);
   } catch (const cereal::Exception& e) {

@@ -32,8 +32,8 @@ constexpr uint32_t kNeuralBins = kNeuralGrid * kNeuralGrid;  // 144
 // bins row-major. A tile is one block of kLanes8 outputs in an inference,
 // and it is compact on the sphere, so that more tiles than rows of 8 lie
 // wholly below a surface and are skipped (neural_infer): on axis-aligned
-// normals 4 to 9 of 18 instead of 0 to 9, and twice as many on average over
-// all normals. (The table numbers its bins row-major: guide_view.h.)
+// normals 4 to 9 of 18 instead of 0 to 9 for blocks of 8 consecutive
+// row-major bins, and twice as many on average over all normals. (The table numbers its bins row-major: guide_view.h.)
 constexpr uint32_t kNeuralTileRows = 2, kNeuralTileCols = 4;
 constexpr uint32_t kNeuralTile = kNeuralTileRows * kNeuralTileCols;       // bins per tile
 constexpr uint32_t kNeuralTiles = kNeuralBins / kNeuralTile;               // 18
@@ -153,7 +153,7 @@ struct NeuralGuideView {
   Float floor = 0.02f;            // share of each distribution spread uniformly
   bool trained = false;           // no optimiser step yet: nothing to guide with
   Float max_target = 3.4e38f;     // larger targets are rejected (and counted), never clamped
-  const Vec3* bin_dirs = nullptr;  // kNeuralBins centre directions (as GuideView::bin_dirs)
+  const Vec3* bin_dirs = nullptr;  // kNeuralBins centre directions, in the network's numbering (tiles)
   const Float* bin_dir_soa = nullptr;  // the same, as x[kNeuralBins], y[...], z[...] (a loop over bins vectorises)
   uint32_t tile_targets = 128;    // learning targets a tile keeps on average (NeuralSampleSink::keep_prob)
   NeuralSampleSink* sink = nullptr;  // the calling thread's (null: targets are not recorded)
@@ -464,11 +464,17 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
     a += 2;
   }
   if (a < count) neural_output_blocks<1>(w3, b3, outs, width, h2, active + a, finish);
-  // The light outputs (raw: neural_light_distribution takes their exp).
-  for (uint32_t o = kNeuralBins; o < outs; ++o) {
-    Float acc = b3[o];
-    for (uint32_t i = 0; i < width; ++i) acc += w3[static_cast<size_t>(i) * outs + o] * h2[i];
-    q[o] = acc;
+  // The light outputs (raw: neural_light_distribution takes their exp),
+  // eight at a time: one hidden unit's light weights are contiguous in w3.
+  // Lanes past the last light read the next unit's first weights (the last
+  // unit's, at most 7 of the outs biases that follow) and are not kept; each kept lane's sum
+  // is the scalar one, in the same order.
+  for (uint32_t o = kNeuralBins; o < outs; o += kLanes8) {
+    F8 acc = zero;
+    for (uint32_t k = 0; k < kLanes8 && o + k < outs; ++k) acc[k] = b3[o + k];
+    const float* col = w3 + o;
+    for (uint32_t i = 0; i < width; ++i, col += outs) acc += lanes_load(col) * lanes_splat(h2[i]);
+    for (uint32_t k = 0; k < kLanes8 && o + k < outs; ++k) q[o + k] = acc[k];
   }
   Float total = 0.f, qmax = 0.f;
   for (uint32_t k = 0; k < kLanes8; ++k) {

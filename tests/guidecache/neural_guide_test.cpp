@@ -489,10 +489,13 @@ TEST(NeuralGuide, AvxAndPortableInferenceAgreeBitForBit) {
 // lanes and widths that leave a tail.
 TEST(NeuralGuide, LaneInferenceEqualsThePlainDefinition) {
   int skipped_blocks = 0, cases = 0;
+  // Light counts that leave a group of eight lanes part-filled (3, 9) or
+  // full (8, 16): the light outputs are computed eight at a time.
   for (uint32_t width : {5u, 8u, 13u, 16u}) {
-    NeuralGuide g = make(small_config(width), 3);
+    const uint32_t lights = width == 5 ? 3 : width == 8 ? 8 : width == 13 ? 9 : kNeuralMaxLights;
+    NeuralGuide g = make(small_config(width), lights);
     std::vector<NeuralTrainingSample> samples = random_samples(200, 7, 1.f);
-    for (size_t i = 0; i < samples.size(); i += 3) samples[i].bin = kNeuralBins + static_cast<uint32_t>(i) % 3;
+    for (size_t i = 0; i < samples.size(); i += 3) samples[i].bin = kNeuralBins + static_cast<uint32_t>(i) % lights;
     g.train_on({{0, samples}});
     const NeuralGuideView v = g.view();
     const NeuralLayout L = g.layout();
@@ -676,7 +679,7 @@ TEST(NeuralGuide, InferenceGivesAProperDistribution) {
   EXPECT_LE(elsewhere, kDraws / 1000);
 
   // A sharp distribution too (a trained network's can be): a few bins with
-  // most of the mass, in the first, a middle and the last row.
+  // most of the mass, in the first, a middle and the last tile.
   NeuralSite sharp = site;
   double total = 0.0;
   for (uint32_t j = 0; j < kNeuralBins; ++j) {
