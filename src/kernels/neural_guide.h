@@ -30,10 +30,11 @@ constexpr uint32_t kNeuralBins = kNeuralGrid * kNeuralGrid;  // 144
 // The network numbers its bins tile by tile: the 12x12 equal-area square is
 // cut into 18 tiles of 2 rows x 4 columns, numbered row-major, each tile's
 // bins row-major. A tile is one block of kLanes8 outputs in an inference,
-// and it is compact on the sphere, so that more tiles than rows of 8 lie
-// wholly below a surface and are skipped (neural_infer): on axis-aligned
-// normals 4 to 9 of 18 instead of 0 to 9 for blocks of 8 consecutive
-// row-major bins, and twice as many on average over all normals. (The table numbers its bins row-major: guide_view.h.)
+// and it is compact on the sphere, so that more tiles than blocks of 8
+// consecutive row-major bins lie wholly below a surface and are skipped
+// (neural_infer): on axis-aligned normals 4 to 9 of 18 instead of 0 to 9,
+// and twice as many on average over all normals. (The table numbers its
+// bins row-major: guide_view.h.)
 constexpr uint32_t kNeuralTileRows = 2, kNeuralTileCols = 4;
 constexpr uint32_t kNeuralTile = kNeuralTileRows * kNeuralTileCols;       // bins per tile
 constexpr uint32_t kNeuralTiles = kNeuralBins / kNeuralTile;               // 18
@@ -467,8 +468,8 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   // The light outputs (raw: neural_light_distribution takes their exp),
   // eight at a time: one hidden unit's light weights are contiguous in w3.
   // Lanes past the last light read the next unit's first weights (the last
-  // unit's, at most 7 of the outs biases that follow) and are not kept; each kept lane's sum
-  // is the scalar one, in the same order.
+  // unit's, at most 7 of the outs biases that follow) and are not kept;
+  // each kept lane's sum is the scalar one, in the same order.
   for (uint32_t o = kNeuralBins; o < outs; o += kLanes8) {
     F8 acc = zero;
     for (uint32_t k = 0; k < kLanes8 && o + k < outs; ++k) acc[k] = b3[o + k];
