@@ -37,15 +37,15 @@ struct NeuralGuideConfig {
   // Adam steps (gradient all-reductions) after each learning pass, each on
   // its share of the pass's targets. Many small steps at a high rate are
   // what lets the network follow what the table learns at once; with
-  // tile_targets, the setting that gave the lowest error at equal time
-  // (docs/neural-guide.md).
+  // tile_targets, of the settings measured the one with the lowest error
+  // at equal time (docs/neural-guide.md).
   uint32_t steps_per_pass = 48;
   Float learning_rate = 2e-2f;
   Float guide_prob = 0.5f;           // mixture weight of guided sampling once trained
   Float floor = 0.02f;               // uniform share of each distribution (as the table's)
   // Learning targets a tile keeps per learning pass, on average (the rest
   // are skipped). More lower the error per sample, and training time grows
-  // with them: twice as many as this were worse at equal time
+  // with them: twice as many, with 64 steps, were worse at equal time
   // (docs/neural-guide.md).
   uint32_t tile_targets = 256;
   // Entries per hash-grid level: 2^table_log2, in [kNeuralMinTableLog2,

@@ -156,7 +156,7 @@ struct NeuralGuideView {
   Float max_target = 3.4e38f;     // larger targets are rejected (and counted), never clamped
   const Vec3* bin_dirs = nullptr;  // kNeuralBins centre directions, in the network's numbering (tiles)
   const Float* bin_dir_soa = nullptr;  // the same, as x[kNeuralBins], y[...], z[...] (a loop over bins vectorises)
-  uint32_t tile_targets = 128;    // learning targets a tile keeps on average (NeuralSampleSink::keep_prob)
+  uint32_t tile_targets = 256;    // learning targets a tile keeps on average (NeuralSampleSink::keep_prob)
   NeuralSampleSink* sink = nullptr;  // the calling thread's (null: targets are not recorded)
 };
 
