@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "kernels/neural_guide.h"
+#include "guidecache/neural_guide.h"
 
 using namespace tessera;
 
@@ -22,26 +22,14 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_inference: lights must be 0 or %u..%u\n", kNeuralMinLights, kNeuralMaxLights);
     return 2;
   }
-  const NeuralLayout L{8, 11, lights};
+  // The shipped guide's view (its bin directions and layouts, default
+  // sizes), with random weights and marked trained.
+  NeuralGuide guide(NeuralGuideConfig{}, Vec3(0.f), Vec3(1.f), 1.f, lights);
   std::mt19937 rng(1);
   std::uniform_real_distribution<float> w(-0.3f, 0.3f), u(0.f, 1.f);
-  std::vector<float> params(L.size());
-  for (float& x : params) x = w(rng);
-  std::vector<Vec3> dirs(kNeuralBins);
-  std::vector<Float> soa(3 * kNeuralBins);
-  for (uint32_t b = 0; b < kNeuralBins; ++b) {
-    dirs[b] = glm::normalize(equal_area_square_to_sphere(
-        Vec2((neural_bin_col(b) + 0.5f) / kNeuralGrid, (neural_bin_row(b) + 0.5f) / kNeuralGrid)));
-    for (int k = 0; k < 3; ++k) soa[k * kNeuralBins + b] = dirs[b][k];
-  }
-  NeuralGuideView v;
-  v.params = params.data();
-  v.width = L.width;
-  v.table_log2 = L.table_log2;
-  v.lights = lights;
+  for (float& x : guide.mutable_params()) x = w(rng);
+  NeuralGuideView v = guide.view();
   v.trained = true;
-  v.bin_dirs = dirs.data();
-  v.bin_dir_soa = soa.data();
   constexpr int kPoints = 4096;
   std::vector<Vec3> ps(kPoints), ns(kPoints);
   const Vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};

@@ -10,7 +10,7 @@ build=${BUILD_DIR:-build}
 bin=$(mktemp -d)/bench_inference
 trap 'rm -rf "$(dirname "$bin")"' EXIT
 g++ -O3 -DNDEBUG -std=c++20 -ffp-contract=off -fno-trapping-math -fno-math-errno -Wno-psabi \
-  -Isrc -I"$build/generated" scripts/bench_inference.cpp "$build/libtessera_guidecache.a" -o "$bin"
+  -Isrc -I"$build/generated" scripts/bench_inference.cpp "$build/libtessera_guidecache.a" -ltbb -o "$bin"
 for normals in axis random; do
   for lights in 0 6; do "$bin" "$normals" "$lights"; done
 done
