@@ -17,8 +17,8 @@
 //     unguided (and the network's training share); against Embree on the
 //     machine that made the fixture (the 2-core CPU) and against the same
 //     kernels on this machine's own cores; relMSE of none, the table and the
-//     network at equal time (0.5 s and 2 s) against a 64x longer unguided
-//     render.
+//     network at equal time (0.5 s and 2 s, or TESSERA_GPU_EQUAL_TIME) against
+//     a 64x longer unguided render.
 // Usage: device_backend_on_device FIXTURE...   (exit 0 pass, 1 fail, 77 no device;
 // --probe: 0 when a device is here; TESSERA_GPU_CHECK_DRY_RUN=1: host
 // threads stand in for the GPU, to check this program itself)
@@ -28,7 +28,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <initializer_list>
 #include <new>
 #include <stdexcept>
 #include <thread>
@@ -136,6 +135,22 @@ Timed render_neural(DeviceBackend& backend, const GpuFixture& f, NeuralGuide& gu
   return t;
 }
 
+// The network's settings: the defaults, or TESSERA_GPU_NEURAL="TARGETS,STEPS"
+// (targets per tile and Adam steps per pass, as --neural-targets/-steps).
+NeuralGuideConfig neural_config() {
+  NeuralGuideConfig c;
+  if (const char* env = std::getenv("TESSERA_GPU_NEURAL")) {
+    unsigned targets = 0, steps = 0;
+    char extra = 0;
+    if (std::sscanf(env, "%u,%u%c", &targets, &steps, &extra) != 2 || targets < 1 || targets > 4096 || steps < 1 ||
+        steps > 1024)
+      throw std::runtime_error(std::string("TESSERA_GPU_NEURAL: '") + env + "' is not TARGETS,STEPS");
+    c.tile_targets = targets;
+    c.steps_per_pass = steps;
+  }
+  return c;
+}
+
 // Relative MSE against a reference, as tessera's image metrics define it:
 // the mean over pixels and channels of (A - F)^2 / (F^2 + 0.01).
 double rel_mse(const Film& a, const Film& reference) {
@@ -152,14 +167,14 @@ double rel_mse(const Film& a, const Film& reference) {
 
 // Equal time on the device: unguided, the table and the network (training
 // included) for the same seconds, each against a long unguided reference.
-void equal_time(DeviceBackend& backend, const GpuFixture& f, uint32_t ref_spp, std::initializer_list<double> budgets) {
+void equal_time(DeviceBackend& backend, const GpuFixture& f, uint32_t ref_spp, const std::vector<double>& budgets) {
   const Timed ref = render(backend, f, nullptr, ref_spp, 0.0, 256);
   std::printf("  equal time on the device, against %u spp unguided (%.1f s):\n", ref_spp, ref.seconds);
   for (const double seconds : budgets) {
     const Timed u = render(backend, f, nullptr, ~0u, seconds);
     GuideField table(GuideConfig{}, f.lo, f.hi, f.lights, f.max_emitted);
     const Timed g = render(backend, f, &table, ~0u, seconds);
-    NeuralGuide network(NeuralGuideConfig{}, f.lo, f.hi, f.max_emitted, f.lights);
+    NeuralGuide network(neural_config(), f.lo, f.hi, f.max_emitted, f.lights);
     const Timed n = render_neural(backend, f, network, ~0u, seconds);
     const double eu = rel_mse(u.film, ref.film), eg = rel_mse(g.film, ref.film), en = rel_mse(n.film, ref.film);
     std::printf("    %.2f s: relMSE none %.3g (%u spp), qtable %.3g (%u spp, %.2fx none's), neural %.3g (%u spp, %.2fx none's, "
@@ -168,6 +183,23 @@ void equal_time(DeviceBackend& backend, const GpuFixture& f, uint32_t ref_spp, s
                 en, static_cast<unsigned>(n.film.pixels[0].n), en / eu, en / eg,
                 100.0 * network.stats().train_seconds / n.seconds);
   }
+}
+
+// The equal-time budgets in seconds: TESSERA_GPU_EQUAL_TIME="0.5,2,8"
+// (default 0.5 and 2; a larger image fills the device and wants longer).
+std::vector<double> equal_time_budgets() {
+  std::vector<double> budgets;
+  const char* env = std::getenv("TESSERA_GPU_EQUAL_TIME");
+  for (const char* p = env ? env : "0.5,2"; *p;) {
+    char* end = nullptr;
+    const double seconds = std::strtod(p, &end);
+    if (end == p || !(seconds > 0.0) || seconds > 600.0)
+      throw std::runtime_error(std::string("TESSERA_GPU_EQUAL_TIME: '") + env + "' is not a list of seconds (0 to 600)");
+    budgets.push_back(seconds);
+    p = *end == ',' ? end + 1 : end;
+    if (*end && *end != ',') throw std::runtime_error(std::string("TESSERA_GPU_EQUAL_TIME: '") + env + "': stray characters");
+  }
+  return budgets;
 }
 
 bool identical(const Film& a, const Film& b) {
@@ -236,7 +268,7 @@ bool check(const std::string& path) {
   ok &= agree(a.film, ga.film, "guided vs unguided", f.name);
 
   auto make_network = [&] {
-    return std::make_unique<NeuralGuide>(NeuralGuideConfig{}, f.lo, f.hi, f.max_emitted, f.lights);
+    return std::make_unique<NeuralGuide>(neural_config(), f.lo, f.hi, f.max_emitted, f.lights);
   };
   auto n1 = make_network(), n2 = make_network();
   const Timed na = render_neural(backend, f, *n1, f.spp), nb = render_neural(backend, f, *n2, f.spp);
@@ -257,6 +289,7 @@ bool check(const std::string& path) {
               ga.seconds, guided_rate * 1e-6, guided_vertex * 1e9, guided_vertex / unguided_vertex,
               static_cast<unsigned long long>(ga.counters.path.guided_samples));
   const double neural_vertex = na.seconds / double(na.counters.path.vertices);
+  std::printf("  neural (%u targets per tile, %u steps per pass):\n", n1->config().tile_targets, n1->config().steps_per_pass);
   std::printf("  neural:   %.2f s, %.2f Msamples/s, %.1f ns per path vertex (%.2fx unguided's, %.2fx the table's), "
               "training %.2f s (%.0f %%), %llu targets, %llu steps, %llu guided samples\n",
               na.seconds, samples / na.seconds * 1e-6, neural_vertex * 1e9, neural_vertex / unguided_vertex,
@@ -288,7 +321,7 @@ bool check(const std::string& path) {
   if (dry_run)
     equal_time(backend, f, 4 * f.spp, {0.05, 0.1});
   else
-    equal_time(backend, f, 64 * f.spp, {0.5, 2.0});
+    equal_time(backend, f, 64 * f.spp, equal_time_budgets());
   return ok;
 }
 

@@ -1,6 +1,8 @@
 // Writes the GPU check's fixtures (gpu_fixture.h) for the shipped Cornell
 // box and door-ajar: run on a machine with the full build, read on one with
-// a GPU (scripts/gpu_check.sh). Usage: make_gpu_fixtures OUT_DIR [SPP]
+// a GPU (scripts/gpu_check.sh). Usage: make_gpu_fixtures OUT_DIR [SPP [WIDTHxHEIGHT]]
+// (default 64 spp at 128x96: small enough for the host emulation's image on
+// two cores; a larger image fills the device, which 128x96 does not)
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -18,17 +20,23 @@
 int main(int argc, char** argv) {
   using namespace tessera;
   if (argc < 2) {
-    std::fprintf(stderr, "usage: make_gpu_fixtures OUT_DIR [SPP]\n");
+    std::fprintf(stderr, "usage: make_gpu_fixtures OUT_DIR [SPP [WIDTHxHEIGHT]]\n");
     return 2;
   }
   const std::string out = argv[1];
   const uint32_t spp = argc > 2 ? static_cast<uint32_t>(std::stoul(argv[2])) : 64;
+  int width = 128, height = 96;
+  if (argc > 3 && (std::sscanf(argv[3], "%dx%d", &width, &height) != 2 || width < 1 || height < 1 ||
+                   width > 8192 || height > 8192)) {
+    std::fprintf(stderr, "make_gpu_fixtures: resolution '%s' is not WIDTHxHEIGHT (1 to 8192 each)\n", argv[3]);
+    return 2;
+  }
   std::filesystem::create_directories(out);
   try {
     for (const char* name : {"cornell-box", "door-ajar"}) {
       SceneDesc desc = load_pbrt_file(std::string(TESSERA_SOURCE_DIR) + "/scenes/" + name + ".pbrt");
-      desc.film.xres = 128;
-      desc.film.yres = 96;
+      desc.film.xres = width;
+      desc.film.yres = height;
       const SceneData scene(std::move(desc));
       RenderOptions opt;
       opt.seed = 5;
