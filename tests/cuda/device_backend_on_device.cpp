@@ -18,7 +18,7 @@
 //     machine that made the fixture (the 2-core CPU) and against the same
 //     kernels on this machine's own cores; relMSE of none, the table and the
 //     network at equal time (0.5 s and 2 s, or TESSERA_GPU_EQUAL_TIME) against
-//     a 64x longer unguided render.
+//     a 64x longer unguided render of another seed.
 // Usage: device_backend_on_device FIXTURE...   (exit 0 pass, 1 fail, 77 no device;
 // --probe: 0 when a device is here; TESSERA_GPU_CHECK_DRY_RUN=1: host
 // threads stand in for the GPU, to check this program itself)
@@ -135,20 +135,43 @@ Timed render_neural(DeviceBackend& backend, const GpuFixture& f, NeuralGuide& gu
   return t;
 }
 
-// The network's settings: the defaults, or TESSERA_GPU_NEURAL="TARGETS,STEPS"
-// (targets per tile and Adam steps per pass, as --neural-targets/-steps).
-NeuralGuideConfig neural_config() {
-  NeuralGuideConfig c;
+// What the environment asks of the figures (read once, before any render,
+// so that a typo costs no device time):
+//   TESSERA_GPU_NEURAL="TARGETS,STEPS": the network's targets per tile and
+//     Adam steps per pass (as --neural-targets and --neural-steps);
+//   TESSERA_GPU_EQUAL_TIME="0.5,2,6": the equal-time budgets in seconds
+//     (default 0.5 and 2; a larger image fills the device and wants longer).
+struct FigureSettings {
+  NeuralGuideConfig network;
+  std::vector<double> budgets{0.5, 2.0};
+};
+
+FigureSettings figure_settings() {
+  FigureSettings f;
   if (const char* env = std::getenv("TESSERA_GPU_NEURAL")) {
-    unsigned targets = 0, steps = 0;
-    char extra = 0;
-    if (std::sscanf(env, "%u,%u%c", &targets, &steps, &extra) != 2 || targets < 1 || targets > 4096 || steps < 1 ||
-        steps > 1024)
-      throw std::runtime_error(std::string("TESSERA_GPU_NEURAL: '") + env + "' is not TARGETS,STEPS");
-    c.tile_targets = targets;
-    c.steps_per_pass = steps;
+    unsigned long targets = 0, steps = 0;
+    int used = -1;
+    if (std::sscanf(env, "%lu,%lu%n", &targets, &steps, &used) != 2 || env[used] != '\0' || targets < 1 ||
+        targets > (1ul << 20) || steps < 1 || steps > 1024)
+      throw std::runtime_error(std::string("TESSERA_GPU_NEURAL: '") + env +
+                               "' is not TARGETS,STEPS (targets 1 to 2^20, steps 1 to 1024)");
+    f.network.tile_targets = static_cast<uint32_t>(targets);
+    f.network.steps_per_pass = static_cast<uint32_t>(steps);
   }
-  return c;
+  if (const char* env = std::getenv("TESSERA_GPU_EQUAL_TIME")) {
+    f.budgets.clear();
+    for (const char* p = env;;) {
+      char* end = nullptr;
+      const double seconds = std::strtod(p, &end);
+      if (end == p || !(seconds > 0.0 && seconds <= 600.0) || (*end != ',' && *end != '\0'))
+        throw std::runtime_error(std::string("TESSERA_GPU_EQUAL_TIME: '") + env +
+                                 "' is not a list of seconds (each above 0, at most 600, comma-separated)");
+      f.budgets.push_back(seconds);
+      if (*end == '\0') break;
+      p = end + 1;
+    }
+  }
+  return f;
 }
 
 // Relative MSE against a reference, as tessera's image metrics define it:
@@ -167,14 +190,21 @@ double rel_mse(const Film& a, const Film& reference) {
 
 // Equal time on the device: unguided, the table and the network (training
 // included) for the same seconds, each against a long unguided reference.
-void equal_time(DeviceBackend& backend, const GpuFixture& f, uint32_t ref_spp, const std::vector<double>& budgets) {
-  const Timed ref = render(backend, f, nullptr, ref_spp, 0.0, 256);
-  std::printf("  equal time on the device, against %u spp unguided (%.1f s):\n", ref_spp, ref.seconds);
+// The reference has a seed of its own: were its samples the unguided
+// render's first ones, that render's error would be understated by the
+// share of the reference it makes up.
+void equal_time(DeviceBackend& backend, const GpuFixture& f, uint32_t ref_spp, const std::vector<double>& budgets,
+                const NeuralGuideConfig& network_config) {
+  GpuFixture other_seed = f;
+  other_seed.settings.seed = f.settings.seed ^ 0x9e3779b97f4a7c15ull;
+  other_seed.settings.sampler.seed = other_seed.settings.seed;
+  const Timed ref = render(backend, other_seed, nullptr, ref_spp, 0.0, 256);
+  std::printf("  equal time on the device, against %u spp unguided of another seed (%.1f s):\n", ref_spp, ref.seconds);
   for (const double seconds : budgets) {
     const Timed u = render(backend, f, nullptr, ~0u, seconds);
     GuideField table(GuideConfig{}, f.lo, f.hi, f.lights, f.max_emitted);
     const Timed g = render(backend, f, &table, ~0u, seconds);
-    NeuralGuide network(neural_config(), f.lo, f.hi, f.max_emitted, f.lights);
+    NeuralGuide network(network_config, f.lo, f.hi, f.max_emitted, f.lights);
     const Timed n = render_neural(backend, f, network, ~0u, seconds);
     const double eu = rel_mse(u.film, ref.film), eg = rel_mse(g.film, ref.film), en = rel_mse(n.film, ref.film);
     std::printf("    %.2f s: relMSE none %.3g (%u spp), qtable %.3g (%u spp, %.2fx none's), neural %.3g (%u spp, %.2fx none's, "
@@ -183,23 +213,6 @@ void equal_time(DeviceBackend& backend, const GpuFixture& f, uint32_t ref_spp, c
                 en, static_cast<unsigned>(n.film.pixels[0].n), en / eu, en / eg,
                 100.0 * network.stats().train_seconds / n.seconds);
   }
-}
-
-// The equal-time budgets in seconds: TESSERA_GPU_EQUAL_TIME="0.5,2,8"
-// (default 0.5 and 2; a larger image fills the device and wants longer).
-std::vector<double> equal_time_budgets() {
-  std::vector<double> budgets;
-  const char* env = std::getenv("TESSERA_GPU_EQUAL_TIME");
-  for (const char* p = env ? env : "0.5,2"; *p;) {
-    char* end = nullptr;
-    const double seconds = std::strtod(p, &end);
-    if (end == p || !(seconds > 0.0) || seconds > 600.0)
-      throw std::runtime_error(std::string("TESSERA_GPU_EQUAL_TIME: '") + env + "' is not a list of seconds (0 to 600)");
-    budgets.push_back(seconds);
-    p = *end == ',' ? end + 1 : end;
-    if (*end && *end != ',') throw std::runtime_error(std::string("TESSERA_GPU_EQUAL_TIME: '") + env + "': stray characters");
-  }
-  return budgets;
 }
 
 bool identical(const Film& a, const Film& b) {
@@ -228,7 +241,7 @@ bool agree(const Film& a, const Film& b, const char* what, const std::string& na
   return ok;
 }
 
-bool check(const std::string& path) {
+bool check(const std::string& path, const FigureSettings& settings) {
   GpuFixture f;
   const PackedScene packed = load_fixture(path, &f);
   std::string why;
@@ -268,7 +281,7 @@ bool check(const std::string& path) {
   ok &= agree(a.film, ga.film, "guided vs unguided", f.name);
 
   auto make_network = [&] {
-    return std::make_unique<NeuralGuide>(neural_config(), f.lo, f.hi, f.max_emitted, f.lights);
+    return std::make_unique<NeuralGuide>(settings.network, f.lo, f.hi, f.max_emitted, f.lights);
   };
   auto n1 = make_network(), n2 = make_network();
   const Timed na = render_neural(backend, f, *n1, f.spp), nb = render_neural(backend, f, *n2, f.spp);
@@ -289,7 +302,8 @@ bool check(const std::string& path) {
               ga.seconds, guided_rate * 1e-6, guided_vertex * 1e9, guided_vertex / unguided_vertex,
               static_cast<unsigned long long>(ga.counters.path.guided_samples));
   const double neural_vertex = na.seconds / double(na.counters.path.vertices);
-  std::printf("  neural (%u targets per tile, %u steps per pass):\n", n1->config().tile_targets, n1->config().steps_per_pass);
+  std::printf("  the network's settings: %u targets per tile, %u steps per pass\n", n1->config().tile_targets,
+              n1->config().steps_per_pass);
   std::printf("  neural:   %.2f s, %.2f Msamples/s, %.1f ns per path vertex (%.2fx unguided's, %.2fx the table's), "
               "training %.2f s (%.0f %%), %llu targets, %llu steps, %llu guided samples\n",
               na.seconds, samples / na.seconds * 1e-6, neural_vertex * 1e9, neural_vertex / unguided_vertex,
@@ -319,9 +333,9 @@ bool check(const std::string& path) {
     std::printf("  FAIL the dry run's two host neural renders differ\n"), ok = false;
   // Figures only (the dry run: briefly, to run the code).
   if (dry_run)
-    equal_time(backend, f, 4 * f.spp, {0.05, 0.1});
+    equal_time(backend, f, 4 * f.spp, {0.05, 0.1}, settings.network);
   else
-    equal_time(backend, f, 64 * f.spp, equal_time_budgets());
+    equal_time(backend, f, 64 * f.spp, settings.budgets, settings.network);
   return ok;
 }
 
@@ -335,10 +349,17 @@ int main(int argc, char** argv) {
     std::printf("usage: device_backend_on_device FIXTURE...\n");
     return 2;
   }
+  tessera::cuda_check::FigureSettings settings;
+  try {
+    settings = tessera::cuda_check::figure_settings();
+  } catch (const std::exception& e) {
+    std::printf("device_backend_on_device: %s\n", e.what());
+    return 2;
+  }
   bool ok = true;
   for (int i = 1; i < argc; ++i) {
     try {
-      ok &= tessera::cuda_check::check(argv[i]);
+      ok &= tessera::cuda_check::check(argv[i], settings);
     } catch (const std::exception& e) {
       std::printf("FAIL %s: %s\n", argv[i], e.what());
       ok = false;

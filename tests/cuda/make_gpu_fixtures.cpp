@@ -25,9 +25,9 @@ int main(int argc, char** argv) {
   }
   const std::string out = argv[1];
   const uint32_t spp = argc > 2 ? static_cast<uint32_t>(std::stoul(argv[2])) : 64;
-  int width = 128, height = 96;
-  if (argc > 3 && (std::sscanf(argv[3], "%dx%d", &width, &height) != 2 || width < 1 || height < 1 ||
-                   width > 8192 || height > 8192)) {
+  int width = 128, height = 96, used = -1;
+  if (argc > 3 && (std::sscanf(argv[3], "%dx%d%n", &width, &height, &used) != 2 || argv[3][used] != '\0' ||
+                   width < 1 || height < 1 || width > 8192 || height > 8192)) {
     std::fprintf(stderr, "make_gpu_fixtures: resolution '%s' is not WIDTHxHEIGHT (1 to 8192 each)\n", argv[3]);
     return 2;
   }
