@@ -62,11 +62,11 @@ void EmbreeScene::release() {
 void EmbreeScene::build(const SceneData& data) {
   scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
-  // Watertight traversal: Embree's default triangle test lets a ray that
-  // meets an edge pass between two triangles on some ISAs (on AVX2 without
-  // AVX-512, paths of an albedo-1 furnace left its closed sphere within 1000
-  // bounces: tests/render/furnace_test.cpp). A closed mesh that leaks light
-  // is a wrong picture; docs/backends.md gives robust mode's cost.
+  // Robust traversal: Embree's default triangle test lets a ray that meets
+  // an edge pass between two triangles on some ISAs (AVX2 without AVX-512):
+  // paths leave a closed albedo-1 sphere within 1000 bounces there
+  // (tests/render/furnace_test.cpp). A closed mesh that leaks light is a
+  // wrong picture; docs/backends.md gives robust mode's cost.
   rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
   const size_t nv = data.positions().size(), nt = data.num_triangles();
   if (nt > 0) {

@@ -138,7 +138,8 @@ Timed render_neural(DeviceBackend& backend, const GpuFixture& f, NeuralGuide& gu
 // What the environment asks of the figures (read once, before any render,
 // so that a typo costs no device time):
 //   TESSERA_GPU_NEURAL="TARGETS,STEPS": the network's targets per tile and
-//     Adam steps per pass (as --neural-targets and --neural-steps);
+//     Adam steps per pass (as --neural-targets and --neural-steps), for the
+//     network's checks as well as its figures;
 //   TESSERA_GPU_EQUAL_TIME="0.5,2,6": the equal-time budgets in seconds
 //     (default 0.5 and 2; a larger image fills the device and wants longer).
 struct FigureSettings {
@@ -150,9 +151,8 @@ FigureSettings figure_settings() {
   FigureSettings f;
   if (const char* env = std::getenv("TESSERA_GPU_NEURAL")) {
     unsigned long targets = 0, steps = 0;
-    int used = -1;
-    if (std::sscanf(env, "%lu,%lu%n", &targets, &steps, &used) != 2 || env[used] != '\0' || targets < 1 ||
-        targets > (1ul << 20) || steps < 1 || steps > 1024)
+    const char* p = env;
+    if (!read_count(&p, 1ul << 20, &targets) || *p++ != ',' || !read_count(&p, 1024, &steps) || *p != '\0')
       throw std::runtime_error(std::string("TESSERA_GPU_NEURAL: '") + env +
                                "' is not TARGETS,STEPS (targets 1 to 2^20, steps 1 to 1024)");
     f.network.tile_targets = static_cast<uint32_t>(targets);
@@ -190,16 +190,20 @@ double rel_mse(const Film& a, const Film& reference) {
 
 // Equal time on the device: unguided, the table and the network (training
 // included) for the same seconds, each against a long unguided reference.
-// The reference has a seed of its own: were its samples the unguided
-// render's first ones, that render's error would be understated by the
-// share of the reference it makes up.
+// The reference takes independent samples of a seed of its own (whatever
+// the fixture's sampler): were its samples the renders' own, their errors
+// would be understated (the unguided render's by the share of the
+// reference it makes up).
 void equal_time(DeviceBackend& backend, const GpuFixture& f, uint32_t ref_spp, const std::vector<double>& budgets,
                 const NeuralGuideConfig& network_config) {
-  GpuFixture other_seed = f;
-  other_seed.settings.seed = f.settings.seed ^ 0x9e3779b97f4a7c15ull;
-  other_seed.settings.sampler.seed = other_seed.settings.seed;
-  const Timed ref = render(backend, other_seed, nullptr, ref_spp, 0.0, 256);
-  std::printf("  equal time on the device, against %u spp unguided of another seed (%.1f s):\n", ref_spp, ref.seconds);
+  GpuFixture independent = f;
+  independent.settings.seed = f.settings.seed ^ 0x9e3779b97f4a7c15ull;
+  independent.settings.sampler = SamplerSetup{};
+  independent.settings.sampler.kind = SamplerKind::Independent;
+  independent.settings.sampler.seed = independent.settings.seed;
+  const Timed ref = render(backend, independent, nullptr, ref_spp, 0.0, 256);
+  std::printf("  equal time on the device, against %u spp unguided, independent samples of another seed (%.1f s):\n",
+              ref_spp, ref.seconds);
   for (const double seconds : budgets) {
     const Timed u = render(backend, f, nullptr, ~0u, seconds);
     GuideField table(GuideConfig{}, f.lo, f.hi, f.lights, f.max_emitted);

@@ -18,6 +18,22 @@
 
 namespace tessera::cuda_check {
 
+// Reads a decimal number in [1, max] at *p (digits only: no sign, no
+// space) and moves *p past it; false if there is none or it is out of
+// range. For the GPU check programs' arguments and settings.
+inline bool read_count(const char** p, unsigned long max, unsigned long* value) {
+  unsigned long v = 0;
+  const char* q = *p;
+  for (; *q >= '0' && *q <= '9'; ++q) {
+    v = v * 10 + static_cast<unsigned long>(*q - '0');
+    if (v > max) return false;
+  }
+  if (q == *p || v < 1) return false;
+  *p = q;
+  *value = v;
+  return true;
+}
+
 struct GpuFixture {
   std::string name;
   TileSettings settings;  // unguided; no guide view

@@ -24,10 +24,16 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string out = argv[1];
-  const uint32_t spp = argc > 2 ? static_cast<uint32_t>(std::stoul(argv[2])) : 64;
-  int width = 128, height = 96, used = -1;
-  if (argc > 3 && (std::sscanf(argv[3], "%dx%d%n", &width, &height, &used) != 2 || argv[3][used] != '\0' ||
-                   width < 1 || height < 1 || width > 8192 || height > 8192)) {
+  unsigned long spp_count = 64, width = 128, height = 96;
+  const char* p = argc > 2 ? argv[2] : "64";
+  if (!cuda_check::read_count(&p, 1ul << 20, &spp_count) || *p != '\0') {
+    std::fprintf(stderr, "make_gpu_fixtures: SPP '%s' is not a count from 1 to 2^20\n", argv[2]);
+    return 2;
+  }
+  const uint32_t spp = static_cast<uint32_t>(spp_count);
+  p = argc > 3 ? argv[3] : "128x96";
+  if (!cuda_check::read_count(&p, 8192, &width) || *p++ != 'x' || !cuda_check::read_count(&p, 8192, &height) ||
+      *p != '\0') {
     std::fprintf(stderr, "make_gpu_fixtures: resolution '%s' is not WIDTHxHEIGHT (1 to 8192 each)\n", argv[3]);
     return 2;
   }
@@ -35,8 +41,8 @@ int main(int argc, char** argv) {
   try {
     for (const char* name : {"cornell-box", "door-ajar"}) {
       SceneDesc desc = load_pbrt_file(std::string(TESSERA_SOURCE_DIR) + "/scenes/" + name + ".pbrt");
-      desc.film.xres = width;
-      desc.film.yres = height;
+      desc.film.xres = static_cast<int>(width);
+      desc.film.yres = static_cast<int>(height);
       const SceneData scene(std::move(desc));
       RenderOptions opt;
       opt.seed = 5;
