@@ -22,6 +22,10 @@ namespace {
 // that 2^19 - 1 saturated tiles still sum within int64.
 constexpr double kGradScale = 16777216.0;
 constexpr double kGradLimit = 17592186044416.0;
+// The hash-grid and output-layer words are quantised per target
+// (GradientSink): one saturates at 2^40 (a gradient of 2^16, counted), so
+// that 2^23 saturated targets at one entry still sum within int64.
+constexpr double kWordLimit = 1099511627776.0;
 constexpr double kLossScale = 1048576.0;
 constexpr double kLossLimit = 1e6;                 // per target, for the loss statistic only
 // |dL/d output| per target: a bound on what one firefly target moves, loose
@@ -55,39 +59,51 @@ inline int64_t to_fixed(double x) {
   return bits - 0x4338000000000000ll;
 }
 
-// Back through one hidden layer (weights input-major, w[i * outs + o]) for
-// one target: adds d_out x in to the weight gradient and d_out to the bias
-// gradient, and gives the gradient at its first d_ins inputs (W^T d_out),
-// zero where a ReLU input was not positive (relu) or as it is.
-void dense_backward(const float* w, const float* in, uint32_t ins, uint32_t outs, const float* d_out, float* gw,
-                    float* gb, uint32_t d_ins, bool relu, float* d_in) {
-  for (uint32_t i = 0; i < ins; ++i) {
-    float* row = gw + static_cast<size_t>(i) * outs;
-    for (uint32_t o = 0; o < outs; ++o) row[o] += d_out[o] * in[i];
-  }
-  for (uint32_t o = 0; o < outs; ++o) gb[o] += d_out[o];
-  for (uint32_t i = 0; i < d_ins; ++i) {
-    const float* col = w + static_cast<size_t>(i) * outs;
-    float acc = 0.f;
-    for (uint32_t o = 0; o < outs; ++o) acc += col[o] * d_out[o];
-    d_in[i] = !relu || in[i] > 0.f ? acc : 0.f;
-  }
-}
-
 }  // namespace
 
 // A training thread's sums: the fixed-point gradient (P words; zero outside
-// the dense hidden-layer block and `dirty`), the float gradient of the tile
-// it is on (all zero between tiles), and the round's statistics.
+// the dense hidden-layer block and `dirty`), the float gradient of the
+// hidden layers of the tile it is on (zero between tiles), and the round's
+// statistics.
 struct NeuralGuide::TrainScratch {
   struct Local {
     std::vector<int64_t> sum;
     std::vector<float> grad;
-    std::vector<uint32_t> touched;  // this tile's hash-grid and output-layer entries
-    std::vector<uint32_t> dirty;    // entries of `sum` outside the dense block made non-zero this round
+    std::vector<uint32_t> dirty;  // entries of `sum` outside the dense block made non-zero this round
     uint64_t loss = 0, count = 0, clamped = 0, nonfinite = 0;
   };
   tbb::enumerable_thread_specific<Local> locals;
+};
+
+// Where one tile's gradient goes. The hidden layers' block (dense: every
+// target reaches all of it) is summed in floats over the tile and quantised
+// once per tile by the round. The hash-grid and output-layer entries a
+// target reaches (a few hundred of tens of thousands) are quantised per
+// target into `words`, the training thread's fixed-point sums, `dirty`
+// listing the words it made non-zero: integer sums, which do not depend on
+// which thread added which target, without a second pass over a list of
+// the tile's entries. Without words (loss_and_gradient, the gradient check)
+// they are summed in `dense` as floats.
+struct NeuralGuide::GradientSink {
+  float* dense = nullptr;
+  int64_t* words = nullptr;
+  std::vector<uint32_t>* dirty = nullptr;
+  uint64_t clamped = 0;
+  void add(uint32_t k, float g) {
+    if (!words) {
+      dense[k] += g;
+      return;
+    }
+    double x = static_cast<double>(g) * kGradScale;  // finite: tile_gradient checked the target
+    if (!(std::fabs(x) <= kWordLimit)) {
+      ++clamped;
+      x = x > 0.0 ? kWordLimit : -kWordLimit;
+    }
+    const int64_t q = to_fixed(x);
+    if (q == 0) return;
+    if (words[k] == 0) dirty->push_back(k);
+    words[k] += q;
+  }
 };
 
 NeuralGuide::NeuralGuide(const NeuralGuideConfig& config, const Vec3& lo, const Vec3& hi, Float radiance_scale,
@@ -170,30 +186,29 @@ void NeuralGuide::views(GuideView* table, NeuralGuideView* neural) {
 uint32_t NeuralGuide::rounds() const { return 1 + (pass_targets_ > 0 ? config_.steps_per_pass : 0u); }
 
 double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& samples, uint32_t first, uint32_t stride,
-                                  std::vector<float>* grad, uint64_t* count, std::vector<uint32_t>* touched) const {
+                                  GradientSink* sink, uint64_t* count, uint64_t* nonfinite) const {
   const NeuralLayout L = layout();
   const uint32_t W = config_.width, O = L.outputs();
   const size_t n = samples.size();
   const size_t batch = n > first ? (n - first + stride - 1) / stride : 0;
-  *count = static_cast<uint64_t>(batch);
+  *count = 0;
   if (batch == 0) return 0.0;
   const NeuralGuideView v = view();
   const float scale = v.scale;
   const float* P = params_.data();
   const float *w1 = P + L.w1(), *b1 = P + L.b1(), *w2 = P + L.w2(), *b2 = P + L.b2(), *w3 = P + L.w3(),
               *b3 = P + L.b3();
-  float* G = grad->data();
-  float *gw1 = G + L.w1(), *gb1 = G + L.b1(), *gw2 = G + L.w2(), *gb2 = G + L.b2(), *gw3 = G + L.w3(),
-        *gb3 = G + L.b3();
+  float* G = sink->dense;
+  float *gw1 = G + L.w1(), *gb1 = G + L.b1(), *gw2 = G + L.w2(), *gb2 = G + L.b2();
   // One target at a time, forward and backward, every sum in a fixed order
   // (weights input-major: w[i * out + o]); the tile's gradient is the sum
   // over its targets in their order. Per-tile minibatches are a few targets
-  // (128 per tile over 32 steps: 4), too small for a matrix library's
+  // (256 per tile over 48 steps: 5), too small for a matrix library's
   // products to pay their packing (docs/neural-guide.md).
   Float x[kNeuralInputs], h1[kNeuralMaxWidth], h2[kNeuralMaxWidth], dh1[kNeuralMaxWidth], dh2[kNeuralMaxWidth];
   float dx[kNeuralEncoded];
   double loss = 0.0;
-  bool output_seen[kNeuralMaxOutputs] = {};
+  uint64_t used = 0;
   for (size_t b = 0; b < batch; ++b) {
     const NeuralTrainingSample& s = samples[first + b * stride];
     // The target, its bootstrapped part recomputed by the network as it is
@@ -213,26 +228,55 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
     neural_hidden_layer(w1, b1, x, kNeuralInputs, W, h1);
     neural_hidden_layer(w2, b2, h1, W, W, h2);
     const uint32_t bin = s.bin < O ? s.bin : 0u;  // a direction bin or a light
-    // The output layer's gradient is non-zero only in the outputs trained.
-    if (touched && !output_seen[bin]) {
-      output_seen[bin] = true;
-      for (uint32_t i = 0; i < W; ++i) touched->push_back(L.w3() + i * O + bin);
-      touched->push_back(L.b3() + bin);
-    }
     float o = b3[bin];
     for (uint32_t i = 0; i < W; ++i) o += w3[static_cast<size_t>(i) * O + bin] * h2[i];
     const float q = neural_exp(o);
     const float ts = t / scale;
     const float denom = q * q + kNeuralLossEps;
-    loss += std::min(static_cast<double>((q - ts) * (q - ts) / denom), kLossLimit);
+    const double target_loss = std::min(static_cast<double>((q - ts) * (q - ts) / denom), kLossLimit);
     const float go = std::clamp(2.f * (q - ts) * q / denom, -kGradClip, kGradClip);
+    // Back through the layers (weights input-major: a column of W^T is a
+    // row of w), nothing added yet: ReLU units that were not positive pass nothing.
+    for (uint32_t i = 0; i < W; ++i) dh2[i] = h2[i] > 0.f ? w3[static_cast<size_t>(i) * O + bin] * go : 0.f;
     for (uint32_t i = 0; i < W; ++i) {
-      gw3[static_cast<size_t>(i) * O + bin] += go * h2[i];
-      dh2[i] = h2[i] > 0.f ? w3[static_cast<size_t>(i) * O + bin] * go : 0.f;
+      const float* row = w2 + static_cast<size_t>(i) * W;
+      float acc = 0.f;
+      for (uint32_t k = 0; k < W; ++k) acc += row[k] * dh2[k];
+      dh1[i] = h1[i] > 0.f ? acc : 0.f;
     }
-    gb3[bin] += go;
-    dense_backward(w2, h1, W, W, dh2, gw2, gb2, W, true, dh1);
-    dense_backward(w1, x, kNeuralInputs, W, dh1, gw1, gb1, kNeuralEncoded, false, dx);  // to the encoding only
+    for (uint32_t i = 0; i < kNeuralEncoded; ++i) {  // to the encoding only, not the normal
+      const float* row = w1 + static_cast<size_t>(i) * W;
+      float acc = 0.f;
+      for (uint32_t k = 0; k < W; ++k) acc += row[k] * dh1[k];
+      dx[i] = acc;
+    }
+    // A NaN or Inf in anything the gradient is made of (a NaN target that
+    // got past the sinks, a NaN weight, an overflow) leaves this target out
+    // (counted): x * 0 is 0 exactly when x is finite.
+    float poison = go * 0.f + static_cast<float>(target_loss) * 0.f;
+    for (uint32_t i = 0; i < kNeuralInputs; ++i) poison += x[i] * 0.f;
+    for (uint32_t i = 0; i < W; ++i) poison += h1[i] * 0.f + h2[i] * 0.f + dh1[i] * 0.f + dh2[i] * 0.f;
+    for (uint32_t i = 0; i < kNeuralEncoded; ++i) poison += dx[i] * 0.f;
+    if (!(poison == 0.f)) {
+      ++*nonfinite;
+      continue;
+    }
+    loss += target_loss;
+    ++used;
+    // The output layer: only the trained output's entries.
+    for (uint32_t i = 0; i < W; ++i) sink->add(L.w3() + i * O + bin, go * h2[i]);
+    sink->add(L.b3() + bin, go);
+    // The hidden layers (dense: d_out x in, and d_out for the bias).
+    for (uint32_t i = 0; i < W; ++i) {
+      float* row = gw2 + static_cast<size_t>(i) * W;
+      for (uint32_t k = 0; k < W; ++k) row[k] += dh2[k] * h1[i];
+    }
+    for (uint32_t k = 0; k < W; ++k) gb2[k] += dh2[k];
+    for (uint32_t i = 0; i < kNeuralInputs; ++i) {
+      float* row = gw1 + static_cast<size_t>(i) * W;
+      for (uint32_t k = 0; k < W; ++k) row[k] += dh1[k] * x[i];
+    }
+    for (uint32_t k = 0; k < W; ++k) gb1[k] += dh1[k];
     // The encoding's gradient, scattered to the corners of each level.
     U8 entry[8];
     F8 weight[8];
@@ -240,21 +284,20 @@ double NeuralGuide::tile_gradient(const std::vector<NeuralTrainingSample>& sampl
     for (uint32_t l = 0; l < kNeuralLevels; ++l) {
       const uint32_t level_base = L.grid() + l * L.table_size() * kNeuralFeatures;
       for (uint32_t c = 0; c < 8; ++c)
-        for (uint32_t f = 0; f < kNeuralFeatures; ++f) {
-          const uint32_t k = level_base + entry[c][l] * kNeuralFeatures + f;
-          // An entry already non-zero in this tile is listed already.
-          if (touched && G[k] == 0.f) touched->push_back(k);
-          G[k] += weight[c][l] * dx[l * kNeuralFeatures + f];
-        }
+        for (uint32_t f = 0; f < kNeuralFeatures; ++f)
+          sink->add(level_base + entry[c][l] * kNeuralFeatures + f, weight[c][l] * dx[l * kNeuralFeatures + f]);
     }
   }
+  *count = used;
   return loss;
 }
 
 double NeuralGuide::loss_and_gradient(const std::vector<NeuralTrainingSample>& samples, std::vector<float>* grad) const {
   grad->assign(params_.size(), 0.f);
-  uint64_t count = 0;
-  const double loss = tile_gradient(samples, 0, 1, grad, &count);
+  GradientSink sink;
+  sink.dense = grad->data();
+  uint64_t count = 0, nonfinite = 0;
+  const double loss = tile_gradient(samples, 0, 1, &sink, &count, &nonfinite);
   if (count == 0) return 0.0;
   for (float& g : *grad) g /= static_cast<float>(count);
   return loss / static_cast<double>(count);
@@ -280,9 +323,9 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
   // One minibatch: every steps_per_pass-th target of each tile, from round - 1.
   const size_t P = params_.size();
   const uint32_t first = round - 1, stride = config_.steps_per_pass;
-  // A tile touches the hidden layers (dense), the output layer's entries
+  // A tile reaches the hidden layers (dense), the output layer's entries
   // of the outputs it trains and a few hash-grid entries: only those are
-  // quantised and cleared again, not every parameter per tile.
+  // quantised and added up, not every parameter per tile.
   const size_t layers = layout().w1(), hidden_end = layout().w3();
   using Local = TrainScratch::Local;
   if (!scratch_) scratch_ = std::make_shared<TrainScratch>();
@@ -300,21 +343,21 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
       local.sum.assign(P, 0);
       local.grad.assign(P, 0.f);
     }
-    local.touched.clear();
+    GradientSink sink;
+    sink.dense = local.grad.data();
+    sink.words = local.sum.data();
+    sink.dirty = &local.dirty;
     uint64_t count = 0;
-    const double loss = tile_gradient(pass_tiles_[i].samples, first, stride, &local.grad, &count, &local.touched);
-    // A tile whose gradient has a NaN or Inf adds nothing but a flag
-    // (counted): the step goes on with the other tiles, the same on every
-    // rank, as a tile's gradient does not depend on where it was computed.
+    const double loss = tile_gradient(pass_tiles_[i].samples, first, stride, &sink, &count, &local.nonfinite);
+    local.clamped += sink.clamped;
+    // The hidden layers' block, summed over the tile's targets: quantised
+    // once per tile, in a loop without branches (on vector lanes). Sums that
+    // overflowed (finite targets, enormous weights) are left out (counted).
     float* grad = local.grad.data();
     int64_t* sum = local.sum.data();
-    bool finite = std::isfinite(loss);
     uint32_t bad = 0;
     for (size_t k = layers; k < hidden_end; ++k) bad += !(std::fabs(grad[k]) <= std::numeric_limits<float>::max());
-    finite = finite && bad == 0;
-    for (size_t t = 0; finite && t < local.touched.size(); ++t) finite = std::isfinite(grad[local.touched[t]]);
-    // The hidden layers' dense block: a loop without branches, on vector lanes.
-    if (finite) {
+    if (bad == 0) {
       uint64_t clamped = 0;
       for (size_t k = layers; k < hidden_end; ++k) {
         const double g = static_cast<double>(grad[k]) * kGradScale;
@@ -325,27 +368,9 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
       local.clamped += clamped;
     } else {
       std::fill(grad + layers, grad + hidden_end, 0.f);
-    }
-    // The listed hash-grid and output-layer entries (each then cleared: a
-    // repeated entry adds nothing more).
-    for (uint32_t k : local.touched) {
-      const float gk = grad[k];
-      grad[k] = 0.f;
-      if (!finite || gk == 0.f) continue;
-      double g = static_cast<double>(gk) * kGradScale;
-      if (!(std::fabs(g) <= kGradLimit)) {
-        ++local.clamped;
-        g = g > 0.0 ? kGradLimit : -kGradLimit;
-      }
-      const int64_t q = to_fixed(g);
-      if (sum[k] == 0 && q != 0) local.dirty.push_back(k);
-      sum[k] += q;
+      ++local.nonfinite;
     }
     if (count == 0) return;
-    if (!finite) {
-      ++local.nonfinite;
-      return;
-    }
     local.loss += static_cast<uint64_t>(std::llround(loss * kLossScale));
     local.count += count;
   });

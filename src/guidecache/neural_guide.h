@@ -70,7 +70,7 @@ struct NeuralGuideStats {
   uint64_t rejected_large = 0;       // targets beyond max_target
   uint64_t dropped = 0;              // kept targets beyond a tile's buffer
   uint64_t gradient_clamped = 0;     // fixed-point gradient words saturated (per tile)
-  uint64_t nonfinite_gradients = 0;  // minibatch gradients with NaN/Inf (the step was skipped)
+  uint64_t nonfinite_gradients = 0;  // targets whose gradient had a NaN or Inf (left out of their step)
   double loss = 0.0;                 // mean loss of the last pass's minibatches
   std::vector<double> pass_loss;     // the same, per learning pass
   double train_seconds = 0.0;        // this process: gradients and steps
@@ -133,12 +133,14 @@ class NeuralGuide final : public Guide {
  private:
   void init_params();
   void build_bin_dirs();
+  // Where tile_gradient puts a tile's gradient (defined in neural_guide.cpp).
+  struct GradientSink;
   // Adds the loss gradient of the given targets of one tile (every
-  // `stride`-th from `first`) to grad; returns the loss sum.
-  // The hash-grid and output-layer entries it adds to are appended to
-  // *touched (when given; repeats possible); the hidden layers' block is dense.
+  // `stride`-th from `first`) to *sink; returns the loss sum over the
+  // targets used (*count of them; a target whose gradient has a NaN or Inf
+  // adds nothing and is counted in *nonfinite).
   double tile_gradient(const std::vector<NeuralTrainingSample>& samples, uint32_t first, uint32_t stride,
-                       std::vector<float>* grad, uint64_t* count, std::vector<uint32_t>* touched = nullptr) const;
+                       GradientSink* sink, uint64_t* count, uint64_t* nonfinite) const;
   void adam_step(uint64_t count);
 
   NeuralGuideConfig config_;

@@ -441,8 +441,9 @@ TEST(NeuralGuide, NonFiniteAndHugeTargetsAreRejectedAndCounted) {
   EXPECT_EQ(g.stats().steps, 8u);
   for (float p : g.params()) ASSERT_TRUE(std::isfinite(p));
   // A NaN that got past the sink (or a NaN weight of the first two
-  // layers; a NaN bias is zeroed by the ReLU) poisons its tile's gradient in one round: that tile is left out of that step
-  // (counted), the other tile still trains.
+  // layers; a NaN bias is zeroed by the ReLU) poisons its target's
+  // gradient: that target is left out of its step (counted), the rest of
+  // its tile and the other tile still train.
   std::vector<NeuralTrainingSample> poisoned = random_samples(64, 10, 1.f);
   poisoned[5].target = std::nanf("");
   g.train_on({{0, poisoned}, {1, random_samples(64, 11, 1.f)}});
