@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <thread>
 #include <vector>
 
@@ -51,6 +52,17 @@ uint32_t pass_spp_for(uint32_t pass, uint32_t max_pass_spp, uint32_t single_pass
   if (pass < single_passes) return 1;
   if (single_passes > 0) pass = pass - single_passes + 2;  // then 2, 4, ...
   return std::min<uint32_t>(max_pass_spp, pass == 0 ? 1u : (1u << std::min(pass - 1, 20u)));
+}
+
+uint32_t pass_spp_within_budget(uint32_t planned, double left_s, const PassStats& last) {
+  if (!(left_s > 0.0)) return 0;
+  if (last.spp == 0 || !(last.seconds > 0.0)) return planned;  // nothing measured to go by
+  const double learning = std::clamp(last.guide_seconds, 0.0, last.seconds);
+  const double per_spp = (last.seconds - learning) / static_cast<double>(last.spp);
+  if (learning + per_spp * static_cast<double>(planned) <= left_s) return planned;
+  if (!(per_spp > 0.0)) return 0;  // the learning alone does not fit
+  const double fit = std::floor((left_s - learning) / per_spp);
+  return fit >= 1.0 ? static_cast<uint32_t>(std::min(fit, static_cast<double>(planned))) : 0u;
 }
 
 namespace {
@@ -177,12 +189,19 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
       stats.stop_reason = "target-error";
       break;
     }
-    if (opt.time_budget_s > 0 && pass > 0 && elapsed() + last_pass_s > opt.time_budget_s) {
-      stats.stop_reason = "time";
-      break;
-    }
     uint32_t pass_spp = pass_spp_for(pass, opt.max_pass_spp, single_passes);
     if (opt.spp > 0) pass_spp = std::min(pass_spp, opt.spp - spp_done);
+    if (opt.time_budget_s > 0 && pass > 0) {
+      const double left = opt.time_budget_s - elapsed();
+      if (!stats.pass_stats.empty())
+        pass_spp = pass_spp_within_budget(pass_spp, left, stats.pass_stats.back());
+      else if (last_pass_s > left)
+        pass_spp = 0;
+      if (pass_spp == 0) {
+        stats.stop_reason = "time";
+        break;
+      }
+    }
     const double pass_start = elapsed();
     const TileCounters before = stats.counters;
     double pass_loss = -1.0, pass_guide_seconds = 0.0;

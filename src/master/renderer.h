@@ -21,7 +21,7 @@ namespace tessera {
 
 struct RenderOptions {
   uint32_t spp = 16;            // 0 = unlimited (then time_budget_s must be set)
-  double time_budget_s = 0.0;   // 0 = none; whole passes are rendered until it is spent
+  double time_budget_s = 0.0;   // 0 = none; passes are rendered until it is spent (pass_spp_within_budget)
   double target_error = 0.0;    // 0 = none; stop after the first pass whose estimated relMSE is <= this
   int32_t max_depth = 5;
   bool nee = true;
@@ -114,6 +114,13 @@ int32_t render_threads(const RenderOptions& options, int32_t ranks_on_this_machi
 // passes in which every sample learns, up to 64). Depends on the pass index and the
 // options only, so a resumed render continues the same schedule.
 uint32_t pass_spp_for(uint32_t pass, uint32_t max_pass_spp, uint32_t single_passes = 0);
+
+// Samples per pixel of the next pass under a time budget with left_s
+// seconds left: the schedule's `planned` where it is expected to fit,
+// else as many as are (at the last pass's rendering time per sample per
+// pixel, plus its learning between passes), else 0: stop. A --time render
+// then ends close to its budget, not up to a whole pass short of it.
+uint32_t pass_spp_within_budget(uint32_t planned, double left_s, const PassStats& last);
 
 // Renders one pass of tiles and combines the guide's learning.
 class PassExecutor {

@@ -141,5 +141,31 @@ TEST_F(TargetError, ResumedRenderStopsWhereAnUninterruptedOneDoes) {
   EXPECT_EQ(again.stats.passes, whole.stats.passes);
 }
 
+// Under --time the next pass is the schedule's where it fits, else cut to
+// the samples that fit (the last pass's rendering time per sample per
+// pixel plus its learning), else the render stops.
+TEST(TimeBudget, NextPassIsCutToTheTimeLeft) {
+  PassStats last;
+  last.spp = 8;
+  last.seconds = 1.0;       // 0.1 s per spp rendering, then 0.2 s learning
+  last.guide_seconds = 0.2;
+  EXPECT_EQ(pass_spp_within_budget(8, 5.0, last), 8u);
+  EXPECT_EQ(pass_spp_within_budget(8, 1.0 + 1e-9, last), 8u);
+  EXPECT_EQ(pass_spp_within_budget(8, 0.75, last), 5u);   // 0.2 + 5 x 0.1 <= 0.75 < 0.2 + 6 x 0.1
+  EXPECT_EQ(pass_spp_within_budget(8, 0.31, last), 1u);
+  EXPECT_EQ(pass_spp_within_budget(8, 0.29, last), 0u);
+  EXPECT_EQ(pass_spp_within_budget(8, 0.0, last), 0u);
+  EXPECT_EQ(pass_spp_within_budget(8, -1.0, last), 0u);
+  EXPECT_EQ(pass_spp_within_budget(1, 0.31, last), 1u);
+  EXPECT_EQ(pass_spp_within_budget(1, 0.29, last), 0u);
+  // A pass that was all learning (or a clock that did not move): nothing
+  // to scale, so the next pass runs whole while the learning fits.
+  last.guide_seconds = 2.0;
+  EXPECT_EQ(pass_spp_within_budget(8, 1.5, last), 8u);
+  EXPECT_EQ(pass_spp_within_budget(8, 0.5, last), 0u);
+  PassStats unmeasured;
+  EXPECT_EQ(pass_spp_within_budget(8, 0.5, unmeasured), 8u);
+}
+
 }  // namespace
 }  // namespace tessera
