@@ -536,7 +536,7 @@ CommandRunner add_render_command(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "embree", "bvh", "cuda", "emulated-device"}));
   c->add_option("-o,--output", a->output, "Output EXR (default: the scene's Film filename in the current directory)");
   c->add_option("--spp", a->spp, "Samples per pixel (overrides the scene's Sampler)")->check(CLI::Range(0, 1 << 30));
-  c->add_option("--time", a->time, "Time budget in seconds: render whole passes until it is spent")->check(positive_number());
+  c->add_option("--time", a->time, "Time budget in seconds: render passes until it is spent, the last cut to the samples that fit")->check(positive_number());
   c->add_option("--target-error", a->target_error,
                  "Stop after the first pass whose estimated relMSE is at or below this (with --time or --spp: whichever comes first)")
       ->check(positive_number());

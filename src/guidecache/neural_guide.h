@@ -13,8 +13,9 @@
 // statistics (the first one sets the output scale); each of the next
 // `steps_per_pass` rounds sums the gradient of one minibatch (every
 // steps_per_pass-th target of each tile), computed tile by tile and
-// quantised to 64-bit fixed point per tile, so that the sum is the same
-// whichever rank (or thread) rendered which tile. Every rank then applies
+// quantised to 64-bit fixed point (the hidden layers per tile, the entries
+// a target reaches outside them per target), so that the integer sum is the
+// same whichever rank (or thread) rendered which tile. Every rank then applies
 // the same Adam step to the same sums: weights stay equal everywhere, and a
 // farm's image equals a single process's bit for bit.
 #pragma once
@@ -69,7 +70,7 @@ struct NeuralGuideStats {
   uint64_t rejected_nonfinite = 0;   // NaN/Inf/negative targets
   uint64_t rejected_large = 0;       // targets beyond max_target
   uint64_t dropped = 0;              // kept targets beyond a tile's buffer
-  uint64_t gradient_clamped = 0;     // fixed-point gradient words saturated (per tile)
+  uint64_t gradient_clamped = 0;     // fixed-point gradient words saturated (hidden layers per tile, others per target)
   uint64_t nonfinite_gradients = 0;  // targets whose gradient had a NaN or Inf (left out of their step)
   double loss = 0.0;                 // mean loss of the last pass's minibatches
   std::vector<double> pass_loss;     // the same, per learning pass

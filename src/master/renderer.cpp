@@ -175,7 +175,6 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
   const uint32_t single_passes =
       guide && guide->single_sample_learning_passes() ? std::min(opt.guide_learn.all_spp, 64u) : 0u;
   uint32_t spp_done = stats.spp;
-  double last_pass_s = stats.pass_stats.empty() ? 0.0 : stats.pass_stats.back().seconds;
   for (uint32_t pass = stats.passes;; ++pass) {
     if (interrupt_requested()) {
       stats.stop_reason = "interrupted";
@@ -191,12 +190,17 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     }
     uint32_t pass_spp = pass_spp_for(pass, opt.max_pass_spp, single_passes);
     if (opt.spp > 0) pass_spp = std::min(pass_spp, opt.spp - spp_done);
+    const TrialPass trial_pass = guide_trial_next_pass(stats.guide_trial, spp_done);
     if (opt.time_budget_s > 0 && pass > 0) {
       const double left = opt.time_budget_s - elapsed();
+      const uint32_t planned = pass_spp;
       if (!stats.pass_stats.empty())
         pass_spp = pass_spp_within_budget(pass_spp, left, stats.pass_stats.back());
-      else if (last_pass_s > left)
+      else if (!(left > 0.0))
         pass_spp = 0;
+      // A trial pass measures its error per sample from each pixel's own
+      // samples: cut below two it would measure nothing.
+      if (trial_pass != TrialPass::None && pass_spp < planned && pass_spp < 2) pass_spp = 0;
       if (pass_spp == 0) {
         stats.stop_reason = "time";
         break;
@@ -206,7 +210,6 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     const TileCounters before = stats.counters;
     double pass_loss = -1.0, pass_guide_seconds = 0.0;
     // Guided unless this is an unguided trial pass or the trial switched guiding off.
-    const TrialPass trial_pass = guide_trial_next_pass(stats.guide_trial, spp_done);
     const bool guided = guide && trial_pass != TrialPass::Unguided &&
                         stats.guide_trial.state != GuideTrialState::SwitchedOff;
     TileSettings pass_settings = settings;
@@ -244,7 +247,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     }
     spp_done += pass_spp;
     ++stats.passes;
-    last_pass_s = elapsed() - pass_start;
+    const double last_pass_s = elapsed() - pass_start;
     PassStats ps;
     ps.spp = pass_spp;
     ps.seconds = last_pass_s;

@@ -120,6 +120,54 @@ TEST(NeuralGuide, GradientMatchesFiniteDifferences) {
   EXPECT_GE(compared, 16u);
 }
 
+// What a round adds up (the per-tile fixed point of the hidden layers, the
+// per-target words of everything else) is the float gradient of
+// loss_and_gradient, which the test above checks: every parameter's word
+// within the rounding of its targets. A NaN target is left out alone.
+TEST(NeuralGuide, RoundSumsAreTheGradientInFixedPoint) {
+  NeuralGuideConfig c = small_config();
+  c.steps_per_pass = 1;  // one minibatch: every target
+  NeuralGuide g = make(c, 4);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+  const NeuralLayout L = g.layout();
+  for (uint32_t i = L.grid(); i < L.w1(); ++i) g.mutable_params()[i] = u(rng);
+  std::vector<NeuralTrainingSample> samples = random_samples(40, 7, 1.f);
+  for (size_t i = 0; i < samples.size(); i += 5) samples[i].bin = kNeuralBins + static_cast<uint32_t>(i / 5) % 4;
+  const size_t n = samples.size(), P = g.params().size();
+  auto round_sums = [&](NeuralGuide& guide, std::vector<NeuralTrainingSample>& s) {
+    NeuralSampleSink sink;
+    sink.data = s.data();
+    sink.count = static_cast<uint32_t>(s.size());
+    guide.training_log()->add_tile(sink);
+    guide.round_accumulators(0);
+    guide.fold_round(0);  // sets the output scale
+    return guide.round_accumulators(1);
+  };
+  const std::vector<uint64_t> acc = round_sums(g, samples);
+  ASSERT_EQ(acc.size(), P + 4);
+  EXPECT_EQ(acc[P + 1], n);  // targets used
+  EXPECT_EQ(acc[P + 3], 0u);
+  std::vector<float> grad;
+  g.loss_and_gradient(samples, &grad);  // the mean: times n below
+  uint32_t nonzero = 0;
+  for (size_t k = 0; k < P; ++k) {
+    const double fixed = static_cast<double>(static_cast<int64_t>(acc[k])) / 16777216.0;
+    const double exact = static_cast<double>(grad[k]) * static_cast<double>(n);
+    ASSERT_NEAR(fixed, exact, static_cast<double>(n) / 16777216.0 + 1e-4 + 1e-5 * std::fabs(exact)) << "parameter " << k;
+    nonzero += acc[k] != 0;
+  }
+  EXPECT_GT(nonzero, 1000u);  // the hidden layers, 40 targets' hash-grid and output entries
+
+  NeuralGuide h = make(c, 4);
+  h.mutable_params() = g.params();
+  std::vector<NeuralTrainingSample> poisoned = samples;
+  poisoned[7].target = std::nanf("");
+  const std::vector<uint64_t> left = round_sums(h, poisoned);
+  EXPECT_EQ(left[P + 1], n - 1);
+  EXPECT_EQ(left[P + 3], 1u);
+}
+
 // One bright direction everywhere: radiance 1 from bin kBright, 0.01 from
 // every other. After training, the network predicts the bright bin within
 // 10 % at points it never saw, the others at 0.01 within 50 % on average

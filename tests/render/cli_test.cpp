@@ -206,7 +206,7 @@ TEST_F(CliTest, ExrHasVarianceLayerAndMetadata) {
   EXPECT_NE(h.findTypedAttribute<Imf::StringAttribute>("software"), nullptr);
 }
 
-TEST_F(CliTest, TimeBudgetStopsAfterWholePasses) {
+TEST_F(CliTest, TimeBudgetStopsTheRender) {
   std::string stats = (dir_ / "t.json").string();
   RunResult r = run("render -q --res 32x32 --time 0.5 -o " + (dir_ / "t.exr").string() + " --stats " + stats);
   ASSERT_EQ(r.exit_code, 0) << r.output;
