@@ -72,15 +72,21 @@ double frozen_loss(const NeuralGuide& g, const std::vector<NeuralTrainingSample>
   return sum / static_cast<double>(s.size());
 }
 
-TEST(NeuralGuide, GradientMatchesFiniteDifferences) {
-  NeuralGuide g = make(small_config(), 4);  // with four light outputs
-  ASSERT_EQ(g.learned_lights(), 4u);
-  g.set_output_scale(1.f);
-  // Larger hash features than the initial ones, so their gradients are not all tiny.
+// Hash features larger than the initial ones, so that their gradients are
+// not all tiny.
+void randomise_hash_features(NeuralGuide& g) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-0.5f, 0.5f);
   const NeuralLayout L = g.layout();
   for (uint32_t i = L.grid(); i < L.w1(); ++i) g.mutable_params()[i] = u(rng);
+}
+
+TEST(NeuralGuide, GradientMatchesFiniteDifferences) {
+  NeuralGuide g = make(small_config(), 4);  // with four light outputs
+  ASSERT_EQ(g.learned_lights(), 4u);
+  g.set_output_scale(1.f);
+  randomise_hash_features(g);
+  const NeuralLayout L = g.layout();
   // Targets near the predictions: the per-target gradient is not clipped.
   std::vector<NeuralTrainingSample> samples = random_samples(12, 5, 1.f);
   for (size_t i = 0; i < samples.size(); i += 3) samples[i].bin = kNeuralBins + static_cast<uint32_t>(i / 3) % 4;
@@ -128,10 +134,7 @@ TEST(NeuralGuide, RoundSumsAreTheGradientInFixedPoint) {
   NeuralGuideConfig c = small_config();
   c.steps_per_pass = 1;  // one minibatch: every target
   NeuralGuide g = make(c, 4);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<float> u(-0.5f, 0.5f);
-  const NeuralLayout L = g.layout();
-  for (uint32_t i = L.grid(); i < L.w1(); ++i) g.mutable_params()[i] = u(rng);
+  randomise_hash_features(g);
   std::vector<NeuralTrainingSample> samples = random_samples(40, 7, 1.f);
   for (size_t i = 0; i < samples.size(); i += 5) samples[i].bin = kNeuralBins + static_cast<uint32_t>(i / 5) % 4;
   const size_t n = samples.size(), P = g.params().size();
