@@ -194,10 +194,8 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     if (opt.time_budget_s > 0 && pass > 0) {
       const double left = opt.time_budget_s - elapsed();
       const uint32_t planned = pass_spp;
-      if (!stats.pass_stats.empty())
-        pass_spp = pass_spp_within_budget(pass_spp, left, stats.pass_stats.back());
-      else if (!(left > 0.0))
-        pass_spp = 0;
+      // No pass measured yet (a resume without pass stats): the schedule's, while time is left.
+      pass_spp = pass_spp_within_budget(pass_spp, left, stats.pass_stats.empty() ? PassStats{} : stats.pass_stats.back());
       // A trial pass measures its error per sample from each pixel's own
       // samples: cut below two it would measure nothing.
       if (trial_pass != TrialPass::None && pass_spp < planned && pass_spp < 2) pass_spp = 0;
