@@ -20,8 +20,10 @@ uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& o
   uint32_t spec = specialisation_for(scene.effects());
   if (options.force_full_specialisation) spec = (kSpecSurfaceAll & ~kSpecGuiding) | (spec & kSpecMedia);
   if (!guide) return spec;
-  // The network runs the full surface integrator (instantiated_spec): the log and stats say so.
-  if (guide->spec_bits() & kSpecNeural) spec = kSpecSurfaceAll | (spec & kSpecMedia);
+  // The network runs the full surface integrator, or in scenes of Lambertian
+  // surfaces and area lights alone one of its own (instantiated_spec): the log and stats say which.
+  if ((guide->spec_bits() & kSpecNeural) && (spec & (kSpecMedia | kSpecSurfaceAll)) != kSpecAreaLights)
+    spec = kSpecSurfaceAll | (spec & kSpecMedia);
   return spec | guide->spec_bits();
 }
 
