@@ -169,8 +169,13 @@ struct NeuralSite {
   Float q[kNeuralMaxOutputs];
   uint32_t skipped = 0;
   Float h2[kNeuralMaxWidth];  // the last hidden layer: a skipped bin's Q is one output from it
-  Float pmf[kNeuralBins];    // guided distribution per bin (floor included)
-  // Inclusive running sum of the tiles' pmf (kNeuralTile bins each), the
+  // The guided distribution per bin, before normalisation: Q x max(cos, 0)
+  // (0 in skipped tiles). A bin's probability is weight x pmf_scale +
+  // pmf_floor (read it through neural_site_pmf): normalised when read, not
+  // for all 144 bins at every vertex.
+  Float weight[kNeuralBins];
+  Float pmf_scale = 0.f, pmf_floor = 0.f;
+  // Inclusive running sum of the tiles' probabilities (kNeuralTile bins each), the
   // last 1: built by the first sample (neural_build_cdf).
   Float tile_cdf[kNeuralTiles];
   bool has_cdf = false;
@@ -186,18 +191,22 @@ struct NeuralSite {
 };
 
 // e^x for the network's outputs, clamped to [kNeuralMinLog, kNeuralMaxLog]:
-// x = n ln2 + f with |f| <= ln2 / 2, e^f by its Taylor series to degree 6
-// (relative error below 1e-6 over the range), 2^n from the exponent bits.
-// A loop over bins of it vectorises, which libm's expf does not (it was
-// most of an inference), and it is the same function on every machine.
+// t = x log2(e) = n + f with |f| <= 1/2, 2^f by a degree-5 polynomial
+// (minimax for relative error, fitted for this; below 2e-7 in float, and
+// below 2e-6 for e^x over the whole range, where rounding t dominates),
+// 2^n from the exponent bits. A loop over bins of it vectorises, which
+// libm's expf does not, and it is the same function on every machine. The
+// reduction in base 2 needs no n ln2 product, and the polynomial is a
+// degree lower than e^f's Taylor series of equal accuracy.
 TESSERA_HOST_DEVICE inline Float neural_exp(Float x) {
   x = x > kNeuralMinLog ? x : kNeuralMinLog;  // selects, not branches (NaN -> the minimum)
   x = x < kNeuralMaxLog ? x : kNeuralMaxLog;
-  // round(log2(e) x): truncation of a positive number (offset by 128) is its floor.
-  const int32_t n = static_cast<int32_t>(x * 1.44269504f + 128.5f) - 128;
-  const Float f = x - static_cast<Float>(n) * 0.693147181f;
+  const Float t = x * 1.44269504f;
+  // round(t): truncation of a positive number (offset by 128) is its floor.
+  const int32_t n = static_cast<int32_t>(t + 128.5f) - 128;
+  const Float f = t - static_cast<Float>(n);
   const Float p =
-      1.f + f * (1.f + f * (0.5f + f * (1.f / 6.f + f * (1.f / 24.f + f * (1.f / 120.f + f * (1.f / 720.f))))));
+      1.f + f * (0.693147004f + f * (0.240222424f + f * (0.0555073358f + f * (0.00967151299f + f * 0.00132647203f))));
   const uint32_t bits = static_cast<uint32_t>(n + 127) << 23;
   Float scale;
   memcpy(&scale, &bits, sizeof scale);
@@ -209,9 +218,11 @@ TESSERA_LANES_FN F8 neural_exp8(F8 x) {
   const F8 lo = lanes_splat(kNeuralMinLog), hi = lanes_splat(kNeuralMaxLog);
   x = lanes_select_gt(x, lo, x, lo);
   x = lanes_select_gt(hi, x, x, hi);
-  const I8 n = lanes_trunc_i(x * 1.44269504f + 128.5f) - 128;
-  const F8 f = x - lanes_float_i(n) * 0.693147181f;
-  const F8 p = 1.f + f * (1.f + f * (0.5f + f * (1.f / 6.f + f * (1.f / 24.f + f * (1.f / 120.f + f * (1.f / 720.f))))));
+  const F8 t = x * 1.44269504f;
+  const I8 n = lanes_trunc_i(t + 128.5f) - 128;
+  const F8 f = t - lanes_float_i(n);
+  const F8 p =
+      1.f + f * (0.693147004f + f * (0.240222424f + f * (0.0555073358f + f * (0.00967151299f + f * 0.00132647203f))));
   return p * lanes_bits_to_float(lanes_u(n + 127) << 23u);
 }
 
@@ -422,13 +433,13 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   const float* w3 = v.params + L.w3();
   const float* b3 = v.params + L.b3();
   Float* q = site->q;
-  Float* pmf = site->pmf;
+  Float* pmf = site->weight;
   const Float* dx = v.bin_dir_soa;
   const Float* dy = dx + kNeuralBins;
   const Float* dz = dy + kNeuralBins;
   const Float nx = n.x, ny = n.y, nz = n.z;
   const F8 scale = lanes_splat(v.scale), zero = lanes_splat(0.f);
-  // max(cos, 0) per bin into pmf (the weights overwrite it), and the blocks to compute.
+  // max(cos, 0) per bin into the weights (Q x it overwrites them), and the blocks to compute.
   uint32_t active[kBlocks], count = 0, skipped = 0;
   for (uint32_t b = 0; b < kBlocks; ++b) {
     const uint32_t j = b * kLanes8;
@@ -487,8 +498,14 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
   const Float floor = glm::clamp(v.floor, 0.f, 1.f);
   const Float uniform = total > 0.f ? floor / static_cast<Float>(kNeuralBins) : 1.f / static_cast<Float>(kNeuralBins);
   const Float w = total > 0.f ? (1.f - floor) / total : 0.f;
-  for (uint32_t j = 0; j < kNeuralBins; ++j) pmf[j] = pmf[j] * w + uniform;
+  site->pmf_scale = w;
+  site->pmf_floor = uniform;
   neural_light_distribution(v, site);
+}
+
+// Bin j's probability in the site's guided distribution (floor included).
+TESSERA_HOST_DEVICE inline Float neural_site_pmf(const NeuralSite& site, uint32_t j) {
+  return site.weight[j] * site.pmf_scale + site.pmf_floor;
 }
 
 // The site's cdf over tiles of bins, built once per vertex by the first
@@ -498,7 +515,7 @@ TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec
 TESSERA_HOST_DEVICE inline void neural_build_cdf(NeuralSite* site) {
   Float tile[kNeuralTiles] = {};
   for (uint32_t k = 0; k < kNeuralTile; ++k)
-    for (uint32_t t = 0; t < kNeuralTiles; ++t) tile[t] += site->pmf[t * kNeuralTile + k];
+    for (uint32_t t = 0; t < kNeuralTiles; ++t) tile[t] += neural_site_pmf(*site, t * kNeuralTile + k);
   Float acc = 0.f;
   for (uint32_t t = 0; t < kNeuralTiles; ++t) {
     acc += tile[t];
@@ -586,7 +603,7 @@ TESSERA_HOST_DEVICE inline uint32_t neural_bin_of(const Vec3& dir) {
 }
 
 TESSERA_HOST_DEVICE inline Float neural_bin_pdf(const NeuralSite& site, uint32_t bin) {
-  return site.pmf[bin] * (static_cast<Float>(kNeuralBins) * kInv4Pi);
+  return neural_site_pmf(site, bin) * (static_cast<Float>(kNeuralBins) * kInv4Pi);
 }
 
 // Draws a bin from the site's cdf (u_bin) and a direction uniformly within it (u).
@@ -598,12 +615,12 @@ TESSERA_HOST_DEVICE inline bool neural_sample(NeuralSite& site, Float u_bin, Vec
   // Then the bin where the running sum within the tile passes what is left
   // of u_bin (the tile's last bin takes the rounding).
   const Float t = u_bin - (tile > 0 ? site.tile_cdf[tile - 1] : 0.f);
-  const Float* p = site.pmf + tile * kNeuralTile;
+  const uint32_t first = tile * kNeuralTile;
   uint32_t k = 0;
-  Float acc = p[0];
-  while (k + 1 < kNeuralTile && !(acc > t)) acc += p[++k];
-  const uint32_t bin = tile * kNeuralTile + k;
-  if (!(site.pmf[bin] > 0.f)) return false;
+  Float acc = neural_site_pmf(site, first);
+  while (k + 1 < kNeuralTile && !(acc > t)) acc += neural_site_pmf(site, first + ++k);
+  const uint32_t bin = first + k;
+  if (!(neural_site_pmf(site, bin) > 0.f)) return false;
   const Float inv_grid = 1.f / static_cast<Float>(kNeuralGrid);
   *dir = equal_area_square_to_sphere(Vec2((static_cast<Float>(neural_bin_col(bin)) + u.x) * inv_grid,
                                           (static_cast<Float>(neural_bin_row(bin)) + u.y) * inv_grid));

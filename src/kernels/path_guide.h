@@ -167,7 +167,7 @@ struct NeuralPathGuide {
     const Float u = rng.uniform();
     if (!neural_sample(y, u, Vec2(0.5f), &dir, &pdf, &j)) return 0.f;
     const Vec3 wi = to_local(v.bin_dirs[j]);
-    const Float pmf = y.pmf[j];
+    const Float pmf = neural_site_pmf(y, j);
     const Float coef =
         luminance(bsdf_eval(b, wo_local, wi)) * fabsf(wi.z) * (4.f * kPi / static_cast<Float>(kNeuralBins)) / pmf;
     // Q is read only where it counts (a bin the BSDF does not reach need not be computed).

@@ -169,7 +169,7 @@ TESSERA_HOST_DEVICE void run_neural_case(const NeuralGuideView& v, const Vec3& p
   neural_infer(v, p, n, &site);
   uint32_t k = 0;
   for (uint32_t j = 0; j < kNeuralBins + kNeuralCheckLights; ++j) out[k++] = neural_site_q(v, site, j);
-  for (uint32_t j = 0; j < kNeuralBins; ++j) out[k++] = site.pmf[j];
+  for (uint32_t j = 0; j < kNeuralBins; ++j) out[k++] = neural_site_pmf(site, j);
   out[k++] = site.irradiance;
   out[k++] = site.qmax;
   for (uint32_t j = 0; j < kNeuralCheckLights; ++j) out[k++] = site.light_pmf[j];

@@ -203,7 +203,7 @@ TEST(NeuralGuide, LearnsASingleBrightDirection) {
         EXPECT_LT(neural_site_q(v, site, j), 0.05) << "bin " << j;
       }
     }
-    EXPECT_GT(site.pmf[kBright], 0.5f);
+    EXPECT_GT(neural_site_pmf(site, kBright), 0.5f);
   }
 }
 
@@ -525,7 +525,9 @@ TEST(NeuralGuide, AvxAndPortableInferenceAgreeBitForBit) {
       const Float qa = neural_site_q(v, a, j), qb = neural_site_q(v, b, j);
       ASSERT_EQ(std::memcmp(&qa, &qb, sizeof qa), 0) << i << " output " << j;
     }
-    ASSERT_EQ(std::memcmp(a.pmf, b.pmf, sizeof a.pmf), 0) << i;
+    ASSERT_EQ(std::memcmp(a.weight, b.weight, sizeof a.weight), 0) << i;
+    ASSERT_EQ(std::memcmp(&a.pmf_scale, &b.pmf_scale, sizeof a.pmf_scale), 0) << i;
+    ASSERT_EQ(std::memcmp(&a.pmf_floor, &b.pmf_floor, sizeof a.pmf_floor), 0) << i;
     ASSERT_EQ(a.light_prob, b.light_prob);
     ASSERT_GT(a.light_prob, 0.f);
     ASSERT_EQ(std::memcmp(a.light_pmf, b.light_pmf, sizeof(Float) * 4), 0) << i;
@@ -627,7 +629,7 @@ TEST(NeuralGuide, LaneInferenceEqualsThePlainDefinition) {
       }
       ASSERT_EQ(site.qmax, qmax);
       const float uniform = v.floor / static_cast<float>(kNeuralBins), w = (1.f - v.floor) / total;
-      for (uint32_t j = 0; j < kNeuralBins; ++j) ASSERT_EQ(site.pmf[j], weighted[j] * w + uniform) << j;
+      for (uint32_t j = 0; j < kNeuralBins; ++j) ASSERT_EQ(neural_site_pmf(site, j), weighted[j] * w + uniform) << j;
     }
   }
   // Random normals leave some blocks wholly below the surface: the skipping was exercised.
@@ -659,6 +661,22 @@ TEST(NeuralGuide, LaneCornersEqualEachLevelsCorners) {
       }
     }
   }
+}
+
+// neural_exp is e^x within 2e-6 (relative) over the clamped range, and the
+// clamp's value beyond it.
+TEST(NeuralGuide, ExpIsExpWithinItsStatedError) {
+  double worst = 0.0;
+  for (int i = 0; i <= 200000; ++i) {
+    const float x = kNeuralMinLog + (kNeuralMaxLog - kNeuralMinLog) * static_cast<float>(i) / 200000.f;
+    const double exact = std::exp(static_cast<double>(x));
+    worst = std::max(worst, std::fabs(static_cast<double>(neural_exp(x)) - exact) / exact);
+  }
+  EXPECT_LT(worst, 2e-6);
+  EXPECT_EQ(neural_exp(kNeuralMaxLog + 5.f), neural_exp(kNeuralMaxLog));
+  EXPECT_EQ(neural_exp(kNeuralMinLog - 5.f), neural_exp(kNeuralMinLog));
+  EXPECT_EQ(neural_exp(std::nanf("")), neural_exp(kNeuralMinLog));
+  EXPECT_EQ(neural_exp(0.f), 1.f);
 }
 
 // neural_exp on eight lanes is neural_exp, including its clamps and NaN.
@@ -698,8 +716,8 @@ TEST(NeuralGuide, InferenceGivesAProperDistribution) {
   neural_infer(v, Vec3(0.3f, 0.6f, 0.2f), glm::normalize(Vec3(0.2f, -0.5f, 1.f)), &site);
   double sum = 0.0;
   for (uint32_t j = 0; j < kNeuralBins; ++j) {
-    EXPECT_GT(site.pmf[j], 0.f);
-    sum += site.pmf[j];
+    EXPECT_GT(neural_site_pmf(site, j), 0.f);
+    sum += neural_site_pmf(site, j);
   }
   EXPECT_NEAR(sum, 1.0, 1e-5);
   // Sampled directions land in the bin they were drawn for, and bins are
@@ -719,12 +737,12 @@ TEST(NeuralGuide, InferenceGivesAProperDistribution) {
     // Mapped back, a direction within float rounding of a bin edge may land
     // in the neighbour (as the table's, guide_sample): rare, never more.
     elsewhere += neural_bin_of(dir) != bin ? 1 : 0;
-    ASSERT_NEAR(pdf, site.pmf[bin] * kNeuralBins / (4.0 * kPi), 1e-6 * pdf);
+    ASSERT_NEAR(pdf, neural_site_pmf(site, bin) * kNeuralBins / (4.0 * kPi), 1e-6 * pdf);
     ++counts[bin];
   }
   double chi2 = 0.0;
   for (uint32_t j = 0; j < kNeuralBins; ++j) {
-    const double expected = kDraws * static_cast<double>(site.pmf[j]);
+    const double expected = kDraws * static_cast<double>(neural_site_pmf(site, j));
     chi2 += (counts[j] - expected) * (counts[j] - expected) / expected;
   }
   EXPECT_LT(chi2, 220.0);
@@ -735,10 +753,11 @@ TEST(NeuralGuide, InferenceGivesAProperDistribution) {
   NeuralSite sharp = site;
   double total = 0.0;
   for (uint32_t j = 0; j < kNeuralBins; ++j) {
-    sharp.pmf[j] = j == 0 || j == 77 || j == 143 ? 0.3f : 1e-3f;
-    total += sharp.pmf[j];
+    sharp.weight[j] = j == 0 || j == 77 || j == 143 ? 0.3f : 1e-3f;
+    total += sharp.weight[j];
   }
-  for (uint32_t j = 0; j < kNeuralBins; ++j) sharp.pmf[j] = static_cast<Float>(sharp.pmf[j] / total);
+  sharp.pmf_scale = static_cast<Float>(1.0 / total);
+  sharp.pmf_floor = 0.f;
   sharp.has_cdf = false;
   std::fill(counts.begin(), counts.end(), 0);
   for (int i = 0; i < kDraws; ++i) {
@@ -750,7 +769,7 @@ TEST(NeuralGuide, InferenceGivesAProperDistribution) {
   }
   chi2 = 0.0;
   for (uint32_t j = 0; j < kNeuralBins; ++j) {
-    const double expected = kDraws * static_cast<double>(sharp.pmf[j]);
+    const double expected = kDraws * static_cast<double>(neural_site_pmf(sharp, j));
     chi2 += (counts[j] - expected) * (counts[j] - expected) / expected;
   }
   EXPECT_LT(chi2, 220.0);
