@@ -21,7 +21,7 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
       ->check(finite_range(0.1, 1048576.0));
   cmd->add_option("--guide-mix", a.mix,
                   "Probability of sampling a direction from the guide instead of the BSDF, the same in every cell "
-                  "(default: learned per cell)")
+                  "(default: learned, per cell for the table, per scene for the network)")
       ->check(finite_range(0.0, 1.0));
   cmd->add_option("--guide-split", a.split, "Updates a cell takes before it splits (0 = 24 per direction bin)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 40));
@@ -125,7 +125,10 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
     nc.learning_rate = static_cast<Float>(a.neural_lr);
     nc.tile_targets = static_cast<uint32_t>(a.neural_targets);
     nc.table_log2 = static_cast<uint32_t>(a.neural_table_log2);
-    if (a.mix) nc.guide_prob = static_cast<Float>(*a.mix);
+    if (a.mix) {
+      nc.guide_prob = static_cast<Float>(*a.mix);
+      nc.learn_mix = false;
+    }
     return std::make_unique<NeuralGuide>(nc, b.lo, b.hi, scene.max_emitted_radiance(), scene.view().num_lights);
   }
   GuideConfig cfg;

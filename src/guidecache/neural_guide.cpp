@@ -34,6 +34,9 @@ constexpr float kGradClip = 100.f;
 constexpr double kAdamBeta1 = 0.9, kAdamBeta2 = 0.99, kAdamEps = 1e-10;
 // Target statistics of round 0: fixed point with unit radiance_scale * 2^-20.
 constexpr double kTargetUnit = 1.0 / 1048576.0;
+// Vertices a learning pass's mixture statistics need before they choose the
+// weight (a single-sample pass of a 256x192 image gives about 10^5).
+constexpr uint64_t kNeuralMixMinVertices = 1024;
 
 uint64_t splitmix(uint64_t* state) {
   uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
@@ -167,7 +170,8 @@ NeuralGuideView NeuralGuide::view() const {
   v.lo = lo_;
   v.extent = extent_;
   v.scale = scale_ > 0.f ? scale_ : radiance_scale_;
-  v.guide_prob = config_.guide_prob;
+  v.guide_prob = mix_weight();
+  v.learn_mix = config_.learn_mix;
   v.floor = config_.floor;
   v.trained = steps_ > 0;
   v.max_target = max_target_;
@@ -317,6 +321,9 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
           sum += static_cast<uint64_t>(static_cast<double>(s.target) / radiance_scale_ / kTargetUnit + 0.5);
     }
     acc_ = {count, sum, pass_counts_.rejected_nonfinite, pass_counts_.rejected_large, pass_counts_.dropped};
+    acc_.insert(acc_.end(), pass_counts_.mix_votes, pass_counts_.mix_votes + kNeuralMixCandidates);
+    acc_.push_back(pass_counts_.mix_vertices);
+    acc_.push_back(pass_counts_.mix_rejected);
     return acc_;
   }
   // One minibatch: every steps_per_pass-th target of each tile, from round - 1.
@@ -437,6 +444,17 @@ void NeuralGuide::fold_round(uint32_t round) {
     totals_.rejected_nonfinite += acc_[2];
     totals_.rejected_large += acc_[3];
     totals_.dropped += acc_[4];
+    totals_.mix_vertices += acc_[5 + kNeuralMixCandidates];
+    totals_.mix_rejected += acc_[6 + kNeuralMixCandidates];
+    // The mixture weight for the next passes: the candidate with the
+    // smallest second moment over the pass's vertices (summed over ranks),
+    // once enough vertices gave theirs.
+    if (config_.learn_mix && acc_[5 + kNeuralMixCandidates] >= kNeuralMixMinVertices) {
+      uint32_t best = kNeuralMixFirstChoice;
+      for (uint32_t k = best + 1; k < kNeuralMixCandidates; ++k)
+        if (acc_[5 + k] < acc_[5 + best]) best = k;
+      mix_candidate_ = static_cast<int32_t>(best);
+    }
     // The first targets set the output scale: their mean radiance (a
     // network that starts near 0 then predicts it, and learns in relative terms).
     if (!(scale_ > 0.f) && acc_[0] > 0) {
@@ -494,8 +512,14 @@ void NeuralGuide::train_on(std::vector<NeuralTileTargets> tiles) {
   }
 }
 
+Float NeuralGuide::mix_weight() const {
+  if (!config_.learn_mix || mix_candidate_ < 0) return config_.guide_prob;
+  return guide_mix_candidate(static_cast<uint32_t>(mix_candidate_));
+}
+
 NeuralGuideStats NeuralGuide::stats() const {
   NeuralGuideStats s = totals_;
+  s.mix_weight = mix_weight();
   s.params = params_.size();
   s.bytes = 3 * params_.size() * sizeof(float);
   s.steps = steps_;
@@ -514,7 +538,7 @@ void NeuralGuide::fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) c
 bool NeuralGuide::operator==(const NeuralGuide& o) const {
   return config_ == o.config_ && lights_ == o.lights_ && lo_ == o.lo_ && extent_ == o.extent_ && radiance_scale_ == o.radiance_scale_ &&
          scale_ == o.scale_ && params_ == o.params_ && adam_m_ == o.adam_m_ && adam_v_ == o.adam_v_ &&
-         steps_ == o.steps_;
+         steps_ == o.steps_ && mix_candidate_ == o.mix_candidate_;
 }
 
 bool NeuralGuide::same_as(const Guide& other) const {

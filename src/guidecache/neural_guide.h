@@ -42,7 +42,10 @@ struct NeuralGuideConfig {
   // at equal time (docs/neural-guide.md).
   uint32_t steps_per_pass = 48;
   Float learning_rate = 2e-2f;
-  Float guide_prob = 0.5f;           // mixture weight of guided sampling once trained
+  // Mixture weight of guided sampling once trained, until a learning pass
+  // has chosen one of kNeuralMixCandidates (learn_mix; off with --guide-mix).
+  Float guide_prob = 0.5f;
+  bool learn_mix = true;
   Float floor = 0.02f;               // uniform share of each distribution (as the table's)
   // Learning targets a tile keeps per learning pass, on average (the rest
   // are skipped). More lower the error per sample, and training time grows
@@ -76,6 +79,9 @@ struct NeuralGuideStats {
   std::vector<double> pass_loss;     // the same, per learning pass
   double train_seconds = 0.0;        // this process: gradients and steps
   double inference_seconds = 0.0;    // one inference, as last measured on this process
+  Float mix_weight = 0.f;            // the mixture weight the next pass samples with
+  uint64_t mix_vertices = 0;         // vertices that gave mixture statistics (all passes, all ranks)
+  uint64_t mix_rejected = 0;         // vertices whose statistics were NaN or overflowed (left out)
 };
 
 class NeuralGuide final : public Guide {
@@ -98,7 +104,15 @@ class NeuralGuide final : public Guide {
   std::vector<uint64_t>& round_accumulators(uint32_t round) override;
   void fold_round(uint32_t round) override;
   bool single_sample_learning_passes() const override { return true; }
-  void set_guide_prob(Float p) override { config_.guide_prob = p; }
+  // A fixed mixture weight: no longer learned.
+  void set_guide_prob(Float p) override {
+    config_.guide_prob = p;
+    config_.learn_mix = false;
+  }
+  // The mixture weight the next pass samples with: the candidate the last
+  // learning pass's statistics chose (NeuralSampleSink::mix_votes), else guide_prob.
+  Float mix_weight() const;
+  int32_t mix_candidate() const { return mix_candidate_; }  // -1: none chosen yet
   void save(std::ostream& out, uint64_t scene_fingerprint) const override;
   void fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const override;
   bool same_as(const Guide& other) const override;
@@ -153,6 +167,8 @@ class NeuralGuide final : public Guide {
   Float scale_ = 0.f;                 // output scale: 0 until the first targets set it
   std::vector<float> params_, adam_m_, adam_v_;
   uint64_t steps_ = 0;
+  // The candidate mixture weight the last learning pass chose (-1: none yet).
+  int32_t mix_candidate_ = -1;
   NeuralGuideStats totals_;
 
   // Derived and per pass (not serialised).

@@ -31,8 +31,10 @@ namespace {
 constexpr char kNeuralMagic[] = "tessera-neural-guide";
 constexpr char kTableMagic[] = "tessera-guide-cache";
 // 2: the hash table's size is a setting; 3: learned light selection; 4: bins
-// numbered by tiles (version 3's, numbered row-major, are read and renumbered).
-constexpr uint32_t kNeuralVersion = 4;
+// numbered by tiles (version 3's, numbered row-major, are read and
+// renumbered); 5: the learned mixture weight (versions 3 and 4 are read
+// with none chosen yet, learning it).
+constexpr uint32_t kNeuralVersion = 5;
 constexpr uint32_t kNeuralRowMajorVersion = 3;
 }  // namespace
 
@@ -41,6 +43,9 @@ void NeuralGuide::save(std::ostream& out, uint64_t scene_fingerprint) const {
   cereal::PortableBinaryOutputArchive ar(out);
   ar(kNeuralVersion, scene_fingerprint);
   const_cast<NeuralGuide*>(this)->serialize(ar);
+  // Version 5's fields, after version 4's.
+  const uint8_t learn_mix = config_.learn_mix ? 1 : 0;
+  ar(learn_mix, mix_candidate_, totals_.mix_vertices, totals_.mix_rejected);
   if (!out) throw std::runtime_error("write failed");
 }
 
@@ -54,11 +59,17 @@ std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_
     cereal::PortableBinaryInputArchive ar(in);
     uint64_t fingerprint = 0;
     ar(version, fingerprint);
-    if (version != kNeuralVersion && version != kNeuralRowMajorVersion)
+    if (version < kNeuralRowMajorVersion || version > kNeuralVersion)
       throw std::runtime_error("neural guide version " + std::to_string(version) + ", this build reads versions " +
-                               std::to_string(kNeuralRowMajorVersion) + " and " + std::to_string(kNeuralVersion));
+                               std::to_string(kNeuralRowMajorVersion) + " to " + std::to_string(kNeuralVersion));
     if (fingerprint != scene_fingerprint) throw std::runtime_error("neural guide was learned on another scene");
     g->serialize(ar);
+    if (version >= 5) {
+      uint8_t learn_mix = 0;
+      ar(learn_mix, g->mix_candidate_, g->totals_.mix_vertices, g->totals_.mix_rejected);
+      if (learn_mix > 1) throw std::runtime_error("corrupt neural guide (mixture setting)");
+      g->config_.learn_mix = learn_mix == 1;
+    }
   } catch (const cereal::Exception& e) {
     throw std::runtime_error(std::string("corrupt or truncated neural guide (") + e.what() + ")");
   } catch (const std::bad_alloc&) {
@@ -80,7 +91,8 @@ std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_
             g->adam_m_.size() == L.size() && g->adam_v_.size() == L.size() && finite_in(g->extent_, 1e-30f, 3e38f) &&
             finite_in(g->radiance_scale_, 1e-30f, 3e38f) && finite_in(g->max_target_, 1e-30f, 3.4e38f) &&
             finite_in(g->scale_, 0.f, 3e38f) && std::isfinite(g->lo_.x) && std::isfinite(g->lo_.y) &&
-            std::isfinite(g->lo_.z);
+            std::isfinite(g->lo_.z) && g->mix_candidate_ >= -1 &&
+            g->mix_candidate_ < static_cast<int32_t>(kNeuralMixCandidates);
   for (size_t i = 0; ok && i < L.size(); ++i)
     ok = std::isfinite(g->params_[i]) && std::isfinite(g->adam_m_[i]) && std::isfinite(g->adam_v_[i]) && g->adam_v_[i] >= 0.f;
   if (!ok) throw std::runtime_error("corrupt neural guide (inconsistent or non-finite fields)");

@@ -40,7 +40,9 @@ enum Specialisation : uint32_t {
   kSpecMedia = 1u << 5,
   kSpecAll = (1u << 6) - 1,
   // The neural guide instead of the Q-table (with kSpecGuiding). Like media,
-  // it runs the full surface integrator: one instantiation (two with media).
+  // it runs the full surface integrator, except in scenes of Lambertian
+  // surfaces and area lights alone: three instantiations (one with media;
+  // worker/render_tile_impl.h).
   kSpecNeural = 1u << 6,
   kSpecIndexCount = 1u << 7,  // every combination of the bits above
 };

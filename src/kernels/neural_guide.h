@@ -128,6 +128,21 @@ struct NeuralTrainingSample {
 // both rules are the same on every backend, so a device's targets equal
 // the CPU's (the device applies the tile's capacity when it gathers them).
 constexpr uint32_t kNeuralPathTargets = 8;
+// The mixture weight is learned for the whole scene: the candidate (the
+// table's per-cell candidates, guide_mix_candidate) under which the learning
+// vertices' estimates have the smallest summed second moment
+// (neural_record_mix in path_guide.h, NeuralGuide::mix_weight), from
+// kNeuralMixFirstChoice on: 0.5, 0.65 or 0.8. Lower weights are recorded,
+// not chosen: a vertex's second moment sees one bounce, and the weight's
+// effect on whole paths was larger and, below 0.5, a loss on the shipped
+// scenes (docs/neural-guide.md).
+constexpr uint32_t kNeuralMixCandidates = 6;
+constexpr uint32_t kNeuralMixFirstChoice = 3;
+// Second moments in units of 2^-20 of the output scale squared; one
+// vertex's sum over the candidates it may choose at most 2^12 (2^32 units):
+// 2^32 vertices at the cap before a sum could overflow.
+constexpr Float kNeuralMixVoteUnit = 1.f / 1048576.f;
+constexpr Float kNeuralMixVertexCap = 4096.f;
 struct NeuralSampleSink {
   NeuralTrainingSample* data = nullptr;
   uint32_t capacity = 0;
@@ -140,6 +155,12 @@ struct NeuralSampleSink {
   uint64_t rejected_nonfinite = 0;  // NaN, Inf or negative targets
   uint64_t rejected_large = 0;      // targets beyond max_target
   uint64_t dropped = 0;             // kept targets beyond capacity
+  // The mixture statistics: per candidate weight, the learning vertices'
+  // summed second moments (kNeuralMixVoteUnit), and how many vertices gave
+  // theirs. Integers: the sums do not depend on the order.
+  uint64_t mix_votes[kNeuralMixCandidates] = {};
+  uint64_t mix_vertices = 0;
+  uint64_t mix_rejected = 0;  // vertices whose statistics were NaN or overflowed (left out)
 };
 
 struct NeuralGuideView {
@@ -153,6 +174,7 @@ struct NeuralGuideView {
   Float guide_prob = 0.5f;        // mixture weight of guided sampling once the network has trained
   Float floor = 0.02f;            // share of each distribution spread uniformly
   bool trained = false;           // no optimiser step yet: nothing to guide with
+  bool learn_mix = true;          // record the mixture statistics (off when the weight is fixed)
   Float max_target = 3.4e38f;     // larger targets are rejected (and counted), never clamped
   const Vec3* bin_dirs = nullptr;  // kNeuralBins centre directions, in the network's numbering (tiles)
   const Float* bin_dir_soa = nullptr;  // the same, as x[kNeuralBins], y[...], z[...] (a loop over bins vectorises)

@@ -91,6 +91,51 @@ struct TablePathGuide {
   }
 };
 
+// A learning vertex's mixture statistics for the network's one weight (the
+// table's per cell, guide_record_mix): the second moment of the vertex's
+// estimate (its direction's and its next-event sample's) had it sampled
+// with each candidate weight, in units of the network's output scale
+// squared, added to the sink in fixed point (kNeuralMixVoteUnit). One
+// vertex's sum over the candidates that may be chosen is capped at
+// kNeuralMixVertexCap (all its candidates keep their proportions): a few
+// fireflies do not decide the scene's weight alone, and the integer sums
+// stay far from overflow. A NaN or an overflow is left out and counted.
+TESSERA_HOST_DEVICE inline void neural_record_mix(const NeuralGuideView& v, const GuideMixSample& m, Float target) {
+  static_assert(kNeuralMixCandidates == kGuideMixEntries, "the table's candidates");
+  NeuralSampleSink* sink = v.sink;
+  if (!sink || !(m.mix_pdf > 0.f)) return;
+  if (!(target >= 0.f) || !(target <= 3.4e38f) || !(v.scale > 0.f)) {
+    ++sink->mix_rejected;
+    return;
+  }
+  const Float inv_scale = 1.f / v.scale;
+  Float s[kNeuralMixCandidates];
+  Float total = 0.f;  // over the candidates that may be chosen
+  for (uint32_t k = 0; k < kNeuralMixCandidates; ++k) {
+    const Float a = guide_mix_candidate(k);
+    const Float pk = a * m.guide_pdf + (1.f - a) * m.bsdf_pdf;
+    const Float radiance = m.emitted > 0.f ? target + m.emitted * power_heuristic(pk, m.light_pdf) : target;
+    const Float val = m.fcos * radiance * inv_scale;
+    s[k] = pk > 0.f ? val * val / (pk * m.mix_pdf) : 0.f;
+    if (m.nee_value > 0.f && m.nee_light_pdf > 0.f) {
+      const Float pk_light_dir = a * m.nee_guide_pdf + (1.f - a) * m.nee_bsdf_pdf;
+      const Float nee = m.nee_value * inv_scale * power_heuristic(m.nee_light_pdf, pk_light_dir) / m.nee_light_pdf;
+      s[k] += nee * nee;
+    }
+    if (k >= kNeuralMixFirstChoice) total += s[k];
+  }
+  bool finite = total <= 3.4e38f;
+  for (uint32_t k = 0; k < kNeuralMixFirstChoice; ++k) finite = finite && s[k] <= 3.4e38f;
+  if (!finite) {  // NaN or overflow
+    ++sink->mix_rejected;
+    return;
+  }
+  if (!(total > 0.f)) return;  // nothing to tell apart (a dark vertex)
+  const Float to_units = (total > kNeuralMixVertexCap ? kNeuralMixVertexCap / total : 1.f) / kNeuralMixVoteUnit;
+  for (uint32_t k = 0; k < kNeuralMixCandidates; ++k) sink->mix_votes[k] += static_cast<uint64_t>(s[k] * to_units + 0.5f);
+  ++sink->mix_vertices;
+}
+
 struct NeuralPathGuide {
   const NeuralGuideView& v;
   NeuralSite site[2];
@@ -183,8 +228,11 @@ struct NeuralPathGuide {
     if (li < v.lights) neural_record(v, site[s], kNeuralBins + li, learned);
   }
   TESSERA_HOST_DEVICE void record_nee(int32_t, Float, Float) const {}
-  TESSERA_HOST_DEVICE bool learns_mix(int32_t, Float) const { return false; }
-  TESSERA_HOST_DEVICE void record_mix(int32_t, const GuideMixSample&, Float) const {}
+  // Vertices that sample with the scene's weight (not faded by a glossy lobe) inform it.
+  TESSERA_HOST_DEVICE bool learns_mix(int32_t, Float guide_p) const {
+    return v.sink != nullptr && v.learn_mix && guide_p == v.guide_prob;
+  }
+  TESSERA_HOST_DEVICE void record_mix(int32_t, const GuideMixSample& m, Float target) const { neural_record_mix(v, m, target); }
 };
 
 }  // namespace tessera

@@ -76,6 +76,9 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
       j["guide_neural_gradient_words_clamped"] = n.gradient_clamped;
       j["guide_neural_nonfinite_gradients"] = n.nonfinite_gradients;
       j["guide_neural_loss"] = n.loss;
+      j["guide_neural_mix"] = n.mix_weight;
+      j["guide_neural_mix_vertices"] = n.mix_vertices;
+      j["guide_neural_mix_out_of_range"] = n.mix_rejected;
       j["guide_neural_train_seconds"] = n.train_seconds;
       j["guide_neural_inference_us"] = n.inference_seconds * 1e6;
       // Shares of the render's wall time: training (rank 0's, between passes),

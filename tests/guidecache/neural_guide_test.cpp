@@ -10,6 +10,7 @@
 
 #include "guidecache/guide_field.h"
 #include "guidecache/neural_guide.h"
+#include "kernels/path_guide.h"
 
 namespace tessera {
 namespace {
@@ -422,7 +423,7 @@ TEST(NeuralGuide, LoadRejectsOtherScenesAndDamage) {
 // file is read with each bin's output moved to its new number (a file saved
 // now and relabelled version 3 answers, at bin neural_bin_at(r, c), what the
 // saved network answers at bin 12 r + c), and the same network's Adam
-// state moves with it. Versions before 3 are refused.
+// state moves with it. Versions before 3 (and after this one) are refused.
 TEST(NeuralGuide, AVersion3FileIsReadWithItsBinsRenumbered) {
   NeuralGuide g = make(small_config());
   g.train_on({{0, random_samples(200, 1, 2.f)}});
@@ -432,7 +433,17 @@ TEST(NeuralGuide, AVersion3FileIsReadWithItsBinsRenumbered) {
   const size_t at = sizeof "tessera-neural-guide" + 1;  // after the magic and cereal's endianness byte
   uint32_t version = 0;
   std::memcpy(&version, file.data() + at, 4);
-  ASSERT_EQ(version, 4u) << "the file's layout changed: update the offset";
+  ASSERT_EQ(version, 5u) << "the file's layout changed: update the offset";
+  // Versions 3 and 4 end before version 5's mixture fields (a flag, the
+  // chosen candidate, two counts). A version-4 file is read as it was
+  // saved, with no weight chosen yet: here the network has chosen none.
+  file.resize(file.size() - (1 + 4 + 8 + 8));
+  version = 4;
+  std::memcpy(file.data() + at, &version, 4);
+  std::stringstream v4(file);
+  std::unique_ptr<NeuralGuide> loaded4 = NeuralGuide::load(v4, 5);
+  EXPECT_TRUE(*loaded4 == g);
+  EXPECT_TRUE(loaded4->config().learn_mix);
   version = 3;
   std::memcpy(file.data() + at, &version, 4);
   std::stringstream v3(file);
@@ -458,11 +469,81 @@ TEST(NeuralGuide, AVersion3FileIsReadWithItsBinsRenumbered) {
   loaded->train_on({{0, renumbered}});
   for (uint32_t j = 0; j < kNeuralBins; ++j)
     ASSERT_EQ(loaded->params()[L.b3() + neural_bin_at(j / kNeuralGrid, j % kNeuralGrid)], g.params()[L.b3() + j]) << j;
-  for (uint32_t old : {1u, 2u, 5u}) {
+  for (uint32_t old : {1u, 2u, 6u}) {
     std::memcpy(file.data() + at, &old, 4);
     std::stringstream refused(file);
     EXPECT_THROW(NeuralGuide::load(refused, 5), std::runtime_error) << old;
   }
+}
+
+// The scene's mixture weight is the candidate under which the learning
+// vertices' second moments are smallest: the largest where the guide's
+// density is where the integrand is, the smallest it may choose (0.5) where
+// it misses it. It is chosen once a pass has enough vertices, kept by save
+// and load, and a fixed weight (--guide-mix) is never replaced.
+TEST(NeuralGuide, MixtureWeightIsTheCandidateWithTheSmallestSecondMoment) {
+  auto pass = [](NeuralGuide& g, Float guide_pdf, int vertices) {
+    NeuralSampleSink sink;
+    NeuralGuideView v = g.view();
+    v.sink = &sink;
+    for (int i = 0; i < vertices; ++i) {
+      GuideMixSample m;  // a direction drawn from the mixture at the current weight
+      m.fcos = 0.5f + 0.001f * static_cast<Float>(i % 7);
+      m.bsdf_pdf = 0.3f;
+      m.guide_pdf = guide_pdf;
+      m.mix_pdf = v.guide_prob * m.guide_pdf + (1.f - v.guide_prob) * m.bsdf_pdf;
+      m.nee_value = 0.2f;  // and its next-event sample, whose MIS weight the candidates change too
+      m.nee_light_pdf = 1.f;
+      m.nee_guide_pdf = guide_pdf;
+      m.nee_bsdf_pdf = 0.3f;
+      neural_record_mix(v, m, 2.f);
+    }
+    EXPECT_EQ(sink.mix_vertices, static_cast<uint64_t>(vertices));
+    g.training_log()->add_tile(sink);
+    for (uint32_t r = 0; r < g.rounds(); ++r) {
+      g.round_accumulators(r);
+      g.fold_round(r);
+    }
+  };
+  NeuralGuide g = make(small_config());
+  EXPECT_EQ(g.mix_weight(), 0.5f);
+  pass(g, 3.f, 100);  // too few vertices: nothing chosen
+  EXPECT_EQ(g.mix_weight(), 0.5f);
+  pass(g, 3.f, 5000);
+  EXPECT_EQ(g.mix_weight(), guide_mix_candidate(kNeuralMixCandidates - 1));
+  EXPECT_EQ(g.view().guide_prob, g.mix_weight());
+  EXPECT_EQ(g.stats().mix_weight, g.mix_weight());
+  std::stringstream bytes;
+  g.save(bytes, 9);
+  EXPECT_TRUE(*NeuralGuide::load(bytes, 9) == g);
+  pass(g, 0.01f, 5000);
+  EXPECT_EQ(g.mix_weight(), guide_mix_candidate(kNeuralMixFirstChoice));
+  EXPECT_EQ(g.mix_weight(), 0.5f);
+  // Non-finite statistics give no vote.
+  NeuralSampleSink sink;
+  NeuralGuideView v = g.view();
+  v.sink = &sink;
+  GuideMixSample bad;
+  bad.fcos = NAN;
+  bad.bsdf_pdf = bad.guide_pdf = bad.mix_pdf = 0.3f;
+  neural_record_mix(v, bad, 1.f);
+  bad.fcos = 1e30f;
+  neural_record_mix(v, bad, 1e30f);
+  neural_record_mix(v, bad, NAN);
+  EXPECT_EQ(sink.mix_vertices, 0u);
+  EXPECT_EQ(sink.mix_rejected, 3u);
+  g.training_log()->add_tile(sink);
+  for (uint32_t r = 0; r < g.rounds(); ++r) {
+    g.round_accumulators(r);
+    g.fold_round(r);
+  }
+  EXPECT_EQ(g.stats().mix_rejected, 3u);
+  EXPECT_EQ(g.stats().mix_vertices, 100u + 5000u + 5000u);
+  // A fixed weight stays.
+  g.set_guide_prob(0.3f);
+  EXPECT_FALSE(g.view().learn_mix);
+  pass(g, 3.f, 5000);
+  EXPECT_EQ(g.mix_weight(), 0.3f);
 }
 
 TEST(NeuralGuide, NonFiniteAndHugeTargetsAreRejectedAndCounted) {

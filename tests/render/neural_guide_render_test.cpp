@@ -83,10 +83,32 @@ TEST(NeuralGuided, BitIdenticalImageAndWeightsAcrossThreadCounts) {
     results[i] = s.run(guides[i].get(), opt);
   }
   EXPECT_GT(guides[0]->stats().steps, 0u);
+  // The mixture statistics came through the integrator and the threads' sinks, and chose a weight.
+  EXPECT_GT(guides[0]->stats().mix_vertices, 0u);
+  EXPECT_GE(guides[0]->mix_candidate(), static_cast<int32_t>(kNeuralMixFirstChoice));
   EXPECT_TRUE(films_identical(results[0].film, results[1].film));
   EXPECT_TRUE(films_identical(results[0].film, results[2].film));
   EXPECT_TRUE(*guides[0] == *guides[1]);
   EXPECT_TRUE(*guides[0] == *guides[2]);
+}
+
+// In a scene of Lambertian surfaces and area lights the network runs an
+// integrator specialised for them: the same image and network as the full one's.
+TEST(NeuralGuided, LambertianSpecialisationEqualsTheFullIntegrator) {
+  GuidedScene s(shipped("door-ajar", 32, 24, 12, 6));
+  RenderResult results[2];
+  std::unique_ptr<NeuralGuide> guides[2];
+  for (int i = 0; i < 2; ++i) {
+    guides[i] = s.make_neural(small_network());
+    RenderOptions opt;
+    opt.seed = 5;
+    opt.force_full_specialisation = i == 1;
+    results[i] = s.run(guides[i].get(), opt);
+  }
+  EXPECT_EQ(results[0].stats.specialisation, kSpecNeural | kSpecGuiding | kSpecAreaLights);
+  EXPECT_EQ(results[1].stats.specialisation & kSpecSurfaceAll, kSpecSurfaceAll);
+  EXPECT_TRUE(films_identical(results[0].film, results[1].film));
+  EXPECT_TRUE(*guides[0] == *guides[1]);
 }
 
 // The network learns in passes of one sample while every sample learns
