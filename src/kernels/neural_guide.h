@@ -133,9 +133,9 @@ constexpr uint32_t kNeuralPathTargets = 8;
 // vertices' estimates have the smallest summed second moment
 // (neural_record_mix in path_guide.h, NeuralGuide::mix_weight), from
 // kNeuralMixFirstChoice on: 0.5, 0.65 or 0.8. Lower weights are recorded,
-// not chosen: a vertex's second moment sees one bounce, and the weight's
-// effect on whole paths was larger and, below 0.5, a loss on the shipped
-// scenes (docs/neural-guide.md).
+// not chosen: a vertex's second moment sees one bounce, the weight's
+// effect on whole paths was larger than it predicts, and no weight below
+// 0.5 was measured to gain on the shipped scenes (docs/neural-guide.md).
 constexpr uint32_t kNeuralMixCandidates = 6;
 constexpr uint32_t kNeuralMixFirstChoice = 3;
 // Second moments in units of 2^-20 of the output scale squared; one
