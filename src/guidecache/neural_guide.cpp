@@ -321,7 +321,7 @@ std::vector<uint64_t>& NeuralGuide::round_accumulators(uint32_t round) {
           sum += static_cast<uint64_t>(static_cast<double>(s.target) / radiance_scale_ / kTargetUnit + 0.5);
     }
     acc_ = {count, sum, pass_counts_.rejected_nonfinite, pass_counts_.rejected_large, pass_counts_.dropped};
-    acc_.insert(acc_.end(), pass_counts_.mix_votes, pass_counts_.mix_votes + kNeuralMixCandidates);
+    acc_.insert(acc_.end(), pass_counts_.mix_moments, pass_counts_.mix_moments + kNeuralMixCandidates);
     acc_.push_back(pass_counts_.mix_vertices);
     acc_.push_back(pass_counts_.mix_rejected);
     return acc_;
@@ -450,10 +450,10 @@ void NeuralGuide::fold_round(uint32_t round) {
     // smallest second moment over the pass's vertices (summed over ranks),
     // once enough vertices gave theirs.
     if (config_.learn_mix && acc_[5 + kNeuralMixCandidates] >= kNeuralMixMinVertices) {
-      uint32_t best = kNeuralMixFirstChoice;
-      for (uint32_t k = best + 1; k < kNeuralMixCandidates; ++k)
+      uint32_t best = 0;
+      for (uint32_t k = 1; k < kNeuralMixCandidates; ++k)
         if (acc_[5 + k] < acc_[5 + best]) best = k;
-      mix_candidate_ = static_cast<int32_t>(best);
+      mix_candidate_ = static_cast<int32_t>(kNeuralMixFirstCandidate + best);
     }
     // The first targets set the output scale: their mean radiance (a
     // network that starts near 0 then predicts it, and learns in relative terms).

@@ -110,9 +110,10 @@ class NeuralGuide final : public Guide {
     config_.learn_mix = false;
   }
   // The mixture weight the next pass samples with: the candidate the last
-  // learning pass's statistics chose (NeuralSampleSink::mix_votes), else guide_prob.
+  // learning pass's statistics chose (NeuralSampleSink::mix_moments), else guide_prob.
   Float mix_weight() const;
-  int32_t mix_candidate() const { return mix_candidate_; }  // -1: none chosen yet
+  // Its index among the table's candidates (guide_mix_candidate; -1: none chosen yet).
+  int32_t mix_candidate() const { return mix_candidate_; }
   void save(std::ostream& out, uint64_t scene_fingerprint) const override;
   void fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const override;
   bool same_as(const Guide& other) const override;
@@ -167,7 +168,8 @@ class NeuralGuide final : public Guide {
   Float scale_ = 0.f;                 // output scale: 0 until the first targets set it
   std::vector<float> params_, adam_m_, adam_v_;
   uint64_t steps_ = 0;
-  // The candidate mixture weight the last learning pass chose (-1: none yet).
+  // The candidate mixture weight the last learning pass chose, as an index of
+  // guide_mix_candidate (kNeuralMixFirstCandidate on; -1: none yet).
   int32_t mix_candidate_ = -1;
   NeuralGuideStats totals_;
 

@@ -91,8 +91,8 @@ std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_
             g->adam_m_.size() == L.size() && g->adam_v_.size() == L.size() && finite_in(g->extent_, 1e-30f, 3e38f) &&
             finite_in(g->radiance_scale_, 1e-30f, 3e38f) && finite_in(g->max_target_, 1e-30f, 3.4e38f) &&
             finite_in(g->scale_, 0.f, 3e38f) && std::isfinite(g->lo_.x) && std::isfinite(g->lo_.y) &&
-            std::isfinite(g->lo_.z) && g->mix_candidate_ >= -1 &&
-            g->mix_candidate_ < static_cast<int32_t>(kNeuralMixCandidates);
+            std::isfinite(g->lo_.z) && (g->mix_candidate_ == -1 || (g->mix_candidate_ >= static_cast<int32_t>(kNeuralMixFirstCandidate) &&
+                                        g->mix_candidate_ < static_cast<int32_t>(kNeuralMixFirstCandidate + kNeuralMixCandidates)));
   for (size_t i = 0; ok && i < L.size(); ++i)
     ok = std::isfinite(g->params_[i]) && std::isfinite(g->adam_m_[i]) && std::isfinite(g->adam_v_[i]) && g->adam_v_[i] >= 0.f;
   if (!ok) throw std::runtime_error("corrupt neural guide (inconsistent or non-finite fields)");

@@ -21,7 +21,7 @@ struct NeuralTileTargets {
 
 struct NeuralLogCounts {
   uint64_t rejected_nonfinite = 0, rejected_large = 0, dropped = 0;
-  uint64_t mix_votes[kNeuralMixCandidates] = {};  // NeuralSampleSink's mixture statistics
+  uint64_t mix_moments[kNeuralMixCandidates] = {};  // NeuralSampleSink's mixture statistics
   uint64_t mix_vertices = 0, mix_rejected = 0;
 };
 
@@ -36,7 +36,7 @@ class NeuralTrainingLog {
     counts_.rejected_nonfinite += sink.rejected_nonfinite;
     counts_.rejected_large += sink.rejected_large;
     counts_.dropped += sink.dropped;
-    for (uint32_t k = 0; k < kNeuralMixCandidates; ++k) counts_.mix_votes[k] += sink.mix_votes[k];
+    for (uint32_t k = 0; k < kNeuralMixCandidates; ++k) counts_.mix_moments[k] += sink.mix_moments[k];
     counts_.mix_vertices += sink.mix_vertices;
     counts_.mix_rejected += sink.mix_rejected;
     tiles_.push_back(std::move(t));

@@ -47,6 +47,13 @@ enum Specialisation : uint32_t {
   kSpecIndexCount = 1u << 7,  // every combination of the bits above
 };
 
+// Scenes of Lambertian surfaces and area lights alone (no textures, no
+// environment, no media), whatever the guiding bit: the neural guide runs
+// an instantiation of its own there (worker/render_tile_impl.h).
+TESSERA_HOST_DEVICE constexpr bool lambertian_area_lights_only(uint32_t spec) {
+  return (spec & (kSpecMedia | (kSpecSurfaceAll & ~kSpecGuiding))) == kSpecAreaLights;
+}
+
 TESSERA_HOST_DEVICE inline uint32_t specialisation_for(uint32_t effects) {
   uint32_t s = 0;
   if (effects & (kEffectGlossy | kEffectSpecular | kEffectTransmission | kEffectMix | kEffectInterface)) s |= kSpecNonDiffuse;

@@ -107,6 +107,24 @@ struct GuideMixSample {
   Float nee_bsdf_pdf = 0.f;
 };
 
+// One candidate's second moment (below) for a vertex's mixture sample m
+// with learning target T, radiance in units of `scale`, had it sampled with
+// weight a: the direction's (3.4e38 where a gives it no density) plus its
+// next-event sample's. Both guides' mixture statistics (guide_record_mix,
+// neural_record_mix).
+TESSERA_HOST_DEVICE inline Float guide_mix_moment(const GuideMixSample& m, Float target, Float scale, Float a) {
+  const Float pk = a * m.guide_pdf + (1.f - a) * m.bsdf_pdf;
+  const Float radiance = m.emitted > 0.f ? target + m.emitted * power_heuristic(pk, m.light_pdf) : target;
+  const Float v = (m.fcos / scale) * radiance;
+  Float moment = pk > 0.f ? v * v / (pk * m.mix_pdf) : 3.4e38f;
+  if (m.nee_value > 0.f && m.nee_light_pdf > 0.f) {
+    const Float pk_light_dir = a * m.nee_guide_pdf + (1.f - a) * m.nee_bsdf_pdf;
+    const Float nee = m.nee_value * power_heuristic(m.nee_light_pdf, pk_light_dir) / (m.nee_light_pdf * scale);
+    moment += nee * nee;
+  }
+  return moment;
+}
+
 // Records, for every candidate weight a_k, the second moment the vertex's
 // estimator would have had with a_k, estimated from this vertex's two samples
 // (s is the cell's scale, see below):
@@ -128,20 +146,10 @@ TESSERA_HOST_DEVICE inline void guide_record_mix(const GuideView& g, int32_t cel
   const Float direct = g.value[static_cast<size_t>(cell) * g.stride + g.nee_entry];
   const Float scale = g.irradiance[cell] * kInvPi + glm::max(direct, 0.f);
   if (!(scale > 0.f) || !(m.mix_pdf > 0.f) || !(target >= 0.f)) return;
-  const Float f_scaled = m.fcos / scale;
   Float s[kGuideMixEntries];
   Float largest = 0.f;
   for (uint32_t k = 0; k < kGuideMixEntries; ++k) {
-    const Float a = guide_mix_candidate(k);
-    const Float pk = a * m.guide_pdf + (1.f - a) * m.bsdf_pdf;
-    const Float radiance = m.emitted > 0.f ? target + m.emitted * power_heuristic(pk, m.light_pdf) : target;
-    const Float v = f_scaled * radiance;
-    s[k] = pk > 0.f ? v * v / (pk * m.mix_pdf) : 3.4e38f;
-    if (m.nee_value > 0.f && m.nee_light_pdf > 0.f) {
-      const Float pk_light_dir = a * m.nee_guide_pdf + (1.f - a) * m.nee_bsdf_pdf;
-      const Float nee = m.nee_value * power_heuristic(m.nee_light_pdf, pk_light_dir) / (m.nee_light_pdf * scale);
-      s[k] += nee * nee;
-    }
+    s[k] = guide_mix_moment(m, target, scale, guide_mix_candidate(k));
     largest = glm::max(largest, s[k]);
   }
   if (!(largest <= g.max_target)) {

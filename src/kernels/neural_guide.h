@@ -128,20 +128,20 @@ struct NeuralTrainingSample {
 // both rules are the same on every backend, so a device's targets equal
 // the CPU's (the device applies the tile's capacity when it gathers them).
 constexpr uint32_t kNeuralPathTargets = 8;
-// The mixture weight is learned for the whole scene: the candidate (the
-// table's per-cell candidates, guide_mix_candidate) under which the learning
-// vertices' estimates have the smallest summed second moment
-// (neural_record_mix in path_guide.h, NeuralGuide::mix_weight), from
-// kNeuralMixFirstChoice on: 0.5, 0.65 or 0.8. Lower weights are recorded,
-// not chosen: a vertex's second moment sees one bounce, the weight's
-// effect on whole paths was larger than it predicts, and no weight below
-// 0.5 was measured to gain on the shipped scenes (docs/neural-guide.md).
-constexpr uint32_t kNeuralMixCandidates = 6;
-constexpr uint32_t kNeuralMixFirstChoice = 3;
+// The mixture weight is learned for the whole scene: the candidate under
+// which the learning vertices' estimates have the smallest summed second
+// moment (neural_record_mix in path_guide.h, NeuralGuide::mix_weight),
+// among the table's per-cell candidates (guide_mix_candidate) from
+// kNeuralMixFirstCandidate on: 0.5, 0.65 or 0.8. Lower weights are not
+// candidates: a vertex's second moment sees one bounce, the weight's effect
+// on whole paths was larger than it predicts, and no weight below 0.5 was
+// measured to gain on the shipped scenes (docs/neural-guide.md).
+constexpr uint32_t kNeuralMixFirstCandidate = 3;
+constexpr uint32_t kNeuralMixCandidates = 3;
 // Second moments in units of 2^-20 of the output scale squared; one
-// vertex's sum over the candidates it may choose at most 2^12 (2^32 units):
-// 2^32 vertices at the cap before a sum could overflow.
-constexpr Float kNeuralMixVoteUnit = 1.f / 1048576.f;
+// vertex's sum over the candidates at most 2^12 (2^32 units): 2^32
+// vertices at the cap before a sum could overflow.
+constexpr Float kNeuralMixMomentUnit = 1.f / 1048576.f;
 constexpr Float kNeuralMixVertexCap = 4096.f;
 struct NeuralSampleSink {
   NeuralTrainingSample* data = nullptr;
@@ -155,10 +155,11 @@ struct NeuralSampleSink {
   uint64_t rejected_nonfinite = 0;  // NaN, Inf or negative targets
   uint64_t rejected_large = 0;      // targets beyond max_target
   uint64_t dropped = 0;             // kept targets beyond capacity
-  // The mixture statistics: per candidate weight, the learning vertices'
-  // summed second moments (kNeuralMixVoteUnit), and how many vertices gave
-  // theirs. Integers: the sums do not depend on the order.
-  uint64_t mix_votes[kNeuralMixCandidates] = {};
+  // The mixture statistics: per candidate weight (from
+  // kNeuralMixFirstCandidate), the learning vertices' summed second moments
+  // (kNeuralMixMomentUnit), and how many vertices gave theirs. Integers:
+  // the sums do not depend on the order.
+  uint64_t mix_moments[kNeuralMixCandidates] = {};
   uint64_t mix_vertices = 0;
   uint64_t mix_rejected = 0;  // vertices whose statistics were NaN or overflowed (left out)
 };

@@ -95,44 +95,29 @@ struct TablePathGuide {
 // table's per cell, guide_record_mix): the second moment of the vertex's
 // estimate (its direction's and its next-event sample's) had it sampled
 // with each candidate weight, in units of the network's output scale
-// squared, added to the sink in fixed point (kNeuralMixVoteUnit). One
-// vertex's sum over the candidates that may be chosen is capped at
-// kNeuralMixVertexCap (all its candidates keep their proportions): a few
-// fireflies do not decide the scene's weight alone, and the integer sums
-// stay far from overflow. A NaN or an overflow is left out and counted.
+// squared, added to the sink in fixed point (kNeuralMixMomentUnit). One
+// vertex's sum over the candidates is capped at kNeuralMixVertexCap (its
+// candidates keep their proportions): a few fireflies do not decide the
+// scene's weight alone, and the integer sums stay far from overflow. A NaN
+// or an overflow is left out and counted.
 TESSERA_HOST_DEVICE inline void neural_record_mix(const NeuralGuideView& v, const GuideMixSample& m, Float target) {
-  static_assert(kNeuralMixCandidates == kGuideMixEntries, "the table's candidates");
+  static_assert(kNeuralMixFirstCandidate + kNeuralMixCandidates <= kGuideMixEntries, "the table's candidates");
   NeuralSampleSink* sink = v.sink;
   if (!sink || !(m.mix_pdf > 0.f)) return;
-  if (!(target >= 0.f) || !(target <= 3.4e38f) || !(v.scale > 0.f)) {
-    ++sink->mix_rejected;
-    return;
-  }
-  const Float inv_scale = 1.f / v.scale;
   Float s[kNeuralMixCandidates];
-  Float total = 0.f;  // over the candidates that may be chosen
+  Float total = 0.f;
   for (uint32_t k = 0; k < kNeuralMixCandidates; ++k) {
-    const Float a = guide_mix_candidate(k);
-    const Float pk = a * m.guide_pdf + (1.f - a) * m.bsdf_pdf;
-    const Float radiance = m.emitted > 0.f ? target + m.emitted * power_heuristic(pk, m.light_pdf) : target;
-    const Float val = m.fcos * radiance * inv_scale;
-    s[k] = pk > 0.f ? val * val / (pk * m.mix_pdf) : 0.f;
-    if (m.nee_value > 0.f && m.nee_light_pdf > 0.f) {
-      const Float pk_light_dir = a * m.nee_guide_pdf + (1.f - a) * m.nee_bsdf_pdf;
-      const Float nee = m.nee_value * inv_scale * power_heuristic(m.nee_light_pdf, pk_light_dir) / m.nee_light_pdf;
-      s[k] += nee * nee;
-    }
-    if (k >= kNeuralMixFirstChoice) total += s[k];
+    s[k] = guide_mix_moment(m, target, v.scale, guide_mix_candidate(kNeuralMixFirstCandidate + k));
+    total += s[k];
   }
-  bool finite = total <= 3.4e38f;
-  for (uint32_t k = 0; k < kNeuralMixFirstChoice; ++k) finite = finite && s[k] <= 3.4e38f;
-  if (!finite) {  // NaN or overflow
+  if (!(total <= 3.4e38f)) {  // NaN or overflow
     ++sink->mix_rejected;
     return;
   }
   if (!(total > 0.f)) return;  // nothing to tell apart (a dark vertex)
-  const Float to_units = (total > kNeuralMixVertexCap ? kNeuralMixVertexCap / total : 1.f) / kNeuralMixVoteUnit;
-  for (uint32_t k = 0; k < kNeuralMixCandidates; ++k) sink->mix_votes[k] += static_cast<uint64_t>(s[k] * to_units + 0.5f);
+  const Float to_units = (total > kNeuralMixVertexCap ? kNeuralMixVertexCap / total : 1.f) / kNeuralMixMomentUnit;
+  for (uint32_t k = 0; k < kNeuralMixCandidates; ++k)
+    sink->mix_moments[k] += static_cast<uint64_t>(s[k] * to_units + 0.5f);
   ++sink->mix_vertices;
 }
 

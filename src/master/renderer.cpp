@@ -22,7 +22,7 @@ uint32_t effective_specialisation(const SceneData& scene, const RenderOptions& o
   if (!guide) return spec;
   // The network runs the full surface integrator, or in scenes of Lambertian
   // surfaces and area lights alone one of its own (instantiated_spec): the log and stats say which.
-  if ((guide->spec_bits() & kSpecNeural) && (spec & (kSpecMedia | kSpecSurfaceAll)) != kSpecAreaLights)
+  if ((guide->spec_bits() & kSpecNeural) && !lambertian_area_lights_only(spec))
     spec = kSpecSurfaceAll | (spec & kSpecMedia);
   return spec | guide->spec_bits();
 }

@@ -226,12 +226,12 @@ TileCounters DeviceBackend::render_tiles(TileQueue& queue, int32_t) {
       launch.targets = static_cast<NeuralTrainingSample*>(
           targets_.reserve(target_paths * kNeuralPathTargets * sizeof(NeuralTrainingSample)));
       launch.target_counts = static_cast<uint32_t*>(target_counts_.reserve(target_paths * sizeof(uint32_t)));
-      launch.target_rejects = static_cast<uint64_t*>(target_rejects_.reserve(kDeviceSinkWords * sizeof(uint64_t)));
+      launch.sink_words = static_cast<uint64_t*>(sink_words_.reserve(kDeviceSinkWords * sizeof(uint64_t)));
       launch.tile_targets =
           static_cast<NeuralTrainingSample*>(tile_targets_.reserve(target_rooms * sizeof(NeuralTrainingSample)));
       launch.tile_target_counts = static_cast<uint32_t*>(tile_target_counts_.reserve(2 * tiles.size() * sizeof(uint32_t)));
       device_->zero(launch.target_counts, target_paths * sizeof(uint32_t));
-      device_->zero(launch.target_rejects, kDeviceSinkWords * sizeof(uint64_t));
+      device_->zero(launch.sink_words, kDeviceSinkWords * sizeof(uint64_t));
     }
     device_->start(launch, served_specialisation(settings_.specialisation));
     // A farm master answers its workers while the device renders.
@@ -265,9 +265,9 @@ void DeviceBackend::gather_targets(const std::vector<TileTask>& tasks, const std
                                    uint64_t rooms) {
   const size_t n = tasks.size();
   std::vector<uint32_t> counts(2 * n);
-  uint64_t rejects[kDeviceSinkWords] = {};
+  uint64_t words[kDeviceSinkWords] = {};
   device_->download(counts.data(), tile_target_counts_.get(), counts.size() * sizeof(uint32_t));
-  device_->download(rejects, target_rejects_.get(), sizeof(rejects));
+  device_->download(words, sink_words_.get(), sizeof(words));
   // Up to the last tile's kept targets (one copy; the rooms' unused ends come too).
   uint64_t used = 0;
   for (size_t i = 0; i < n; ++i)
@@ -282,12 +282,12 @@ void DeviceBackend::gather_targets(const std::vector<TileTask>& tasks, const std
     sink.capacity = tiles[i].room;
     sink.dropped = counts[n + i];
     if (i == 0) {
-      sink.rejected_nonfinite = rejects[0];
-      sink.rejected_large = rejects[1];
-      sink.dropped += rejects[2];
-      for (uint32_t k = 0; k < kNeuralMixCandidates; ++k) sink.mix_votes[k] = rejects[3 + k];
-      sink.mix_vertices = rejects[3 + kNeuralMixCandidates];
-      sink.mix_rejected = rejects[4 + kNeuralMixCandidates];
+      sink.rejected_nonfinite = words[0];
+      sink.rejected_large = words[1];
+      sink.dropped += words[2];
+      for (uint32_t k = 0; k < kNeuralMixCandidates; ++k) sink.mix_moments[k] = words[3 + k];
+      sink.mix_vertices = words[3 + kNeuralMixCandidates];
+      sink.mix_rejected = words[4 + kNeuralMixCandidates];
     }
     settings_.neural_log->add_tile(sink);
   }

@@ -83,7 +83,7 @@ class DeviceBackend : public TileBackend {
   std::unique_ptr<DeviceApi> device_;  // declared first: the buffers are freed before it goes
   Buffer scene_bytes_{*device_}, scene_view_{*device_}, guide_bytes_{*device_}, guide_acc_{*device_};
   Buffer tiles_{*device_}, pixels_{*device_}, values_{*device_}, counters_{*device_};
-  Buffer network_{*device_}, targets_{*device_}, target_counts_{*device_}, target_rejects_{*device_};
+  Buffer network_{*device_}, targets_{*device_}, target_counts_{*device_}, sink_words_{*device_};
   Buffer tile_targets_{*device_}, tile_target_counts_{*device_};
   BvhView bvh_;
   TileSettings settings_;      // the pass's, as the host gave them

@@ -56,11 +56,11 @@ struct DeviceLaunch {
   // ([tile]) and how many were dropped beyond it ([num_tiles + tile]).
   NeuralTrainingSample* targets = nullptr;
   uint32_t* target_counts = nullptr;
-  uint64_t* target_rejects = nullptr;  // [kDeviceSinkWords]: rejected, too large, dropped, then the mixture statistics
+  uint64_t* sink_words = nullptr;  // [kDeviceSinkWords]: rejected, too large, dropped, then the mixture statistics
   NeuralTrainingSample* tile_targets = nullptr;
   uint32_t* tile_target_counts = nullptr;
 };
-// Words of DeviceLaunch::target_rejects: a launch's sink counters, summed.
+// Words of DeviceLaunch::sink_words: a launch's sink counters, summed.
 constexpr uint32_t kDeviceSinkWords = 3 + kNeuralMixCandidates + 2;
 
 // The integrator a specialisation is served by on the portable BVH: the
@@ -112,13 +112,13 @@ TESSERA_HOST_DEVICE inline void trace_device_sample(const DeviceLaunch& launch, 
   if constexpr ((Spec & kSpecNeural) != 0) {
     if (path.neural.sink != nullptr) {
       launch.target_counts[path_slot] = sink.count;
-      if (sink.rejected_nonfinite) atomic_add_u64(launch.target_rejects + 0, sink.rejected_nonfinite);
-      if (sink.rejected_large) atomic_add_u64(launch.target_rejects + 1, sink.rejected_large);
-      if (sink.dropped) atomic_add_u64(launch.target_rejects + 2, sink.dropped);
+      if (sink.rejected_nonfinite) atomic_add_u64(launch.sink_words + 0, sink.rejected_nonfinite);
+      if (sink.rejected_large) atomic_add_u64(launch.sink_words + 1, sink.rejected_large);
+      if (sink.dropped) atomic_add_u64(launch.sink_words + 2, sink.dropped);
       for (uint32_t k = 0; k < kNeuralMixCandidates; ++k)
-        if (sink.mix_votes[k]) atomic_add_u64(launch.target_rejects + 3 + k, sink.mix_votes[k]);
-      if (sink.mix_vertices) atomic_add_u64(launch.target_rejects + 3 + kNeuralMixCandidates, sink.mix_vertices);
-      if (sink.mix_rejected) atomic_add_u64(launch.target_rejects + 4 + kNeuralMixCandidates, sink.mix_rejected);
+        if (sink.mix_moments[k]) atomic_add_u64(launch.sink_words + 3 + k, sink.mix_moments[k]);
+      if (sink.mix_vertices) atomic_add_u64(launch.sink_words + 3 + kNeuralMixCandidates, sink.mix_vertices);
+      if (sink.mix_rejected) atomic_add_u64(launch.sink_words + 4 + kNeuralMixCandidates, sink.mix_rejected);
     }
   }
   const uint64_t* mine = reinterpret_cast<const uint64_t*>(&tc);

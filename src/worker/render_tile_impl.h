@@ -26,7 +26,7 @@ void merge_splats_by_pixel(std::vector<Splat>& splats, size_t first);
 constexpr uint32_t kSpecNeuralLambertian = kSpecNeural | kSpecGuiding | kSpecAreaLights;
 constexpr uint32_t instantiated_spec(uint32_t s) {
   if ((s & kSpecNeural) && (s & kSpecGuiding)) {
-    if ((s & (kSpecMedia | kSpecSurfaceAll)) == (kSpecGuiding | kSpecAreaLights)) return kSpecNeuralLambertian;
+    if (lambertian_area_lights_only(s)) return kSpecNeuralLambertian;
     return kSpecNeural | kSpecSurfaceAll | (s & kSpecMedia);
   }
   s &= ~kSpecNeural;

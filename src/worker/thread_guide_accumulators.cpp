@@ -44,7 +44,7 @@ void ThreadGuideAccumulators::begin_tile(const TileSettings& mine, const TileJob
   sink->count = 0;
   sink->tile = job.index;
   sink->rejected_nonfinite = sink->rejected_large = sink->dropped = 0;
-  for (uint64_t& v : sink->mix_votes) v = 0;
+  for (uint64_t& v : sink->mix_moments) v = 0;
   sink->mix_vertices = sink->mix_rejected = 0;
   sink->keep_prob = neural_tile_keep_prob(mine, job);
 }

@@ -510,16 +510,17 @@ TEST(NeuralGuide, MixtureWeightIsTheCandidateWithTheSmallestSecondMoment) {
   pass(g, 3.f, 100);  // too few vertices: nothing chosen
   EXPECT_EQ(g.mix_weight(), 0.5f);
   pass(g, 3.f, 5000);
-  EXPECT_EQ(g.mix_weight(), guide_mix_candidate(kNeuralMixCandidates - 1));
+  EXPECT_EQ(g.mix_candidate(), static_cast<int32_t>(kNeuralMixFirstCandidate + kNeuralMixCandidates - 1));
+  EXPECT_EQ(g.mix_weight(), 0.8f);
   EXPECT_EQ(g.view().guide_prob, g.mix_weight());
   EXPECT_EQ(g.stats().mix_weight, g.mix_weight());
   std::stringstream bytes;
   g.save(bytes, 9);
   EXPECT_TRUE(*NeuralGuide::load(bytes, 9) == g);
   pass(g, 0.01f, 5000);
-  EXPECT_EQ(g.mix_weight(), guide_mix_candidate(kNeuralMixFirstChoice));
+  EXPECT_EQ(g.mix_candidate(), static_cast<int32_t>(kNeuralMixFirstCandidate));
   EXPECT_EQ(g.mix_weight(), 0.5f);
-  // Non-finite statistics give no vote.
+  // Non-finite statistics are left out and counted.
   NeuralSampleSink sink;
   NeuralGuideView v = g.view();
   v.sink = &sink;

@@ -85,7 +85,8 @@ TEST(NeuralGuided, BitIdenticalImageAndWeightsAcrossThreadCounts) {
   EXPECT_GT(guides[0]->stats().steps, 0u);
   // The mixture statistics came through the integrator and the threads' sinks, and chose a weight.
   EXPECT_GT(guides[0]->stats().mix_vertices, 0u);
-  EXPECT_GE(guides[0]->mix_candidate(), static_cast<int32_t>(kNeuralMixFirstChoice));
+  EXPECT_NE(guides[0]->mix_candidate(), -1);
+  EXPECT_EQ(guides[0]->view().guide_prob, guide_mix_candidate(static_cast<uint32_t>(guides[0]->mix_candidate())));
   EXPECT_TRUE(films_identical(results[0].film, results[1].film));
   EXPECT_TRUE(films_identical(results[0].film, results[2].film));
   EXPECT_TRUE(*guides[0] == *guides[1]);
