@@ -169,6 +169,7 @@ NeuralGuideView NeuralGuide::view() const {
   v.lights = lights_;
   v.lo = lo_;
   v.extent = extent_;
+  v.reuse_radius = config_.reuse_cells * extent_ / static_cast<Float>(neural_level_resolution(kNeuralLevels - 1));
   v.scale = scale_ > 0.f ? scale_ : radiance_scale_;
   v.guide_prob = mix_weight();
   v.learn_mix = config_.learn_mix;

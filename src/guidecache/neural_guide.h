@@ -57,6 +57,11 @@ struct NeuralGuideConfig {
   // largest whose parameters and Adam's moments stay under 1 MB.
   uint32_t table_log2 = 11;
   uint64_t seed = 1;                 // weight initialisation
+  // How far from a pixel's earlier first vertex a later sample's may lie
+  // and reuse its site (NeuralFirstSite, kernels/path_guide.h), in cells of
+  // the hash grid's finest level (0: only at the same point). Behaviour,
+  // not learned state: not saved.
+  Float reuse_cells = 2.f;
   bool operator==(const NeuralGuideConfig&) const = default;
 };
 

@@ -36,6 +36,7 @@ struct PathCounters {
   uint64_t light_paths = 0;        // light paths traced for caustics (light_paths.h)
   uint64_t light_splats = 0;       // pixel contributions they made
   uint64_t caustic_emission_skipped = 0;  // emitter hits left to the light tracer
+  uint64_t neural_sites_reused = 0;       // vertices that reused their pixel's first site (NeuralFirstSite)
 };
 
 struct PathSettings {
@@ -61,6 +62,9 @@ struct PathSettings {
   // first vertex scatters non-specularly and whose later vertices are all
   // delta-only surfaces: the path tracer leaves it out.
   bool light_traced_caustics = false;
+  // With kSpecNeural: the pixel's first-vertex site the tile loop keeps
+  // between its samples (null: none; path_guide.h).
+  NeuralFirstSite* neural_first = nullptr;
 };
 
 namespace detail {
@@ -178,7 +182,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
   // The guide, per vertex (path_guide.h); `guide` is the table's view where
   // it learns next-event probability (the network does not: null).
   auto pg = [&]() {
-    if constexpr (kNeural) return NeuralPathGuide(settings.neural);
+    if constexpr (kNeural) return NeuralPathGuide(settings.neural, settings.neural_first);
     else return TablePathGuide{settings.guide};
   }();
   const GuideView* guide = kGuide ? pg.light_guide() : nullptr;
@@ -461,6 +465,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
         // The side the path is on: the two faces of a wall never share a cell.
         Vec3 n_side = glm::dot(h.ng, wo) >= 0.f ? h.ng : -h.ng;
         cell = pg.locate(h.p, n_side);
+        if constexpr (kNeural) c.neural_sites_reused += pg.reused ? 1u : 0u;
         if (learn) {
           pg.note_normal(cell, n_side);
           // Emission the integrator weights by MIS is NEE's to deliver.

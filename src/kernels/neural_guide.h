@@ -171,6 +171,7 @@ struct NeuralGuideView {
   uint32_t lights = 0;            // learned lights (NeuralLayout::lights): the scene's lights 0..lights-1
   Vec3 lo{0.f};                   // the encoded cube: [lo, lo + extent]^3 (the scene's bounds)
   Float extent = 1.f;
+  Float reuse_radius = 0.f;       // NeuralFirstSite's (path_guide.h), from NeuralGuideConfig::reuse_cells
   Float scale = 1.f;              // Q = scale * exp(output)
   Float guide_prob = 0.5f;        // mixture weight of guided sampling once the network has trained
   Float floor = 0.02f;            // share of each distribution spread uniformly

@@ -121,13 +121,41 @@ TESSERA_HOST_DEVICE inline void neural_record_mix(const NeuralGuideView& v, cons
   ++sink->mix_vertices;
 }
 
+// A pixel's first path vertex as the network saw it, kept from one of the
+// pixel's samples to the next by the CPU tile loop (render_tile_spec): a
+// later sample whose first vertex lies on the same surface nearby
+// (neural_site_reusable) reuses the site instead of running the network
+// again. Unbiased: the distribution a vertex samples with is then a
+// function of an earlier, independent sample, and its density is the one
+// it samples with. Training still records each vertex's own point.
+struct NeuralFirstSite {
+  NeuralSite site;
+  bool valid = false;
+};
+
+// Whether a site computed at (site.p, site.n) may stand for a vertex at (p,
+// n): the same side of a surface facing the same way, within the view's
+// reuse_radius (NeuralGuideConfig::reuse_cells: by default two cells of
+// the hash grid's finest level, within which about 0.7 of a pixel's later
+// first vertices lay on pillars and door-ajar at 256x192, and the error
+// per sample of a trained network did not change: docs/neural-guide.md).
+TESSERA_HOST_DEVICE inline bool neural_site_reusable(const NeuralGuideView& v, const NeuralSite& site, const Vec3& p,
+                                                     const Vec3& n) {
+  const Vec3 d = p - site.p;
+  return glm::dot(n, site.n) >= 0.9999f && glm::dot(d, d) <= v.reuse_radius * v.reuse_radius;
+}
+
 struct NeuralPathGuide {
   const NeuralGuideView& v;
   NeuralSite site[2];
   int32_t last = 1;  // slot of the latest vertex located
+  NeuralFirstSite* first = nullptr;  // the pixel's first-vertex site (null: every vertex runs the network)
+  bool at_first = true;              // the next vertex located is the path's first
+  bool reused = false;               // the latest vertex located reused `first`
   // The sites are filled by locate(), not zeroed here (about 1.5 kB each).
-  TESSERA_HOST_DEVICE explicit NeuralPathGuide(const NeuralGuideView& view) : v(view) {}
-  NeuralPathGuide(const NeuralGuideView&&) = delete;  // it keeps a reference: not to a temporary
+  TESSERA_HOST_DEVICE explicit NeuralPathGuide(const NeuralGuideView& view, NeuralFirstSite* first_site = nullptr)
+      : v(view), first(first_site) {}
+  NeuralPathGuide(const NeuralGuideView&&, NeuralFirstSite* = nullptr) = delete;  // it keeps a reference: not to a temporary
   // Next-event estimation at every vertex (no table to learn its probability).
   TESSERA_HOST_DEVICE const GuideView* light_guide() const { return nullptr; }
   // Light selection as the table's (light_select_pmf, select_light), from
@@ -150,13 +178,28 @@ struct NeuralPathGuide {
 
   // Runs the network into the slot not holding the latest vertex: the latest
   // one (a pending target's) stays readable.
+  // The path's first vertex reuses or renews the pixel's first site.
   TESSERA_HOST_DEVICE int32_t locate(const Vec3& p, const Vec3& n_side) {
     last ^= 1;
+    reused = false;
+    const bool keep = first != nullptr && at_first;
+    at_first = false;
+    if (keep && first->valid && neural_site_reusable(v, first->site, p, n_side)) {
+      site[last] = first->site;
+      site[last].p = p;  // what the vertex's training targets record
+      site[last].n = n_side;
+      reused = true;
+      return last;
+    }
 #if TESSERA_IS_GPU_CODE
     neural_infer(v, p, n_side, &site[last]);
 #else
     neural_infer_cpu(v, p, n_side, &site[last]);
 #endif
+    if (keep) {
+      first->site = site[last];
+      first->valid = true;
+    }
     return last;
   }
   TESSERA_HOST_DEVICE uint32_t bins() const { return kNeuralBins; }

@@ -254,6 +254,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     ps.samples = stats.counters.samples - before.samples;
     ps.zero_radiance = stats.counters.zero_radiance - before.zero_radiance;
     ps.vertices = stats.counters.path.vertices - before.path.vertices;
+    ps.neural_sites_reused = stats.counters.path.neural_sites_reused - before.path.neural_sites_reused;
     ps.guided_samples = stats.counters.path.guided_samples - before.path.guided_samples;
     ps.guidable_vertices = stats.counters.path.guidable_vertices - before.path.guidable_vertices;
     ps.guide_loss = pass_loss;

@@ -51,6 +51,7 @@ struct PassStats {
   uint64_t samples = 0;
   uint64_t zero_radiance = 0;
   uint64_t vertices = 0;      // surface interactions
+  uint64_t neural_sites_reused = 0;  // of them, those that reused their pixel's first network site
   uint64_t guided_samples = 0;
   uint64_t guidable_vertices = 0;
   double estimated_rel_mse = -1.0;  // of the image after this pass; < 0 = not yet estimable

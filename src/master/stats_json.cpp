@@ -81,13 +81,14 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
       j["guide_neural_mix_out_of_range"] = n.mix_rejected;
       j["guide_neural_train_seconds"] = n.train_seconds;
       j["guide_neural_inference_us"] = n.inference_seconds * 1e6;
+      j["guide_neural_sites_reused"] = c.path.neural_sites_reused;
       // Shares of the render's wall time: training (rank 0's, between passes),
-      // and inference estimated as one per path vertex at the measured cost,
-      // spread over the threads.
+      // and inference estimated as one per path vertex that did not reuse
+      // its pixel's first site, at the measured cost, spread over the threads.
       const double wall = std::max(s.seconds, 1e-9);
       j["guide_neural_train_fraction"] = n.train_seconds / wall;
       j["guide_neural_inference_fraction"] =
-          double(c.path.vertices) * n.inference_seconds / (std::max(1, s.threads) * wall);
+          double(c.path.vertices - c.path.neural_sites_reused) * n.inference_seconds / (std::max(1, s.threads) * wall);
     }
     if (s.ranks > 1) {
       j["guide_sync"] = (s.guide_sync);
@@ -136,10 +137,12 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
                       {"estimated_relmse", p.estimated_rel_mse},
                       {"guide_loss", p.guide_loss},
                       {"guide_seconds", p.guide_seconds},
-                      // The network's inference, one per path vertex at its last measured cost.
+                      // The network's inference, one per path vertex (but those
+                      // that reused a site) at its last measured cost.
                       {"guide_inference_fraction",
                        s.guide_mode == "neural" && p.seconds > 0
-                           ? double(p.vertices) * s.neural_guide.inference_seconds / (std::max(1, s.threads) * p.seconds)
+                           ? double(p.vertices - p.neural_sites_reused) * s.neural_guide.inference_seconds /
+                                 (std::max(1, s.threads) * p.seconds)
                            : 0.0}});
   }
   j["per_pass"] = passes;

@@ -16,7 +16,7 @@ namespace {
 // A new field in the guide's view must be uploaded in upload_guide (or shown
 // not to need it): this fails the build until someone looks.
 static_assert(sizeof(GuideView) == 200, "GuideView changed: upload its new arrays in upload_guide, then update this size");
-static_assert(sizeof(NeuralGuideView) == 88,
+static_assert(sizeof(NeuralGuideView) == 96,
               "NeuralGuideView changed: upload its new arrays in upload_network, then update this size");
 
 // Device memory for the learning targets of one batch (tiles stop joining a

@@ -115,10 +115,12 @@ using TileFn = TileCounters (*)(const SceneView&, const EmbreeTracer&, const Til
 
 template <size_t... I>
 constexpr std::array<TileFn, sizeof...(I)> make_table(std::index_sequence<I...>) {
-  return {&render_tile_spec<instantiated_spec(static_cast<uint32_t>(I)), EmbreeTracer>...};
+  return {&render_tile_spec<instantiated_spec(static_cast<uint32_t>(I)), EmbreeTracer, true>...};
 }
 
-// One instantiation per specialisation; chosen once per tile.
+// One instantiation per specialisation; chosen once per tile. The network's
+// pixels share their first sites between samples (NeuralFirstSite); the bvh
+// backend's do not, as the device's, which traces each sample alone.
 constexpr auto kTileFns = make_table(std::make_index_sequence<kSpecIndexCount>{});
 
 }  // namespace

@@ -85,6 +85,7 @@ struct TileCounters {
     path.light_paths += o.path.light_paths;
     path.light_splats += o.path.light_splats;
     path.caustic_emission_skipped += o.path.caustic_emission_skipped;
+    path.neural_sites_reused += o.path.neural_sites_reused;
     samples += o.samples;
     zero_radiance += o.zero_radiance;
     rejected_nonfinite += o.rejected_nonfinite;

@@ -36,12 +36,19 @@ constexpr uint32_t instantiated_spec(uint32_t s) {
 
 // Adds samples [sample_begin, sample_end) of every pixel of the job, in
 // sample order, and with light-traced caustics one light path per sample
-// whose splats are appended to *splats.
-template <uint32_t Spec, class Tracer>
+// whose splats are appended to *splats. ReuseFirstSite: with the neural
+// guide, a pixel's samples share the network's site at their first vertex
+// where they hit the same spot (NeuralFirstSite, kernels/path_guide.h;
+// the same on any thread and rank: a pixel's samples of a job are traced
+// in order by one thread).
+template <uint32_t Spec, class Tracer, bool ReuseFirstSite = false>
 TileCounters render_tile_spec(const SceneView& s, const Tracer& tracer, const TileSettings& settings,
                               const TileJob& job, TilePixels pixels, std::vector<Splat>* splats) {
   TileCounters tc;
   PathSettings path = settings.path;
+  NeuralFirstSite first_site;
+  constexpr bool kReuse = ReuseFirstSite && (Spec & kSpecNeural) != 0;
+  if constexpr (kReuse) path.neural_first = &first_site;
   const bool light_paths = path.light_traced_caustics && splats != nullptr;
   const SamplerSetup light_sampler = light_path_sampler(settings);
   auto add_splat = [&](uint64_t pixel, const Rgb& v) {
@@ -59,6 +66,7 @@ TileCounters render_tile_spec(const SceneView& s, const Tracer& tracer, const Ti
       const int32_t ix = s.camera.film_x0 + x, iy = s.camera.film_y0 + y;
       const uint64_t pixel_index = static_cast<uint64_t>(iy) * static_cast<uint64_t>(s.camera.width) + ix;
       PixelAccum& acc = pixels.at(job, x, y);
+      first_site.valid = false;
       for (uint32_t si = job.sample_begin; si < job.sample_end; ++si) {
         add_camera_sample<Spec>(s, tracer, settings, path, ix, iy, si, acc, tc);
         if (light_paths) {

@@ -857,5 +857,81 @@ TEST(NeuralGuide, InferenceGivesAProperDistribution) {
   EXPECT_LT(chi2, 220.0);
 }
 
+// A pixel's later samples reuse the network's site at their first vertex
+// (NeuralFirstSite) where it lies within the view's reuse_radius on a
+// surface facing the same way: the earlier sample's
+// distribution, bit for bit, with the vertex's own point and normal for its
+// training targets. Farther away, on another surface, at a deeper vertex,
+// in a new pixel or without a kept site, the network runs (and renews the
+// kept site where the vertex is a path's first).
+TEST(NeuralGuide, FirstVertexSiteIsReusedOnlyNearbyOnTheSameSurface) {
+  NeuralGuide g = make(small_config(), 3);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> w(-0.5f, 0.5f);
+  for (float& x : g.mutable_params()) x = w(rng);
+  NeuralGuideView v = g.view();
+  v.trained = true;
+  const Float radius = v.reuse_radius;
+  ASSERT_EQ(radius, 2.f * v.extent / 256.f);  // two of the finest level's cells (NeuralGuideConfig::reuse_cells)
+  const Vec3 n(0.f, 1.f, 0.f), p(0.31f, 0.2f, 0.47f);
+  auto fresh = [&](const Vec3& at, const Vec3& normal) {
+    NeuralSite s;
+    neural_infer_cpu(v, at, normal, &s);
+    return s;
+  };
+  auto same_distribution = [](const NeuralSite& a, const NeuralSite& b) {
+    bool same = a.irradiance == b.irradiance && a.qmax == b.qmax && a.light_prob == b.light_prob;
+    for (uint32_t j = 0; j < kNeuralBins; ++j) same = same && neural_site_pmf(a, j) == neural_site_pmf(b, j);
+    for (uint32_t l = 0; l < 3; ++l) same = same && a.light_pmf[l] == b.light_pmf[l];
+    return same;
+  };
+  const NeuralSite at_p = fresh(p, n);
+  const Vec3 near = p + Vec3(0.9f * radius, 0.f, 0.f), far = p + Vec3(0.f, 0.f, 1.1f * radius);
+  ASSERT_FALSE(same_distribution(at_p, fresh(far, n))) << "the test needs points the network tells apart";
+  NeuralFirstSite first;
+  {
+    NeuralPathGuide pg(v, &first);
+    const int32_t s = pg.locate(p, n);
+    EXPECT_FALSE(pg.reused);
+    ASSERT_TRUE(first.valid);
+    EXPECT_TRUE(same_distribution(pg.site[s], at_p));
+    pg.locate(p, n);  // a deeper vertex at the same spot
+    EXPECT_FALSE(pg.reused);
+  }
+  {
+    NeuralPathGuide pg(v, &first);  // the pixel's next sample
+    const int32_t s = pg.locate(near, n);
+    EXPECT_TRUE(pg.reused);
+    EXPECT_TRUE(same_distribution(pg.site[s], at_p));
+    EXPECT_EQ(pg.site[s].p, near);
+    EXPECT_EQ(pg.site[s].n, n);
+  }
+  {
+    NeuralPathGuide pg(v, &first);  // another surface through the same spot
+    const Vec3 tilted = glm::normalize(Vec3(0.05f, 1.f, 0.f));
+    const int32_t s = pg.locate(near, tilted);
+    EXPECT_FALSE(pg.reused);
+    EXPECT_TRUE(same_distribution(pg.site[s], fresh(near, tilted)));
+  }
+  {
+    NeuralPathGuide pg(v, &first);  // too far: runs, and the kept site is now far's
+    const int32_t s = pg.locate(far, n);
+    EXPECT_FALSE(pg.reused);
+    EXPECT_TRUE(same_distribution(pg.site[s], fresh(far, n)));
+    EXPECT_TRUE(same_distribution(first.site, fresh(far, n)));
+  }
+  first.valid = false;  // a new pixel
+  {
+    NeuralPathGuide pg(v, &first);
+    pg.locate(far, n);
+    EXPECT_FALSE(pg.reused);
+  }
+  {
+    NeuralPathGuide pg(v);  // nothing kept (the device, the bvh backend)
+    pg.locate(far, n);
+    EXPECT_FALSE(pg.reused);
+  }
+}
+
 }  // namespace
 }  // namespace tessera

@@ -48,7 +48,11 @@ TEST(NeuralGuided, DoorAjarAndShelterAgreeWithUnguided) {
   for (const char* name : {"door-ajar", "shelter"}) {
     SCOPED_TRACE(name);
     GuidedScene s(shipped(name, 40, 30, 192, 8));
-    auto guide = s.make_neural(small_network());
+    // A pixel's later samples reuse its first site wherever they land on the
+    // same surface (NeuralFirstSite, at the largest radius): still unbiased.
+    NeuralGuideConfig c = small_network();
+    c.reuse_cells = 1e4f;
+    auto guide = s.make_neural(c);
     // Shelter's three quad lights (six triangles): selection is learned (and must stay unbiased).
     EXPECT_EQ(guide->learned_lights(), std::string(name) == "shelter" ? 6u : 0u);
     RenderResult g = s.run(guide.get());
@@ -58,6 +62,7 @@ TEST(NeuralGuided, DoorAjarAndShelterAgreeWithUnguided) {
     expect_agree(channel_stats(g.film), mu, name);
     EXPECT_TRUE(all_finite(g.film));
     EXPECT_GT(g.stats.counters.path.guided_samples, g.stats.counters.path.vertices / 20);
+    EXPECT_GT(g.stats.counters.path.neural_sites_reused, g.stats.counters.path.vertices / 10);
     if (guide->learned_lights() > 0) {
       // The render selected lights from the network's distribution (after its first step).
       NeuralSite site;
@@ -70,12 +75,14 @@ TEST(NeuralGuided, DoorAjarAndShelterAgreeWithUnguided) {
 }
 
 TEST(NeuralGuided, BitIdenticalImageAndWeightsAcrossThreadCounts) {
-  GuidedScene s(shipped("shelter", 32, 24, 12, 6));
+  GuidedScene s(shipped("shelter", 32, 24, 24, 6));  // 16 single-sample learning passes, then one of 8
   RenderResult results[3];
   std::unique_ptr<NeuralGuide> guides[3];
   const int threads[3] = {1, 2, 4};
   for (int i = 0; i < 3; ++i) {
-    guides[i] = s.make_neural(small_network());
+    NeuralGuideConfig c = small_network();
+    c.reuse_cells = 1e4f;  // pixels' samples share first sites (NeuralFirstSite) wherever they may
+    guides[i] = s.make_neural(c);
     RenderOptions opt;
     opt.threads = threads[i];
     opt.tile_size = 8;
@@ -87,6 +94,9 @@ TEST(NeuralGuided, BitIdenticalImageAndWeightsAcrossThreadCounts) {
   EXPECT_GT(guides[0]->stats().mix_vertices, 0u);
   EXPECT_NE(guides[0]->mix_candidate(), -1);
   EXPECT_EQ(guides[0]->view().guide_prob, guide_mix_candidate(static_cast<uint32_t>(guides[0]->mix_candidate())));
+  // Pixels shared first sites between samples, the same ones whichever thread traced them.
+  EXPECT_GT(results[0].stats.counters.path.neural_sites_reused, 0u);
+  EXPECT_EQ(results[0].stats.counters.path.neural_sites_reused, results[2].stats.counters.path.neural_sites_reused);
   EXPECT_TRUE(films_identical(results[0].film, results[1].film));
   EXPECT_TRUE(films_identical(results[0].film, results[2].film));
   EXPECT_TRUE(*guides[0] == *guides[1]);
