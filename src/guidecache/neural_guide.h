@@ -32,8 +32,9 @@ namespace tessera {
 
 struct NeuralGuideConfig {
   // Neurons per hidden layer (two layers), at most kNeuralMaxWidth. Wider
-  // did not lower the error (docs/neural-guide.md), and the output layer
-  // (width x (144 + learned lights)) is most of an inference's arithmetic.
+  // lowers the error per sample where the light is intricate (shelter) but
+  // not at equal time: the output layer (width x (144 + learned lights)) is
+  // most of an inference's arithmetic (docs/neural-guide.md).
   uint32_t width = 8;
   // Adam steps (gradient all-reductions) after each learning pass, each on
   // its share of the pass's targets. Many small steps at a high rate are
