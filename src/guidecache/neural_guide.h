@@ -61,7 +61,8 @@ struct NeuralGuideConfig {
   // How far from a pixel's earlier first vertex a later sample's may lie
   // and reuse its site (NeuralFirstSite, kernels/path_guide.h), in cells of
   // the hash grid's finest level (0: only at the same point). Behaviour,
-  // not learned state: not saved.
+  // not learned state: not saved (a loaded guide, a farm worker's and a
+  // resumed one have the default; only code sets another).
   Float reuse_cells = 2.f;
   bool operator==(const NeuralGuideConfig&) const = default;
 };

@@ -323,6 +323,10 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
               break;
             }
             ++c.medium_vertices;
+            // A pixel's first network site stands only for first vertices its
+            // camera ray reached: a path that scattered first took other random
+            // numbers along, which a sample reaching a surface directly samples with.
+            if constexpr (kNeural) pg.at_first = false;
             if (depth == 1) first_vertex_connectable = settings.light_traced_caustics;
             last_vertex_delta_only = false;
             const Vec3 p = ray.o + seg.t * ray.d;

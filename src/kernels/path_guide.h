@@ -126,8 +126,12 @@ TESSERA_HOST_DEVICE inline void neural_record_mix(const NeuralGuideView& v, cons
 // later sample whose first vertex lies on the same surface nearby
 // (neural_site_reusable) reuses the site instead of running the network
 // again. Unbiased: the distribution a vertex samples with is then a
-// function of an earlier, independent sample, and its density is the one
-// it samples with. Training still records each vertex's own point.
+// function of another sample's camera ray alone (a path that scattered in
+// a medium first neither reuses nor renews the site: trace_path), whose
+// random numbers are other dimensions than those this vertex samples with,
+// and every sampler randomises its dimensions independently; the density
+// the vertex is weighted with is that distribution's. Training still
+// records each vertex's own point.
 struct NeuralFirstSite {
   NeuralSite site;
   bool valid = false;

@@ -95,6 +95,7 @@ TESSERA_HOST_DEVICE inline void trace_device_sample(const DeviceLaunch& launch, 
   uint64_t path_slot = 0;
   if constexpr ((Spec & kSpecNeural) != 0) {
     path.neural.sink = nullptr;
+    path.neural_first = nullptr;  // each sample alone (the CPU tile loop's first sites are host memory)
     const GuideLearnSchedule& learn = launch.settings.learn;
     if (launch.targets != nullptr && t.learning_samples > 0 && learn.learns(si)) {
       uint32_t ordinal = 0;  // among the tile's learning samples

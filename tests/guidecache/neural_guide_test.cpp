@@ -895,8 +895,10 @@ TEST(NeuralGuide, FirstVertexSiteIsReusedOnlyNearbyOnTheSameSurface) {
     EXPECT_FALSE(pg.reused);
     ASSERT_TRUE(first.valid);
     EXPECT_TRUE(same_distribution(pg.site[s], at_p));
-    pg.locate(p, n);  // a deeper vertex at the same spot
+    pg.locate(p, n);  // a deeper vertex at the same spot: runs
     EXPECT_FALSE(pg.reused);
+    pg.locate(far, n);  // and one elsewhere leaves the kept site alone
+    EXPECT_EQ(first.site.p, p);
   }
   {
     NeuralPathGuide pg(v, &first);  // the pixel's next sample
@@ -905,25 +907,38 @@ TEST(NeuralGuide, FirstVertexSiteIsReusedOnlyNearbyOnTheSameSurface) {
     EXPECT_TRUE(same_distribution(pg.site[s], at_p));
     EXPECT_EQ(pg.site[s].p, near);
     EXPECT_EQ(pg.site[s].n, n);
+    EXPECT_EQ(first.site.p, p) << "a reuse keeps the kept site";
   }
   {
-    NeuralPathGuide pg(v, &first);  // another surface through the same spot
-    const Vec3 tilted = glm::normalize(Vec3(0.05f, 1.f, 0.f));
-    const int32_t s = pg.locate(near, tilted);
-    EXPECT_FALSE(pg.reused);
-    EXPECT_TRUE(same_distribution(pg.site[s], fresh(near, tilted)));
-  }
-  {
-    NeuralPathGuide pg(v, &first);  // too far: runs, and the kept site is now far's
+    NeuralPathGuide pg(v, &first);  // too far on the same surface: runs, and renews the kept site
     const int32_t s = pg.locate(far, n);
     EXPECT_FALSE(pg.reused);
     EXPECT_TRUE(same_distribution(pg.site[s], fresh(far, n)));
     EXPECT_TRUE(same_distribution(first.site, fresh(far, n)));
+    EXPECT_EQ(first.site.p, far);
+  }
+  const Vec3 tilted = glm::normalize(Vec3(0.05f, 1.f, 0.f));
+  {
+    NeuralPathGuide pg(v, &first);  // another surface through the same spot: runs, renews
+    const int32_t s = pg.locate(far, tilted);
+    EXPECT_FALSE(pg.reused);
+    EXPECT_TRUE(same_distribution(pg.site[s], fresh(far, tilted)));
+  }
+  {
+    NeuralPathGuide pg(v, &first);  // a path that scattered in a medium first (trace_path)
+    pg.at_first = false;
+    pg.locate(far, tilted);
+    EXPECT_FALSE(pg.reused);
+  }
+  {
+    NeuralPathGuide pg(v, &first);  // (what the new pixel below would reuse)
+    pg.locate(far, tilted);
+    EXPECT_TRUE(pg.reused);
   }
   first.valid = false;  // a new pixel
   {
     NeuralPathGuide pg(v, &first);
-    pg.locate(far, n);
+    pg.locate(far, tilted);
     EXPECT_FALSE(pg.reused);
   }
   {
