@@ -335,7 +335,7 @@ def main():
     ap.add_argument("--time", type=float, default=30.0, help="wall-clock seconds per render")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--threads", type=int, default=0, help="0 = all cores")
-    ap.add_argument("--backend", default="embree", help="what renders every method (default embree: on a GPU machine auto would put some methods on the GPU and the neural guide on the CPU, and their times would not compare)")
+    ap.add_argument("--backend", default="embree", help="what renders every method (default embree: the 2-core CPU the figures in docs/ are for; on a GPU machine auto would render on the GPU, where the methods compare differently: docs/backends.md)")
     ap.add_argument("--stop-repeats", type=int, default=3, help="seeds per scene and method for the stopping rule")
     ap.add_argument("--ref-spp", type=int, default=ref_cache.DEFAULT_SPP)
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "accuracy"), help="renders and snapshots")

@@ -76,7 +76,7 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--ref-spp", type=int, default=8192)
     ap.add_argument("--threads", type=int, default=0)
-    ap.add_argument("--backend", default="embree", help="what renders every method (default embree: on a GPU machine auto would put some methods on the GPU and the neural guide on the CPU, and their times would not compare)")
+    ap.add_argument("--backend", default="embree", help="what renders every method (default embree: the 2-core CPU the figures in docs/ are for; on a GPU machine auto would render on the GPU, where the methods compare differently: docs/backends.md)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench-guiding"))
     ap.add_argument("--results", default="results.json", help="file name of the results, in --out")
     ap.add_argument("--guide-args", default="", help="extra options for the guided methods, e.g. '--guide-budget 4'")

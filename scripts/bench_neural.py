@@ -79,7 +79,7 @@ def main():
     ap.add_argument("--spp", type=int, default=64, help="samples per pixel of the equal-samples renders")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--threads", type=int, default=2, help="2: the CI machine's cores (0 = all)")
-    ap.add_argument("--backend", default="embree", help="what renders every method (default embree: on a GPU machine auto would put some methods on the GPU and the neural guide on the CPU, and their times would not compare)")
+    ap.add_argument("--backend", default="embree", help="what renders every method (default embree: the 2-core CPU the figures in docs/ are for; on a GPU machine auto would render on the GPU, where the methods compare differently: docs/backends.md)")
     ap.add_argument("--res", default="", help="WxH for every render")
     ap.add_argument("--reference", action="store_true", help="judge against cached references (scripts/reference.py)")
     ap.add_argument("--ref-spp", type=int, default=8192)

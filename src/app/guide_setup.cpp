@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "app/commands.h"
@@ -58,19 +59,24 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
   cmd->add_option("--guide-in", a.in, "Start from a guide cache saved by --guide-out (same scene only)");
   cmd->add_option("--guide-out", a.out, "Save the learned guide cache after rendering");
   cmd->add_option("--neural-width", a.neural_width, "--guide neural: neurons per hidden layer (two layers)")
-      ->check(CLI::Range(int64_t{1}, int64_t{kNeuralMaxWidth}));
+      ->check(CLI::Range(int64_t{1}, int64_t{kNeuralMaxWidth}))
+      ->each([&a](const std::string&) { a.neural_given.push_back("--neural-width"); });
   cmd->add_option("--neural-steps", a.neural_steps,
                   "--guide neural: Adam steps after each learning pass (each all-reduces the gradients in a farm)")
-      ->check(CLI::Range(int64_t{1}, int64_t{1024}));
-  cmd->add_option("--neural-lr", a.neural_lr, "--guide neural: Adam's learning rate")->check(finite_range(1e-6, 1.0));
+      ->check(CLI::Range(int64_t{1}, int64_t{1024}))
+      ->each([&a](const std::string&) { a.neural_given.push_back("--neural-steps"); });
+  cmd->add_option("--neural-lr", a.neural_lr, "--guide neural: Adam's learning rate")->check(finite_range(1e-6, 1.0))
+      ->each([&a](const std::string&) { a.neural_given.push_back("--neural-lr"); });
   cmd->add_option("--neural-targets", a.neural_targets,
                   "--guide neural: learning targets a tile keeps per learning pass, on average (training time grows with it)")
-      ->check(CLI::Range(int64_t{1}, int64_t{1} << 20));
+      ->check(CLI::Range(int64_t{1}, int64_t{1} << 20))
+      ->each([&a](const std::string&) { a.neural_given.push_back("--neural-targets"); });
   cmd->add_option("--neural-table", a.neural_table_log2,
                   "--guide neural: entries per hash-grid level, as a power of two (default " +
                       std::to_string(NeuralGuideConfig{}.table_log2) +
                       "; 12 is the largest whose state stays under 1 MB; the state doubles with each step)")
-      ->check(CLI::Range(int64_t{kNeuralMinTableLog2}, int64_t{kNeuralMaxTableLog2}));
+      ->check(CLI::Range(int64_t{kNeuralMinTableLog2}, int64_t{kNeuralMaxTableLog2}))
+      ->each([&a](const std::string&) { a.neural_given.push_back("--neural-table"); });
 }
 
 void apply_guide_render_options(const GuideArgs& a, RenderOptions* opt) {
@@ -85,6 +91,32 @@ bool guiding_helps(uint32_t effects) {
   const bool lit = (effects & (kEffectAreaLights | kEffectDeltaLights | kEffectEnvironment)) != 0;
   return scatters && lit;
 }
+
+namespace {
+
+// A network keeps the settings it was trained with (its shape, and how it
+// trains, are saved with it): a --neural-* option that differs from the
+// loaded network's would be silently ignored, so it is refused instead.
+void check_neural_options_match(const GuideArgs& a, const NeuralGuideConfig& c) {
+  auto refuse = [](const std::string& option, const std::string& given, const std::string& saved) {
+    throw std::runtime_error("its network was trained with " + option + " " + saved + ", not " + given +
+                             " (a loaded network keeps its settings: drop the option, or train a new network)");
+  };
+  for (const std::string& o : a.neural_given) {
+    if (o == "--neural-width" && a.neural_width != int64_t{c.width})
+      refuse(o, std::to_string(a.neural_width), std::to_string(c.width));
+    if (o == "--neural-steps" && a.neural_steps != int64_t{c.steps_per_pass})
+      refuse(o, std::to_string(a.neural_steps), std::to_string(c.steps_per_pass));
+    if (o == "--neural-lr" && static_cast<Float>(a.neural_lr) != c.learning_rate)
+      refuse(o, (std::ostringstream{} << a.neural_lr).str(), (std::ostringstream{} << c.learning_rate).str());
+    if (o == "--neural-targets" && a.neural_targets != int64_t{c.tile_targets})
+      refuse(o, std::to_string(a.neural_targets), std::to_string(c.tile_targets));
+    if (o == "--neural-table" && a.neural_table_log2 != int64_t{c.table_log2})
+      refuse(o, std::to_string(a.neural_table_log2), std::to_string(c.table_log2));
+  }
+}
+
+}  // namespace
 
 std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, std::string* why) {
   std::string mode = a.mode;
@@ -109,6 +141,9 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
       // A table file serves qtable and qlearning (its rule comes from the file); auto takes either kind.
       if (a.mode != "auto" && (g->mode() == "neural") != (mode == "neural"))
         throw std::runtime_error("holds a " + g->mode() + " guide, not --guide " + mode);
+      if (const auto* net = dynamic_cast<const NeuralGuide*>(g.get())) check_neural_options_match(a, net->config());
+      else if (!a.neural_given.empty())
+        throw std::runtime_error("holds a " + g->mode() + " guide, and " + a.neural_given[0] + " is for --guide neural");
       if (a.mix) g->set_guide_prob(static_cast<Float>(*a.mix));
       if (auto* field = dynamic_cast<GuideField*>(g.get())) field->set_nee_gain(a.nee == "always" ? 0.f : GuideConfig{}.nee_gain);
       *why = "loaded from " + a.in;
@@ -117,6 +152,8 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
       throw std::runtime_error("--guide-in " + a.in + ": " + e.what());
     }
   }
+  if (mode != "neural" && !a.neural_given.empty())
+    throw std::runtime_error(a.neural_given[0] + " is for --guide neural; the guide is " + mode + " (" + *why + ")");
   const Bounds& b = scene.bounds();
   if (mode == "neural") {
     NeuralGuideConfig nc;

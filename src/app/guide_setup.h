@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "guidecache/guide_field.h"
 #include "guidecache/neural_guide.h"
@@ -37,6 +38,10 @@ struct GuideArgs {
   double neural_lr = NeuralGuideConfig{}.learning_rate;
   int64_t neural_targets = NeuralGuideConfig{}.tile_targets;
   int64_t neural_table_log2 = NeuralGuideConfig{}.table_log2;
+  // The --neural-* options given on the command line, in order: a network
+  // loaded with --guide-in keeps the settings it was trained with, so a
+  // given one that differs is an error, not silently ignored.
+  std::vector<std::string> neural_given;
 };
 
 void add_guide_options(CLI::App* cmd, GuideArgs& args);

@@ -2,8 +2,9 @@
 // moments, collects a pass's learning targets, and trains between passes.
 //
 // What it learns is what the Q-table learns: per direction bin, the radiance
-// arriving at a point (expected-SARSA targets, computed by the integrator
-// from the network frozen during the pass: the target network). The loss is
+// arriving at a point (expected-SARSA targets, recorded by the integrator
+// with the network frozen during the pass; each training step recomputes a
+// target's bootstrapped part with the network as it is then). The loss is
 // relative L2, (Q - T)^2 / (Q^2 + eps) with Q held constant in the
 // denominator (Müller et al. 2021), whose minimiser is the mean target, as
 // the table's running mean; its gradient is clipped, which bounds what a

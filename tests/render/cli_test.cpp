@@ -245,6 +245,29 @@ TEST_F(CliTest, GuideCacheOptions) {
   EXPECT_NE(run("render --guide bogus").exit_code, 0);
 }
 
+// A network keeps the settings it was trained with: a --neural-* option that
+// differs from the loaded network's is refused in one line, not ignored, and
+// one given to a table guide is refused too.
+TEST_F(CliTest, NeuralOptionsThatContradictTheGuideAreRefused) {
+  const std::string net = (dir_ / "cornell.nguide").string(), out = (dir_ / "n.exr").string();
+  RunResult saved =
+      run("render -q --res 16x16 --spp 2 --guide neural --neural-width 4 --neural-steps 3 --guide-out " + net + " -o " + out);
+  ASSERT_EQ(saved.exit_code, 0) << saved.output;
+  EXPECT_EQ(run("render -q --res 16x16 --spp 1 --guide-in " + net + " -o " + out).exit_code, 0);
+  RunResult same = run("render -q --res 16x16 --spp 1 --guide neural --neural-width 4 --neural-steps 3 --guide-in " +
+                       net + " -o " + out);
+  EXPECT_EQ(same.exit_code, 0) << same.output;
+  RunResult wider = run("render -q --res 16x16 --spp 1 --neural-width 8 --guide-in " + net + " -o " + out);
+  EXPECT_NE(wider.exit_code, 0);
+  EXPECT_NE(wider.output.find("trained with --neural-width 4, not 8"), std::string::npos) << wider.output;
+  RunResult steps = run("render -q --res 16x16 --spp 1 --guide neural --neural-steps 48 --guide-in " + net + " -o " + out);
+  EXPECT_NE(steps.exit_code, 0);
+  EXPECT_NE(steps.output.find("--neural-steps 3, not 48"), std::string::npos) << steps.output;
+  RunResult table = run("render -q --res 16x16 --spp 1 --guide qtable --neural-width 4 -o " + out);
+  EXPECT_NE(table.exit_code, 0);
+  EXPECT_NE(table.output.find("--neural-width is for --guide neural"), std::string::npos) << table.output;
+}
+
 // The learning schedule reaches the render and its stats; fewer learning
 // samples mean fewer guide updates; bad values are refused.
 // Ctrl-C (SIGINT) during a long render: it stops after the pass under way
