@@ -208,6 +208,7 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
     if (m.guide) {
       try {
         m.guide = guide_from_bytes(m.resume->guide, *m.scene);
+        check_guide_options(a.guide, *m.guide);
       } catch (const std::exception& e) {
         throw std::runtime_error("--resume " + a.resume + ": " + e.what());
       }

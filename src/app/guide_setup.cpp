@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -92,31 +94,46 @@ bool guiding_helps(uint32_t effects) {
   return scatters && lit;
 }
 
-namespace {
-
 // A network keeps the settings it was trained with (its shape, and how it
 // trains, are saved with it): a --neural-* option that differs from the
 // loaded network's would be silently ignored, so it is refused instead.
-void check_neural_options_match(const GuideArgs& a, const NeuralGuideConfig& c) {
+void check_guide_options(const GuideArgs& a, const Guide& guide) {
+  const auto* net = dynamic_cast<const NeuralGuide*>(&guide);
+  if (!net) {
+    if (!a.neural_given.empty())
+      throw std::runtime_error("holds a " + guide.mode() + " guide, and " + a.neural_given[0] + " is for --guide neural");
+    return;
+  }
+  const NeuralGuideConfig& c = net->config();
   auto refuse = [](const std::string& option, const std::string& given, const std::string& saved) {
     throw std::runtime_error("its network was trained with " + option + " " + saved + ", not " + given +
                              " (a loaded network keeps its settings: drop the option, or train a new network)");
+  };
+  // Shortest that tells them apart: the learning rate is compared as the network stores it.
+  auto rates = [](Float given, Float saved) {
+    for (int digits : {6, std::numeric_limits<Float>::max_digits10}) {
+      std::ostringstream g, s;
+      g << std::setprecision(digits) << given;
+      s << std::setprecision(digits) << saved;
+      if (g.str() != s.str()) return std::make_pair(g.str(), s.str());
+    }
+    return std::make_pair(std::string(), std::string());
   };
   for (const std::string& o : a.neural_given) {
     if (o == "--neural-width" && a.neural_width != int64_t{c.width})
       refuse(o, std::to_string(a.neural_width), std::to_string(c.width));
     if (o == "--neural-steps" && a.neural_steps != int64_t{c.steps_per_pass})
       refuse(o, std::to_string(a.neural_steps), std::to_string(c.steps_per_pass));
-    if (o == "--neural-lr" && static_cast<Float>(a.neural_lr) != c.learning_rate)
-      refuse(o, (std::ostringstream{} << a.neural_lr).str(), (std::ostringstream{} << c.learning_rate).str());
+    if (o == "--neural-lr" && static_cast<Float>(a.neural_lr) != c.learning_rate) {
+      const auto [given, saved] = rates(static_cast<Float>(a.neural_lr), c.learning_rate);
+      refuse(o, given, saved);
+    }
     if (o == "--neural-targets" && a.neural_targets != int64_t{c.tile_targets})
       refuse(o, std::to_string(a.neural_targets), std::to_string(c.tile_targets));
     if (o == "--neural-table" && a.neural_table_log2 != int64_t{c.table_log2})
       refuse(o, std::to_string(a.neural_table_log2), std::to_string(c.table_log2));
   }
 }
-
-}  // namespace
 
 std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, std::string* why) {
   std::string mode = a.mode;
@@ -130,6 +147,8 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
   if (mode == "none" && a.mode == "auto" && !a.in.empty()) mode = "qtable";  // auto with a file: the file decides
   if (mode == "none") {
     if (!a.in.empty()) throw std::runtime_error("--guide none and --guide-in " + a.in + " contradict each other");
+    if (!a.neural_given.empty())
+      throw std::runtime_error(a.neural_given[0] + " is for --guide neural; the guide is none (" + *why + ")");
     return nullptr;
   }
   if (!a.in.empty()) {
@@ -141,9 +160,7 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
       // A table file serves qtable and qlearning (its rule comes from the file); auto takes either kind.
       if (a.mode != "auto" && (g->mode() == "neural") != (mode == "neural"))
         throw std::runtime_error("holds a " + g->mode() + " guide, not --guide " + mode);
-      if (const auto* net = dynamic_cast<const NeuralGuide*>(g.get())) check_neural_options_match(a, net->config());
-      else if (!a.neural_given.empty())
-        throw std::runtime_error("holds a " + g->mode() + " guide, and " + a.neural_given[0] + " is for --guide neural");
+      check_guide_options(a, *g);
       if (a.mix) g->set_guide_prob(static_cast<Float>(*a.mix));
       if (auto* field = dynamic_cast<GuideField*>(g.get())) field->set_nee_gain(a.nee == "always" ? 0.f : GuideConfig{}.nee_gain);
       *why = "loaded from " + a.in;

@@ -38,9 +38,9 @@ struct GuideArgs {
   double neural_lr = NeuralGuideConfig{}.learning_rate;
   int64_t neural_targets = NeuralGuideConfig{}.tile_targets;
   int64_t neural_table_log2 = NeuralGuideConfig{}.table_log2;
-  // The --neural-* options given on the command line, in order: a network
-  // loaded with --guide-in keeps the settings it was trained with, so a
-  // given one that differs is an error, not silently ignored.
+  // The --neural-* options given on the command line: a network loaded
+  // with --guide-in or --resume keeps the settings it was trained with, so
+  // a given one that differs is an error, not silently ignored.
   std::vector<std::string> neural_given;
 };
 
@@ -57,6 +57,11 @@ bool guiding_helps(uint32_t effects);
 // nullptr when guiding is off. Loads --guide-in when given (its learning rule
 // and budget then come from the file). *why explains the choice for the log.
 std::unique_ptr<Guide> make_guide(const GuideArgs& args, const SceneData& scene, std::string* why);
+
+// Throws std::runtime_error where a guide loaded from a file or a checkpoint
+// contradicts the --neural-* options given: a network trained with other
+// settings, or a table guide.
+void check_guide_options(const GuideArgs& args, const Guide& guide);
 
 // Throws std::runtime_error where a loaded guide does not fit the scene in a
 // way the scene fingerprint cannot tell (a network's light outputs).

@@ -246,8 +246,8 @@ TEST_F(CliTest, GuideCacheOptions) {
 }
 
 // A network keeps the settings it was trained with: a --neural-* option that
-// differs from the loaded network's is refused in one line, not ignored, and
-// one given to a table guide is refused too.
+// differs from the network loaded from a file or a checkpoint is refused in
+// one line, not ignored, and one given where no network guides is refused too.
 TEST_F(CliTest, NeuralOptionsThatContradictTheGuideAreRefused) {
   const std::string net = (dir_ / "cornell.nguide").string(), out = (dir_ / "n.exr").string();
   RunResult saved =
@@ -263,9 +263,28 @@ TEST_F(CliTest, NeuralOptionsThatContradictTheGuideAreRefused) {
   RunResult steps = run("render -q --res 16x16 --spp 1 --guide neural --neural-steps 48 --guide-in " + net + " -o " + out);
   EXPECT_NE(steps.exit_code, 0);
   EXPECT_NE(steps.output.find("--neural-steps 3, not 48"), std::string::npos) << steps.output;
+  RunResult rate = run("render -q --res 16x16 --spp 1 --neural-lr 0.01 --guide-in " + net + " -o " + out);
+  EXPECT_NE(rate.exit_code, 0);
+  EXPECT_NE(rate.output.find("--neural-lr 0.02, not 0.01"), std::string::npos) << rate.output;
   RunResult table = run("render -q --res 16x16 --spp 1 --guide qtable --neural-width 4 -o " + out);
   EXPECT_NE(table.exit_code, 0);
   EXPECT_NE(table.output.find("--neural-width is for --guide neural"), std::string::npos) << table.output;
+  RunResult none = run("render -q --res 16x16 --spp 1 --guide none --neural-table 12 -o " + out);
+  EXPECT_NE(none.exit_code, 0);
+  EXPECT_NE(none.output.find("--neural-table is for --guide neural"), std::string::npos) << none.output;
+
+  // A checkpoint's network is held to the options given with --resume as well.
+  const std::string ckpt = (dir_ / "n.ckpt").string();
+  const std::string trained = " --res 16x16 --guide neural --neural-width 4 --neural-steps 3 -o " + out;
+  ASSERT_EQ(run("render -q --spp 2 --checkpoint " + ckpt + trained).exit_code, 0);
+  RunResult resumed = run("render -q --spp 3 --resume " + ckpt + trained);
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.output;
+  RunResult resumed_wider =
+      run("render -q --spp 3 --res 16x16 --guide neural --neural-width 8 -o " + out + " --resume " + ckpt);
+  EXPECT_NE(resumed_wider.exit_code, 0);
+  EXPECT_NE(resumed_wider.output.find("--resume " + ckpt + ": its network was trained with --neural-width 4, not 8"),
+            std::string::npos)
+      << resumed_wider.output;
 }
 
 // The learning schedule reaches the render and its stats; fewer learning
