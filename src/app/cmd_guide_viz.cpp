@@ -128,9 +128,10 @@ int run_guide_viz(VizArgs a) {
     throw std::runtime_error("guide-viz: nothing to do; give --distribution FILE.exr and/or --diagnostic FILE.exr");
   SceneData scene(load_scene_or_builtin(a.scene));
   EmbreeBackend embree(scene);
-  // Without a file to load, something must be learned: the table unless --guide neural.
+  // Without a file to load, something must be learned: the table unless
+  // --guide neural, or --neural-* options, ask for the network.
   if (!a.guide.in.empty()) a.guide.mode = "auto";  // the file says which kind
-  else if (a.guide.mode == "auto" || a.guide.mode == "none") a.guide.mode = "qtable";
+  else if (a.guide.mode == "auto" || a.guide.mode == "none") a.guide.mode = a.guide.neural_given.empty() ? "qtable" : "neural";
   std::string why;
   std::unique_ptr<Guide> field = make_guide(a.guide, scene, &why);
   if (a.guide.in.empty()) {

@@ -273,6 +273,16 @@ TEST_F(CliTest, NeuralOptionsThatContradictTheGuideAreRefused) {
   EXPECT_NE(none.exit_code, 0);
   EXPECT_NE(none.output.find("--neural-table is for --guide neural"), std::string::npos) << none.output;
 
+  // guide-viz learns a network where --neural-* options ask for one, and holds a loaded one to them.
+  const std::string dist = (dir_ / "q.exr").string(), at = " --point 0 0.2 0 --normal 0 1 0 --distribution " + dist;
+  RunResult viz = run("guide-viz --train-spp 2 --neural-width 4" + at);
+  EXPECT_EQ(viz.exit_code, 0) << viz.output;
+  EXPECT_NE(viz.output.find("trained the neural guide"), std::string::npos) << viz.output;
+  EXPECT_TRUE(fs::exists(dist));
+  RunResult viz_wider = run("guide-viz --neural-width 8 --guide-in " + net + at);
+  EXPECT_NE(viz_wider.exit_code, 0);
+  EXPECT_NE(viz_wider.output.find("trained with --neural-width 4, not 8"), std::string::npos) << viz_wider.output;
+
   // A checkpoint's network is held to the options given with --resume as well.
   const std::string ckpt = (dir_ / "n.ckpt").string();
   const std::string trained = " --res 16x16 --guide neural --neural-width 4 --neural-steps 3 -o " + out;
