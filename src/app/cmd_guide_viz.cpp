@@ -131,7 +131,8 @@ int run_guide_viz(VizArgs a) {
   // Without a file to load, something must be learned: the table unless
   // --guide neural, or --neural-* options, ask for the network.
   if (!a.guide.in.empty()) a.guide.mode = "auto";  // the file says which kind
-  else if (a.guide.mode == "auto" || a.guide.mode == "none") a.guide.mode = a.guide.neural_given.empty() ? "qtable" : "neural";
+  else if (a.guide.mode == "auto" || a.guide.mode == "none")
+    a.guide.mode = a.guide.neural_given.empty() ? "qtable" : "neural";
   std::string why;
   std::unique_ptr<Guide> field = make_guide(a.guide, scene, &why);
   if (a.guide.in.empty()) {

@@ -145,10 +145,12 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
     *why = "--guide " + mode;
   }
   if (mode == "none" && a.mode == "auto" && !a.in.empty()) mode = "qtable";  // auto with a file: the file decides
+  // Without a file, --neural-* options shape a new network (a loaded guide
+  // is held to them by check_guide_options).
+  if (a.in.empty() && mode != "neural" && !a.neural_given.empty())
+    throw std::runtime_error(a.neural_given[0] + " is for --guide neural; the guide is " + mode + " (" + *why + ")");
   if (mode == "none") {
     if (!a.in.empty()) throw std::runtime_error("--guide none and --guide-in " + a.in + " contradict each other");
-    if (!a.neural_given.empty())
-      throw std::runtime_error(a.neural_given[0] + " is for --guide neural; the guide is none (" + *why + ")");
     return nullptr;
   }
   if (!a.in.empty()) {
@@ -169,8 +171,6 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
       throw std::runtime_error("--guide-in " + a.in + ": " + e.what());
     }
   }
-  if (mode != "neural" && !a.neural_given.empty())
-    throw std::runtime_error(a.neural_given[0] + " is for --guide neural; the guide is " + mode + " (" + *why + ")");
   const Bounds& b = scene.bounds();
   if (mode == "neural") {
     NeuralGuideConfig nc;
