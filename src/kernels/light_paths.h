@@ -33,7 +33,11 @@
 // carries its own three wavelengths, as a camera path does.
 #pragma once
 
-#include "integrator.h"
+#include "bsdf_spec.h"
+#include "light_sampling.h"
+#include "material_eval.h"
+#include "path_state.h"
+#include "volume_transport.h"
 
 namespace tessera {
 

@@ -1,13 +1,25 @@
 // The integrator's one interface to a guide, per path: locate a vertex,
 // the mixture weight there, sample a direction and its density, the
-// radiance predicted along a bin, and record learning targets. Two plain
+// radiance predicted along a bin, and record learning targets. Three plain
 // implementations, picked at compile time by the specialisation bits
-// (kSpecGuiding, kSpecNeural): TablePathGuide over the Q-table's GuideView
-// (what trace_path did inline before, operation for operation, so its
-// images are unchanged), and NeuralPathGuide, which runs the network once
-// per vertex into one of two sites (the current vertex and the one whose
-// target is pending). A vertex is named by an int32_t handle: the table's
-// cell, the neural site's slot; -1 is none.
+// (make_path_guide): NoPathGuide (no guiding: light selection by power,
+// nothing else), TablePathGuide over the Q-table's GuideView, and
+// NeuralPathGuide, which runs the network once per vertex into one of two
+// sites (the current vertex and the one whose target is pending). A vertex
+// is named by an int32_t handle: the table's cell, the neural site's slot;
+// -1 is none. Each also carries the path's pending learning target
+// (PendingTarget, path_learning.h), which the integrator's hooks fill and
+// commit.
+//
+// The hooks, by the stage that calls them (integrator.h):
+// - surface interaction: locates(depth), locate, reused_site, note_normal;
+// - medium interaction: at_medium_vertex;
+// - direct light: nee_probability, pick_light, light_pmf, lookup, lookup_pdf;
+// - the vertex's estimate: learned, bins_integral, record, record_nee,
+//   record_light;
+// - scattering: probability, prefetch_sample, sample, bin_of, bin_pdf,
+//   value, learns_mix, record_mix;
+// - Russian roulette: survival.
 #pragma once
 
 #include "guiding.h"
@@ -26,10 +38,69 @@ struct GuideBootstrap {
   Float value = 0.f;
 };
 
+// Learning update waiting for the end of the current segment x -> y: into
+// entry `bin` of x's vertex `cell`. `le` is the part of the target known at
+// y's hit (emission next-event estimation does not cover); the rest comes
+// from y's NEE and bins, or, where y has only a delta lobe (at_delta), from
+// the direction it takes.
+struct PendingTarget {
+  int32_t cell = -1;
+  uint32_t bin = 0;
+  Float le = 0.f;
+  bool at_delta = false;
+  // The pending direction's densities, for the mixture-weight statistics
+  // (mix.mix_pdf 0: the vertex did not take part).
+  GuideMixSample mix;
+};
+
+// No guiding: every hook is the unguided integrator's choice (light
+// selection by power, next-event estimation everywhere, the BSDF alone).
+struct NoPathGuide {
+  static constexpr bool kLearns = false;
+  PendingTarget pending;  // never filled
+  TESSERA_HOST_DEVICE Float nee_probability(int32_t) const { return 1.f; }
+  TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, int32_t cell, uint32_t li) const {
+    return light_select_pmf(s, nullptr, cell, li);
+  }
+  TESSERA_HOST_DEVICE uint32_t pick_light(const SceneView& s, int32_t cell, Float u, Float* pmf) const {
+    return select_light(s, nullptr, cell, u, pmf);
+  }
+  TESSERA_HOST_DEVICE bool locates(int32_t, int32_t) const { return false; }
+  TESSERA_HOST_DEVICE int32_t locate(const Vec3&, const Vec3&) { return -1; }
+  TESSERA_HOST_DEVICE bool reused_site() const { return false; }
+  TESSERA_HOST_DEVICE void at_medium_vertex() {}
+  TESSERA_HOST_DEVICE void note_normal(int32_t, const Vec3&) const {}
+  TESSERA_HOST_DEVICE bool learned(int32_t) const { return false; }
+  TESSERA_HOST_DEVICE Float probability(int32_t, const BsdfParams&, bool) const { return 0.f; }
+  TESSERA_HOST_DEVICE void prefetch_sample(int32_t, Float) const {}
+  using DirLookup = Float;
+  TESSERA_HOST_DEVICE DirLookup lookup(int32_t, const Vec3&) const { return 0.f; }
+  TESSERA_HOST_DEVICE Float lookup_pdf(DirLookup) const { return 0.f; }
+  TESSERA_HOST_DEVICE bool sample(int32_t, Float, Vec2, Vec3*, Float*, uint32_t*) const { return false; }
+  TESSERA_HOST_DEVICE uint32_t bin_of(const Vec3&) const { return 0; }
+  TESSERA_HOST_DEVICE Float bin_pdf(int32_t, uint32_t) const { return 0.f; }
+  TESSERA_HOST_DEVICE Float value(int32_t, uint32_t) const { return 0.f; }
+  TESSERA_HOST_DEVICE Float survival(int32_t, uint32_t, Float, Float, Float) const { return 0.f; }
+  template <class ToLocal>
+  TESSERA_HOST_DEVICE Float bins_integral(int32_t, const BsdfParams&, bool, const Vec3&, const ToLocal&, PixelSampler&,
+                                          GuideBootstrap*) const {
+    return 0.f;
+  }
+  TESSERA_HOST_DEVICE bool record(int32_t, uint32_t, Float, const GuideBootstrap&) const { return false; }
+  TESSERA_HOST_DEVICE void record_light(int32_t, uint32_t, Float) const {}
+  TESSERA_HOST_DEVICE void record_nee(int32_t, Float, Float) const {}
+  TESSERA_HOST_DEVICE bool learns_mix(int32_t, Float) const { return false; }
+  TESSERA_HOST_DEVICE void record_mix(int32_t, const GuideMixSample&, Float) const {}
+};
+
 struct TablePathGuide {
+  static constexpr bool kLearns = true;
   const GuideView& g;
+  PendingTarget pending;
+  TESSERA_HOST_DEVICE explicit TablePathGuide(const GuideView& view) : g(view) {}
+  TablePathGuide(const GuideView&&) = delete;  // it keeps a reference: not to a temporary
   // Light selection and next-event probability are learned per cell.
-  TESSERA_HOST_DEVICE const GuideView* light_guide() const { return &g; }
+  TESSERA_HOST_DEVICE Float nee_probability(int32_t cell) const { return tessera::nee_probability(&g, cell); }
   // Probability that next-event estimation at `cell` (-1: none, as in a
   // medium) traces a shadow ray to light li, and the draw of that light.
   TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, int32_t cell, uint32_t li) const {
@@ -39,7 +110,10 @@ struct TablePathGuide {
     return select_light(s, &g, cell, u, pmf);
   }
 
+  TESSERA_HOST_DEVICE bool locates(int32_t, int32_t) const { return true; }
   TESSERA_HOST_DEVICE int32_t locate(const Vec3& p, const Vec3& n_side) { return guide_find_cell(g, p, n_side); }
+  TESSERA_HOST_DEVICE bool reused_site() const { return false; }
+  TESSERA_HOST_DEVICE void at_medium_vertex() {}
   TESSERA_HOST_DEVICE uint32_t bins() const { return g.bins; }
   TESSERA_HOST_DEVICE Vec3 bin_dir(uint32_t j) const { return g.bin_dirs[j]; }
   TESSERA_HOST_DEVICE Float irradiance(int32_t cell) const { return g.irradiance[cell]; }
@@ -127,7 +201,7 @@ TESSERA_HOST_DEVICE inline void neural_record_mix(const NeuralGuideView& v, cons
 // (neural_site_reusable) reuses the site instead of running the network
 // again. Unbiased: the distribution a vertex samples with is then a
 // function of another sample's camera ray alone (a path that scattered in
-// a medium first neither reuses nor renews the site: trace_path), whose
+// a medium first neither reuses nor renews the site: at_medium_vertex), whose
 // random numbers are other dimensions than those this vertex samples with,
 // and every sampler randomises its dimensions independently; the density
 // the vertex is weighted with is that distribution's. Training still
@@ -150,7 +224,9 @@ TESSERA_HOST_DEVICE inline bool neural_site_reusable(const NeuralGuideView& v, c
 }
 
 struct NeuralPathGuide {
+  static constexpr bool kLearns = true;
   const NeuralGuideView& v;
+  PendingTarget pending;
   NeuralSite site[2];
   int32_t last = 1;  // slot of the latest vertex located
   NeuralFirstSite* first = nullptr;  // the pixel's first-vertex site (null: every vertex runs the network)
@@ -161,7 +237,7 @@ struct NeuralPathGuide {
       : v(view), first(first_site) {}
   NeuralPathGuide(const NeuralGuideView&&, NeuralFirstSite* = nullptr) = delete;  // it keeps a reference: not to a temporary
   // Next-event estimation at every vertex (no table to learn its probability).
-  TESSERA_HOST_DEVICE const GuideView* light_guide() const { return nullptr; }
+  TESSERA_HOST_DEVICE Float nee_probability(int32_t) const { return 1.f; }
   // Light selection as the table's (light_select_pmf, select_light), from
   // the site's learned distribution where it has one, else by power.
   TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, int32_t slot, uint32_t li) const {
@@ -180,6 +256,14 @@ struct NeuralPathGuide {
     return li;
   }
 
+  // The network is not run where the path ends (it would guide nothing,
+  // and the pending target is dropped there).
+  TESSERA_HOST_DEVICE bool locates(int32_t depth, int32_t max_depth) const { return depth != max_depth; }
+  TESSERA_HOST_DEVICE bool reused_site() const { return reused; }
+  // A pixel's first network site stands only for first vertices its camera
+  // ray reached: a path that scattered in a medium first took other random
+  // numbers along, which a sample reaching a surface directly samples with.
+  TESSERA_HOST_DEVICE void at_medium_vertex() { at_first = false; }
   // Runs the network into the slot not holding the latest vertex: the latest
   // one (a pending target's) stays readable.
   // The path's first vertex reuses or renews the pixel's first site.

@@ -62,15 +62,9 @@ class CudaDevice : public DeviceApi {
   void zero(void* dst, size_t bytes) override { cuda_check_error(cudaMemset(dst, 0, bytes), "cudaMemset"); }
   void start(const DeviceLaunch& launch, uint32_t spec) override {
     if (launch.num_tiles == 0 || launch.max_samples == 0) return;
-    switch (served_specialisation(spec)) {
-      case kServedSurface | kSpecGuiding: launch_render_tiles<kServedSurface | kSpecGuiding>(launch); break;
-      case kServedSurface | kSpecGuiding | kSpecNeural:
-        launch_render_tiles<kServedSurface | kSpecGuiding | kSpecNeural>(launch);
-        break;
-      case kServedSurface: launch_render_tiles<kServedSurface>(launch); break;
-      default:
-        throw std::runtime_error("the CUDA backend has no media kernels (device_backend_obstacle keeps such scenes off it)");
-    }
+    if (spec & kSpecMedia)
+      throw std::runtime_error("the CUDA backend has no media kernels (device_backend_obstacle keeps such scenes off it)");
+    dispatch_served<false>(spec, [&](auto served) { launch_render_tiles<decltype(served)::value>(launch); });
     accumulate_kernel<<<launch.num_tiles, kCudaThreadsPerBlock>>>(launch);
     cuda_check_error(cudaGetLastError(), "launch");
     cuda_check_error(cudaEventRecord(done_), "cudaEventRecord");

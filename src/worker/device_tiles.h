@@ -10,6 +10,9 @@
 // the neural guide's targets are gathered per tile after the trace.
 #pragma once
 
+#include <stdexcept>
+#include <type_traits>
+
 #include "kernels/bvh.h"
 #include "master/film.h"
 #include "worker/pixel_sample.h"
@@ -72,6 +75,33 @@ constexpr uint32_t kServedMedia = kSpecMedia | kServedSurface;
 TESSERA_HOST_DEVICE constexpr uint32_t served_specialisation(uint32_t spec) {
   const uint32_t guide = (spec & kSpecGuiding) ? spec & (kSpecGuiding | kSpecNeural) : 0u;
   return ((spec & kSpecMedia) ? kServedMedia : kServedSurface) | guide;
+}
+
+// The one switch from a specialisation to its served instantiation:
+// fn(std::integral_constant<uint32_t, Served>{}) for the portable BVH's
+// backends (worker/bvh_backend.cpp, worker/host_device.cpp,
+// worker/cuda_device.cu). WithMedia false: a backend without media
+// kernels (the CUDA device), for which a media specialisation is a logic error.
+template <bool WithMedia = true, class Fn>
+decltype(auto) dispatch_served(uint32_t spec, Fn&& fn) {
+  using std::integral_constant;
+  switch (served_specialisation(spec)) {
+    case kServedSurface: return fn(integral_constant<uint32_t, kServedSurface>{});
+    case kServedSurface | kSpecGuiding: return fn(integral_constant<uint32_t, kServedSurface | kSpecGuiding>{});
+    case kServedSurface | kSpecGuiding | kSpecNeural:
+      return fn(integral_constant<uint32_t, kServedSurface | kSpecGuiding | kSpecNeural>{});
+    default: break;
+  }
+  if constexpr (WithMedia) {
+    switch (served_specialisation(spec)) {
+      case kServedMedia | kSpecGuiding: return fn(integral_constant<uint32_t, kServedMedia | kSpecGuiding>{});
+      case kServedMedia | kSpecGuiding | kSpecNeural:
+        return fn(integral_constant<uint32_t, kServedMedia | kSpecGuiding | kSpecNeural>{});
+      default: return fn(integral_constant<uint32_t, kServedMedia>{});
+    }
+  } else {
+    throw std::logic_error("a media specialisation on a backend without media kernels");
+  }
 }
 
 static_assert(sizeof(TileCounters) % sizeof(uint64_t) == 0, "TileCounters is added word by word");

@@ -36,16 +36,7 @@ class EmulatedDevice : public HostMemoryDevice {
   bool has_media_kernels() const override { return true; }
   // Runs the launch to its end: the emulation has nothing to overlap.
   void start(const DeviceLaunch& launch, uint32_t spec) override {
-    switch (served_specialisation(spec)) {
-      case kServedMedia | kSpecGuiding | kSpecNeural:
-        return run_launch<kServedMedia | kSpecGuiding | kSpecNeural>(launch, arena_);
-      case kServedSurface | kSpecGuiding | kSpecNeural:
-        return run_launch<kServedSurface | kSpecGuiding | kSpecNeural>(launch, arena_);
-      case kServedMedia | kSpecGuiding: return run_launch<kServedMedia | kSpecGuiding>(launch, arena_);
-      case kServedMedia: return run_launch<kServedMedia>(launch, arena_);
-      case kServedSurface | kSpecGuiding: return run_launch<kServedSurface | kSpecGuiding>(launch, arena_);
-      default: return run_launch<kServedSurface>(launch, arena_);
-    }
+    dispatch_served(spec, [&](auto served) { run_launch<decltype(served)::value>(launch, arena_); });
   }
 
  private:
