@@ -27,8 +27,8 @@
 #include <vector>
 
 #include "comm/wire.h"
-#include "master/film.h"
-#include "worker/render_tile.h"
+#include "render/film.h"
+#include "render/render_tile.h"
 
 namespace tessera {
 

@@ -10,8 +10,8 @@
 #include <thread>
 
 #include "comm/farm_protocol.h"
-#include "master/interrupt.h"
-#include "master/ordered_splats.h"
+#include "render/interrupt.h"
+#include "render/ordered_splats.h"
 
 namespace tessera {
 namespace {

@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "comm/farm_protocol.h"
-#include "master/interrupt.h"
-#include "worker/guide_binding.h"
+#include "render/interrupt.h"
+#include "render/guide_binding.h"
 
 namespace tessera {
 namespace {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "../test_dir.h"
-#include "master/snapshots.h"
+#include "render/snapshots.h"
 
 namespace tessera {
 namespace {
