@@ -1,7 +1,8 @@
-// What a tile is: a rectangle of pixels and a range of sample indices, the
-// settings every tile of a render shares, and the counters a tile returns.
-// Rendering one is a pure function of (scene, job, seed); each backend
-// (render/tile_backend.h) does it with its own ray queries.
+// What a tile is rendered with: the settings every tile of a render shares,
+// the counters a tile returns and where its pixel accumulators are (the tile
+// itself, TileJob, is in render/tile_job.h). Rendering one is a pure
+// function of (scene, job, seed); each backend (render/tile_backend.h) does
+// it with its own ray queries.
 #pragma once
 
 #include <algorithm>
@@ -10,14 +11,9 @@
 
 #include "kernels/integrator.h"
 #include "render/film.h"
+#include "render/tile_job.h"
 
 namespace tessera {
-
-struct TileJob {
-  int32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // [x0, x1) x [y0, y1)
-  uint32_t sample_begin = 0, sample_end = 0;
-  uint32_t index = 0;  // the tile's place in the pass: light-path splats are added to the film in this order
-};
 
 // Which samples train the guide, by sample index (so it is the same on every
 // thread and rank): every sample below all_spp, then every `every`-th (0:
