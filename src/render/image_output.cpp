@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "render/renderer.h"
 #include "scene/image_io.h"
 
 namespace tessera {

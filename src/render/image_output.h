@@ -7,10 +7,11 @@
 #include <string>
 
 #include "render/film.h"
-#include "render/renderer.h"
 #include "scene/scene_desc.h"
 
 namespace tessera {
+
+struct RenderStats;  // render/renderer.h
 
 struct ExrMetadata {
   std::map<std::string, std::string> strings;

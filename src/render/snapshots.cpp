@@ -6,6 +6,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "render/renderer.h"
+
 namespace tessera {
 
 SnapshotPolicy parse_snapshot_policy(const std::string& text) {

@@ -7,9 +7,10 @@
 #include <vector>
 
 #include "render/image_output.h"
-#include "render/renderer.h"
 
 namespace tessera {
+
+struct RenderResult;  // render/renderer.h
 
 // When to write: every `every_s` seconds, or each time the samples per
 // pixel reach the next power of two (evenly spaced on a log-log plot).

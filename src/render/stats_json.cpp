@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "render/renderer.h"
 #include "scene/scene_effects.h"
 
 namespace tessera {

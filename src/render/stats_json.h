@@ -5,10 +5,11 @@
 
 #include <vector>
 
-#include "render/renderer.h"
 #include "render/snapshots.h"
 
 namespace tessera {
+
+struct RenderStats;  // render/renderer.h
 
 std::string stats_to_json(const RenderStats& stats, const std::string& scene, int32_t width, int32_t height,
                           uint64_t seed, const std::vector<SnapshotRecord>& snapshots = {});

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "../test_dir.h"
+#include "render/renderer.h"
 #include "render/snapshots.h"
 
 namespace tessera {
