@@ -3,10 +3,12 @@
 
     app -> farm roles (master, worker -> comm) -> render -> scene, guidecache -> kernels
 
-Reads every #include "..." under src/ and prints one line per include that
-goes the wrong way (file:line, the include, the rule it breaks); exits 1 if
-there is any. The rules are the three tables below; docs/architecture.md
-shows MAY_INCLUDE as printed by --table, and --docs checks that it still does.
+Reads every #include under src/ and prints one line per include that goes
+the wrong way (file:line, the include, the rule it breaks); exits 1 if there
+is any. The rules are the tables below: MAY_INCLUDE (folder to folder),
+NEVER_REACHES (through any chain of includes), LIBRARY_HOMES (<...> headers
+kept in their files), and the named EXCEPTIONS. docs/architecture.md shows
+MAY_INCLUDE as --table prints it; --docs checks that it still does.
 
     scripts/check_layers.py [--src DIR] [--docs FILE] [--table] [--self-test]
 
