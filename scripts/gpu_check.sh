@@ -29,7 +29,7 @@ if [ -n "${GPU_BUNDLE:-}" ]; then
   if [ "$rc" -eq 77 ]; then status=77; elif [ "$rc" -ne 0 ]; then status=1; fi
 fi
 "$nvcc" "${flags[@]}" tests/cuda/kernels_on_device.cu -o "$out/kernels_on_device" || exit 1
-"$nvcc" "${flags[@]}" tests/cuda/bvh_on_device.cu src/worker/bvh_build.cpp -o "$out/bvh_on_device" || exit 1
+"$nvcc" "${flags[@]}" tests/cuda/bvh_on_device.cu src/render/bvh_build.cpp -o "$out/bvh_on_device" || exit 1
 for check in kernels_on_device bvh_on_device; do
   "$out/$check" 2>&1 | tee "$out/$check.txt"
   rc=${PIPESTATUS[0]}

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "master/film.h"
+#include "render/film.h"
 
 namespace tessera::testing {
 

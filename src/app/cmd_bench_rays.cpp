@@ -15,7 +15,7 @@
 #include "app/scene_loading.h"
 #include "kernels/rng.h"
 #include "kernels/sampling.h"
-#include "worker/embree_backend.h"
+#include "render/embree_backend.h"
 
 namespace tessera {
 namespace {

@@ -5,9 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
-#include "master/error_estimate.h"
-#include "master/image_metrics.h"
-#include "master/image_output.h"
+#include "render/error_estimate.h"
+#include "render/image_metrics.h"
+#include "render/image_output.h"
 #include "scene/image_io.h"
 
 namespace tessera {

@@ -13,9 +13,9 @@
 #include "app/guide_setup.h"
 #include "app/scene_loading.h"
 #include "kernels/guide_diagnostic.h"
-#include "master/image_output.h"
-#include "master/renderer.h"
-#include "worker/embree_backend.h"
+#include "render/image_output.h"
+#include "render/renderer.h"
+#include "render/embree_backend.h"
 #include "scene/sampler_setup.h"
 
 namespace tessera {

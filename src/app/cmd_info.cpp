@@ -9,7 +9,7 @@
 #include "scene/scene_effects.h"
 #include "scene/spectral_choice.h"
 #include "scene/system_memory.h"
-#include "worker/scene_data.h"
+#include "render/scene_data.h"
 
 namespace tessera {
 namespace {

@@ -19,19 +19,19 @@
 #include "comm/scene_wire.h"
 #include "master/checkpoint.h"
 #include "master/farm_master.h"
-#include "master/image_output.h"
-#include "master/interrupt.h"
-#include "master/renderer.h"
-#include "master/snapshots.h"
-#include "master/stats_json.h"
+#include "render/image_output.h"
+#include "render/interrupt.h"
+#include "render/renderer.h"
+#include "render/snapshots.h"
+#include "render/stats_json.h"
 #include "scene/pbrt_film.h"
 #include "scene/sampler_setup.h"
 #include "scene/scene_effects.h"
 #include "app/memory_check.h"
 #include "scene/light_paths.h"
 #include "scene/spectral_choice.h"
-#include "worker/backends.h"
-#include "worker/cpu_affinity.h"
+#include "render/backends.h"
+#include "render/cpu_affinity.h"
 #include "worker/farm_worker.h"
 
 namespace tessera {
@@ -516,7 +516,7 @@ int run_render_farm(const RenderArgs& a) {
 }
 
 // Ctrl-C or SIGTERM: the render stops after its pass and writes what it has
-// (master/interrupt.h); the exit status then says it was interrupted.
+// (render/interrupt.h); the exit status then says it was interrupted.
 int run_render(const RenderArgs& a) {
   // Open MPI's launcher (not srun) starts its kill sequence with SIGCONT.
   install_interrupt_handlers(std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr);

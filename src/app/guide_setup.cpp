@@ -11,7 +11,7 @@
 
 #include "app/commands.h"
 #include "kernels/effects.h"
-#include "master/renderer.h"
+#include "render/renderer.h"
 
 namespace tessera {
 

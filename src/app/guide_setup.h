@@ -10,8 +10,8 @@
 
 #include "guidecache/guide_field.h"
 #include "guidecache/neural_guide.h"
-#include "master/renderer.h"
-#include "worker/scene_data.h"
+#include "render/renderer.h"
+#include "render/scene_data.h"
 
 namespace tessera {
 

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "master/film.h"
+#include "render/film.h"
 
 namespace tessera {
 

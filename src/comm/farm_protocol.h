@@ -21,14 +21,20 @@
 // After a guided pass, every rank all-reduces the guide's accumulators
 // (--guide-sync pass) and folds them: identical sums, identical fields on
 // every rank. After an unguided pass, none does.
+//
+// The schema sees plain structs only (render/tile_job.h, render/film.h'
+// accumulators), never the integrator: scripts/check_layers.py holds it so.
 #pragma once
 
+#include <cstdint>
+#include <cstring>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "comm/wire.h"
-#include "master/film.h"
-#include "worker/render_tile.h"
+#include "render/film.h"
+#include "render/tile_job.h"
 
 namespace tessera {
 
@@ -65,10 +71,42 @@ struct TileWork {
   }
 };
 
+// A batch's counters (TileCounters, render/render_tile.h) as a request
+// carries them: their bytes. TileCounters holds the integrator's
+// PathCounters, which the schema need not see, so the schema fixes only
+// their size: a counter added there stops to_wire and from_wire compiling
+// until kWords follows (the farm's messages and checkpoints change with it).
+struct WireCounters {
+  static constexpr size_t kWords = 19;
+  uint64_t words[kWords] = {};
+
+  template <class Counters>
+  static WireCounters to_wire(const Counters& c) {
+    check_layout<Counters>();
+    WireCounters w;
+    std::memcpy(w.words, &c, sizeof(w.words));
+    return w;
+  }
+  template <class Counters>
+  Counters from_wire() const {
+    check_layout<Counters>();
+    Counters c;
+    std::memcpy(&c, words, sizeof(words));
+    return c;
+  }
+
+ private:
+  template <class Counters>
+  static constexpr void check_layout() {
+    static_assert(std::is_trivially_copyable_v<Counters> && sizeof(Counters) == sizeof(words),
+                  "TileCounters changed: update WireCounters::kWords");
+  }
+};
+
 struct TileRequest {
   uint32_t capacity = 0;
   std::vector<TileWork> results;
-  TileCounters counters;  // of the results
+  WireCounters counters;  // of the results
   bool interrupted = false;
   template <class Archive>
   void serialize(Archive& ar) {

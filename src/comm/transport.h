@@ -5,7 +5,7 @@
 // tests without mpirun).
 //
 // Rank 0 is the master. Messages are byte strings with a tag; what they
-// contain is master/farm_protocol.h's business.
+// contain is comm/farm_protocol.h's business.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,5 @@
 // A bounding volume hierarchy over the scene's triangles, built on the host
-// (worker/bvh_build.h) and traversed by code that g++ and nvcc compile
+// (render/bvh_build.h) and traversed by code that g++ and nvcc compile
 // alike: the ray queries of the portable backend, on the CPU (where tests
 // compare it with Embree) and on the GPU. Ours, because the GPU needs one
 // (Embree is CPU-only, OptiX is not in Debian); its rules are Embree's:

@@ -35,7 +35,7 @@ namespace tessera {
 
 // float is deliberate for everything that travels along a path: it is what
 // Embree traces with and what the GPU is fast at. Pixel accumulation uses double
-// (see src/master/film.h).
+// (see src/render/film.h).
 using Float = float;
 using Vec2 = glm::vec2;
 using Vec3 = glm::vec3;

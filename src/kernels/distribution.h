@@ -1,6 +1,6 @@
 // Piecewise-constant 1D and 2D distributions over read-only views, for
 // importance sampling lights and environment maps. Built on the host
-// (src/worker/distribution_build.h), sampled on either side.
+// (src/render/distribution_build.h), sampled on either side.
 #pragma once
 
 #include "vecmath.h"

@@ -42,14 +42,14 @@ enum Specialisation : uint32_t {
   // The neural guide instead of the Q-table (with kSpecGuiding). Like media,
   // it runs the full surface integrator, except in scenes of Lambertian
   // surfaces and area lights alone: three instantiations (one with media;
-  // worker/render_tile_impl.h).
+  // render/render_tile_impl.h).
   kSpecNeural = 1u << 6,
   kSpecIndexCount = 1u << 7,  // every combination of the bits above
 };
 
 // Scenes of Lambertian surfaces and area lights alone (no textures, no
 // environment, no media), whatever the guiding bit: the neural guide runs
-// an instantiation of its own there (worker/render_tile_impl.h).
+// an instantiation of its own there (render/render_tile_impl.h).
 TESSERA_HOST_DEVICE constexpr bool lambertian_area_lights_only(uint32_t spec) {
   return (spec & (kSpecMedia | (kSpecSurfaceAll & ~kSpecGuiding))) == kSpecAreaLights;
 }

@@ -120,7 +120,7 @@ struct NeuralTrainingSample {
 
 // Where learning targets go while a tile renders: on the CPU one sink per
 // thread and tile (data: the tile's buffer), on a device one per path (data:
-// the path's kNeuralPathTargets slots; worker/device_tiles.h). A target is
+// the path's kNeuralPathTargets slots; render/device_tiles.h). A target is
 // kept with probability keep_prob, decided by a hash of (tile, path, its
 // number in the path): deterministic, whichever thread, rank or device
 // renders the path. A path keeps at most kNeuralPathTargets (the rest are

@@ -1,5 +1,5 @@
 // Read-only views of a built scene: flat arrays + sizes, valid on the side
-// (CPU or GPU) whose memory they point into. Built by src/worker/scene_data.h.
+// (CPU or GPU) whose memory they point into. Built by src/render/scene_data.h.
 #pragma once
 
 #include "camera_projection.h"

@@ -10,8 +10,8 @@
 #include <thread>
 
 #include "comm/farm_protocol.h"
-#include "master/interrupt.h"
-#include "master/ordered_splats.h"
+#include "render/interrupt.h"
+#include "render/ordered_splats.h"
 
 namespace tessera {
 namespace {
@@ -133,7 +133,7 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
     }
     {
       std::lock_guard<std::mutex> lock(counters_mutex);
-      counters->add(req.counters);
+      counters->add(req.counters.from_wire<TileCounters>());
     }
     TileJobs reply;
     for (uint32_t k = 0; k < req.capacity; ++k) {

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "comm/transport.h"
-#include "master/renderer.h"
+#include "render/renderer.h"
 
 namespace tessera {
 

@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "comm/farm_protocol.h"
-#include "master/interrupt.h"
-#include "worker/guide_binding.h"
+#include "render/interrupt.h"
+#include "render/guide_binding.h"
 
 namespace tessera {
 namespace {
@@ -48,7 +48,7 @@ void render_pass_tiles(Transport& t, TileBackend& backend, int32_t threads, uint
         throw std::runtime_error("malformed tile job");
     BatchQueue queue(jobs.jobs);
     TileRequest req{capacity, {}, {}};
-    req.counters = backend.render_tiles(queue, threads);
+    req.counters = WireCounters::to_wire(backend.render_tiles(queue, threads));
     req.results = std::move(jobs.jobs);
     req.interrupted = interrupt_requested();  // signalled: the master stops the farm after this pass
     t.send(0, kTagRequest, encode(req));

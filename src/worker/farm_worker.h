@@ -5,8 +5,8 @@
 
 #include "comm/transport.h"
 #include "guidecache/guide.h"
-#include "worker/render_tile.h"
-#include "worker/tile_backend.h"
+#include "render/render_tile.h"
+#include "render/tile_backend.h"
 
 namespace tessera {
 

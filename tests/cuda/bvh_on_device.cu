@@ -15,7 +15,7 @@
 #include "kernels/bvh.h"
 #include "kernels/rng.h"
 #include "kernels/sampling.h"
-#include "worker/bvh_build.h"
+#include "render/bvh_build.h"
 
 #include "cuda_check.h"
 

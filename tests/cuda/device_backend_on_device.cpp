@@ -38,9 +38,9 @@
 #include "gpu_fixture.h"
 #include "guidecache/guide_field.h"
 #include "guidecache/neural_guide.h"
-#include "worker/guide_binding.h"
-#include "worker/device_backend.h"
-#include "worker/host_memory_device.h"
+#include "render/guide_binding.h"
+#include "render/device_backend.h"
+#include "render/host_memory_device.h"
 
 namespace tessera::cuda_check {
 namespace {

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "../film_stats.h"
-#include "master/film.h"
-#include "worker/tile_backend.h"
+#include "render/film.h"
+#include "render/tile_backend.h"
 
 namespace tessera::cuda_check {
 

@@ -1,5 +1,5 @@
 // A scene made ready for the GPU check on a machine that has only a GPU and
-// nvcc's runtime: the packed scene (worker/scene_pack.h), the settings its
+// nvcc's runtime: the packed scene (render/scene_pack.h), the settings its
 // tiles render with, what a guide over it needs, and the image the host
 // emulation of the device kernel gave for it. Written by
 // make_gpu_fixtures.cpp, read by device_backend_on_device.cpp.
@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "master/film.h"
-#include "worker/render_tile.h"
-#include "worker/pod_io.h"
-#include "worker/scene_pack.h"
+#include "render/film.h"
+#include "render/render_tile.h"
+#include "render/pod_io.h"
+#include "render/scene_pack.h"
 
 namespace tessera::cuda_check {
 

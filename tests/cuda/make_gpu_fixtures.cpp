@@ -10,12 +10,12 @@
 
 #include "gpu_fixture.h"
 #include "device_pass.h"
-#include "master/renderer.h"
+#include "render/renderer.h"
 #include "scene/pbrt_loader.h"
 #include "scene/sampler_setup.h"
-#include "worker/bvh_build.h"
-#include "worker/device_backend.h"
-#include "worker/embree_backend.h"
+#include "render/bvh_build.h"
+#include "render/device_backend.h"
+#include "render/embree_backend.h"
 
 int main(int argc, char** argv) {
   using namespace tessera;

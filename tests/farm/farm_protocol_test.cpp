@@ -11,8 +11,8 @@
 #include "comm/inproc_transport.h"
 #include "comm/scene_wire.h"
 #include "master/farm_master.h"
-#include "worker/backends.h"
-#include "worker/embree_backend.h"
+#include "render/backends.h"
+#include "render/embree_backend.h"
 #include "worker/farm_worker.h"
 
 namespace tessera {

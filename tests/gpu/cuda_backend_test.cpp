@@ -12,9 +12,9 @@
 
 #include "../render/guided_helpers.h"
 #include "../render/render_helpers.h"
-#include "worker/backends.h"
-#include "worker/device_api.h"
-#include "worker/embree_backend.h"
+#include "render/backends.h"
+#include "render/device_api.h"
+#include "render/embree_backend.h"
 
 namespace tessera {
 namespace {

@@ -1,4 +1,4 @@
-// The portable BVH (kernels/bvh.h, worker/bvh_build.h) against Embree: the
+// The portable BVH (kernels/bvh.h, render/bvh_build.h) against Embree: the
 // same closest hits (triangle and distance) and the same shadow-ray
 // answers on random and camera rays of the shipped scenes, with cut-outs,
 // one-way curve tubes and moving triangles; and a tree every triangle is in
@@ -16,9 +16,9 @@
 #include "furnace_scene.h"
 #include "guided_helpers.h"
 #include "render_helpers.h"
-#include "worker/backends.h"
-#include "worker/bvh_build.h"
-#include "worker/embree_backend.h"
+#include "render/backends.h"
+#include "render/bvh_build.h"
+#include "render/embree_backend.h"
 
 namespace tessera {
 namespace {

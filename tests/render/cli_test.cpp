@@ -18,7 +18,7 @@
 #include "../cli_run.h"
 #include "../json_read.h"
 #include "render_helpers.h"
-#include "worker/device_api.h"
+#include "render/device_api.h"
 
 namespace tessera {
 namespace {

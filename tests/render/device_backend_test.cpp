@@ -1,5 +1,5 @@
-// The device backend (worker/device_backend.h) on the host-emulated device:
-// the scene packed into one buffer (worker/scene_pack.h), the guide uploaded
+// The device backend (render/device_backend.h) on the host-emulated device:
+// the scene packed into one buffer (render/scene_pack.h), the guide uploaded
 // per pass, batches of tiles rendered by the CUDA kernel's body and the
 // learning returned as integers. Its images equal the portable BVH's on the
 // CPU bit for bit (the same per-sample code in the same order), guided or
@@ -18,15 +18,15 @@
 #include "guidecache/neural_guide.h"
 #include "guided_helpers.h"
 #include "master/farm_master.h"
-#include "master/image_output.h"
+#include "render/image_output.h"
 #include "render_helpers.h"
-#include "worker/backends.h"
-#include "worker/bvh_backend.h"
-#include "worker/bvh_build.h"
-#include "worker/device_api.h"
-#include "worker/device_backend.h"
+#include "render/backends.h"
+#include "render/bvh_backend.h"
+#include "render/bvh_build.h"
+#include "render/device_api.h"
+#include "render/device_backend.h"
 #include "worker/farm_worker.h"
-#include "worker/scene_pack.h"
+#include "render/scene_pack.h"
 
 namespace tessera {
 namespace {

@@ -22,7 +22,7 @@
 #include "../cli_run.h"
 #include "../exr_read.h"
 #include "../json_read.h"
-#include "master/image_output.h"
+#include "render/image_output.h"
 #include "furnace_scene.h"
 #include "render_helpers.h"
 

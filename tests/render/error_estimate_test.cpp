@@ -1,5 +1,5 @@
 // The relMSE a film estimates of itself from its per-pixel sample
-// variances (master/error_estimate.h):
+// variances (render/error_estimate.h):
 //  - on hand-made films whose value is worked out by hand, including the
 //    rare-bright-sample pixel, the F^2 >= 0 clamp and the minimum spp;
 //  - the image overload (what `tessera compare` uses on an EXR's variance
@@ -17,8 +17,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "master/error_estimate.h"
-#include "master/image_metrics.h"
+#include "render/error_estimate.h"
+#include "render/image_metrics.h"
 #include "furnace_scene.h"
 #include "render_helpers.h"
 

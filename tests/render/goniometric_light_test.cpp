@@ -7,7 +7,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "master/image_output.h"
+#include "render/image_output.h"
 #include "render_helpers.h"
 
 namespace tessera {

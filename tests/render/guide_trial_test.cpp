@@ -1,4 +1,4 @@
-// --guide auto's trial (master/guide_trial.h): guided and unguided passes
+// --guide auto's trial (render/guide_trial.h): guided and unguided passes
 // alternate once the guide has learned; the method with the lower relative
 // variance x cost per sample goes on. Every sample stays in the image, so it
 // remains unbiased whichever way the trial goes; the decision depends on the
@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "guided_helpers.h"
-#include "master/guide_trial.h"
+#include "render/guide_trial.h"
 
 namespace tessera {
 namespace {

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "master/image_metrics.h"
+#include "render/image_metrics.h"
 
 namespace tessera {
 namespace {

@@ -3,7 +3,7 @@
 // framing and brightness.
 #include <gtest/gtest.h>
 
-#include "master/image_metrics.h"
+#include "render/image_metrics.h"
 #include "render_helpers.h"
 #include "scene/image_io.h"
 

@@ -3,7 +3,7 @@
 // lit through a window gets the same image with less noise.
 #include <gtest/gtest.h>
 
-#include "master/error_estimate.h"
+#include "render/error_estimate.h"
 #include "render_helpers.h"
 
 namespace tessera {

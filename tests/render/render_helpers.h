@@ -7,12 +7,12 @@
 #include <filesystem>
 #include <string>
 
-#include "master/film.h"
-#include "master/renderer.h"
+#include "render/film.h"
+#include "render/renderer.h"
 #include "scene/pbrt_loader.h"
 #include "scene/sampler_setup.h"
-#include "worker/embree_backend.h"
-#include "worker/scene_data.h"
+#include "render/embree_backend.h"
+#include "render/scene_data.h"
 
 namespace tessera::testing {
 

@@ -13,7 +13,8 @@
 #include <vector>
 
 #include "../test_dir.h"
-#include "master/snapshots.h"
+#include "render/renderer.h"
+#include "render/snapshots.h"
 
 namespace tessera {
 namespace {

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <string>
 
-#include "master/error_estimate.h"
+#include "render/error_estimate.h"
 #include "furnace_scene.h"
 #include "render_helpers.h"
 

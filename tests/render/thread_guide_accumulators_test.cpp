@@ -10,7 +10,7 @@
 #include <mutex>
 
 #include "guidecache/guide_field.h"
-#include "worker/thread_guide_accumulators.h"
+#include "render/thread_guide_accumulators.h"
 
 namespace tessera {
 namespace {

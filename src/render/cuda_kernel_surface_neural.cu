@@ -1,0 +1,6 @@
+// The device kernel for served specialisation kServedSurface | kSpecGuiding | kSpecNeural (see cuda_kernels.h).
+#include "render/cuda_kernels_impl.cuh"
+
+namespace tessera {
+TESSERA_INSTANTIATE_RENDER_TILES(kServedSurface | kSpecGuiding | kSpecNeural)
+}  // namespace tessera

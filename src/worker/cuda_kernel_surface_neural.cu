@@ -1,6 +1,0 @@
-// The device kernel for served specialisation kServedSurface | kSpecGuiding | kSpecNeural (see cuda_kernels.h).
-#include "worker/cuda_kernels_impl.cuh"
-
-namespace tessera {
-TESSERA_INSTANTIATE_RENDER_TILES(kServedSurface | kSpecGuiding | kSpecNeural)
-}  // namespace tessera
