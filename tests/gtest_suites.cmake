@@ -48,7 +48,8 @@ foreach(_line IN LISTS _lines)
       list(APPEND _found_own "${_name}")
       list(APPEND _excluded_${_suite} "${_name}")
       add_test("${_name}" "${_tessera_bin}" "--gtest_filter=${_name}")
-      set_tests_properties("${_name}" PROPERTIES LABELS "${_tessera_area}"
+      # COST: started first by ctest -j even without timings from an earlier run.
+      set_tests_properties("${_name}" PROPERTIES LABELS "${_tessera_area}" COST 1000
                            SKIP_REGULAR_EXPRESSION "\\[  SKIPPED \\]")
     else()
       set(_has_rest_${_suite} TRUE)
