@@ -107,6 +107,8 @@ TEST_F(FarmCliTest, RanksWithDifferentBackendsWriteTheLocalImage) {
   EXPECT_NE(read_text(js).find("\"backend\": \"bvh+emulated-device\""), std::string::npos) << read_text(js);
 }
 
+// Slow (a whole render, a killed one and an mpirun resume; a ctest test of
+// its own): the render must be long enough to be killed after its first pass.
 TEST_F(FarmCliTest, KilledRenderResumesBitIdenticallyOnOtherRankCounts) {
   const std::string args = kDoor + " -q --no-preview --res 128x96 --spp 160 --seed 4";
   RunResult whole = run("render " + args + " -o " + path("whole.exr"));
@@ -126,6 +128,8 @@ TEST_F(FarmCliTest, KilledRenderResumesBitIdenticallyOnOtherRankCounts) {
   EXPECT_TRUE(exr_channels(path("resumed.exr")) == exr_channels(path("whole.exr")));
 }
 
+// Slow (waits out its 3 s + 2 s of signal timing, then resumes; a ctest
+// test of its own, mostly asleep while the others run).
 // Ctrl-C to mpirun (Open MPI sends every rank SIGCONT, SIGTERM
 // odls_base_sigkill_timeout seconds later, 5 here, and SIGKILL as long
 // again): the master stops the farm after the pass under way and writes the
@@ -180,6 +184,7 @@ TEST_F(FarmCliTest, SignalledWorkerStopsTheWholeFarm) {
   EXPECT_NE(stats.find("\"stop_reason\": \"interrupted\""), std::string::npos) << stats;
 }
 
+// Slow (one run of the binary per bad checkpoint, and mpirun; a ctest test of its own).
 TEST_F(FarmCliTest, BadCheckpointsAreRefusedAndLeaveOutputsAlone) {
   const std::string args = kDoor + " -q --no-preview --res 32x24 --spp 4 --seed 4";
   const std::string ck = path("good.ckpt");

@@ -271,6 +271,9 @@ TEST(BsdfChi2, CoatedDiffuse) {
 
 // The test has teeth: a pdf 10% off in roughness, or a diffuse pdf that ignores
 // the specular-lobe probability, is rejected.
+// Slow (9 chi^2 tests of kSamples = 500000 samples each, over a layered BSDF
+// that is costly to evaluate; a ctest test of its own): kSamples sets the
+// power that DetectsWrongPdf shows.
 TEST(BsdfChi2, CoatedConductor) {
   // The proposal's density, every roughness combination with a non-delta part.
   for (double t : kWoThetas) {
@@ -521,6 +524,7 @@ Rgb layer_walk_weight(const BsdfParams& coat, Vec3 wo, Rng& rng) {
 // walk's, rough coats included. (pbrt-v4's own f() weighs its two next-event
 // strategies at the base with densities of different directions and comes
 // out 5-15 % above its walk for these coats; this test fails for it.)
+// Slow (layered walks for every configuration; a ctest test of its own).
 TEST(BsdfEnergy, RoughCoatsAgreeWithTheLayerWalk) {
   const BsdfParams cfgs[] = {coated(0.3f, Rgb(0.8f)), coated(0.1f, Rgb(0.5f, 0.8f, 0.2f)),
                              coated_conductor(0.3f, 0.3f), coated_conductor(0.141f, 0.0447f, Rgb(0.155f, 0.117f, 0.138f),

@@ -248,6 +248,8 @@ TEST_F(CliTest, GuideCacheOptions) {
 // A network keeps the settings it was trained with: a --neural-* option that
 // differs from the network loaded from a file or a checkpoint is refused in
 // one line, not ignored, and one given where no network guides is refused too.
+// Slow-ish (13 runs of the binary, each loading its ~260 libraries; a
+// ctest test of its own): one per refusal it checks.
 TEST_F(CliTest, NeuralOptionsThatContradictTheGuideAreRefused) {
   const std::string net = (dir_ / "cornell.nguide").string(), out = (dir_ / "n.exr").string();
   RunResult saved =

@@ -312,6 +312,8 @@ AttributeEnd
 // The hard scenes with both learning rules: the light is hidden (door-ajar),
 // or each light has its own blocker and the guide also learns light
 // selection (shelter, 3 quads = 6 lights).
+// Slow-ish (door-ajar at 512 spp, three times; a ctest test of its own):
+// the spp buys the 3% standard error that expect_precise asks for.
 TEST(GuidedUnbiased, DoorAjarAndShelterAgreeWithUnguidedForBothRules) {
   struct Case {
     const char* name;
@@ -388,6 +390,8 @@ void inject_huge_bin(GuidedScene& s, GuideField& guide, uint32_t bin) {
 // heavy-tailed, so the normal approximation behind the 4-sigma comparison
 // needs many samples: at 512 spp one of the six cases missed it by chance,
 // with and without guided roulette alike, and agreed again at 2048.
+// Slow on purpose (7 renders at 2048 spp, ~10 s on an idle core; a ctest
+// test of its own): the spp is what the heavy tail needs, as said above.
 TEST(GuideDegenerate, HugeBinWithPureGuidedSamplingStaysFiniteAndUnbiased) {
   SceneDesc d = load_builtin_cornell_box();
   d.film.xres = 32;

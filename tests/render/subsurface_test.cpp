@@ -39,6 +39,8 @@ TEST(Subsurface, WhiteFurnaceKeepsEnergy) {
   for (double s : sum) EXPECT_NEAR(s, 1.0, 0.01);
 }
 
+// Slow (several renders of random walks at a mean free path of 0.01 of the
+// sphere, many scattering events per walk; a ctest test of its own).
 TEST(Subsurface, ReflectanceSetsTheColourOfAThickObject) {
   // mfp 0.01 of a unit sphere: nearly semi-infinite. Chiang et al.'s albedo
   // fit behind a boundary of index 1.33 gives about 0.9 of the colour asked.
