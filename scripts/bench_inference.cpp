@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "guidecache/neural_guide.h"
+#include "guidecache/neural/neural_guide.h"
 
 using namespace tessera;
 

@@ -12,7 +12,7 @@
 #include "app/commands.h"
 #include "app/guide_setup.h"
 #include "app/scene_loading.h"
-#include "kernels/guide_diagnostic.h"
+#include "guidecache/guide_diagnostic.h"
 #include "render/image_output.h"
 #include "render/renderer.h"
 #include "render/embree_backend.h"

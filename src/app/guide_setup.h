@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "guidecache/guide_field.h"
-#include "guidecache/neural_guide.h"
+#include "guidecache/table/guide_field.h"
+#include "guidecache/neural/neural_guide.h"
 #include "render/renderer.h"
 #include "render/scene_data.h"
 

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "guidecache/guide_view.h"
-#include "kernels/neural_guide.h"
+#include "guidecache/table/guide_view.h"
+#include "guidecache/neural/neural_view.h"
 
 namespace tessera {
 

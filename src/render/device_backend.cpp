@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "guidecache/neural_training_log.h"
+#include "guidecache/neural/neural_training_log.h"
 #include "render/neural_tile_targets.h"
 #include "render/scene_pack.h"
 

@@ -1,6 +1,6 @@
 // The Embree backend: one Embree scene holding every triangle, traced by
 // this process's threads. Integrators only see EmbreeTracer's
-// intersect/occluded (see kernels/integrator.h); the pass loop only sees
+// intersect/occluded (see integrator/integrator.h); the pass loop only sees
 // EmbreeBackend as a TileBackend (render/tile_backend.h).
 #pragma once
 
@@ -8,7 +8,7 @@
 
 #include <string>
 
-#include "kernels/integrator.h"
+#include "integrator/integrator.h"
 #include "render/cpu_tile_backend.h"
 #include "render/scene_data.h"
 

@@ -17,7 +17,7 @@ struct PixelAccum {
   uint64_t n = 0;
 };
 
-// Light paths' contributions to a pixel (kernels/light_paths.h): sums over
+// Light paths' contributions to a pixel (integrator/light_paths.h): sums over
 // all light paths traced for the image, each path adding at most once.
 struct SplatAccum {
   double sum[3] = {0, 0, 0};

@@ -4,7 +4,7 @@
 // pixel, sample index) only, so a sample is the same wherever it runs.
 #pragma once
 
-#include "kernels/integrator.h"
+#include "integrator/integrator.h"
 #include "render/film.h"
 #include "render/render_tile.h"
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "kernels/effects.h"
-#include "kernels/path_state.h"
+#include "integrator/path_state.h"
 #include "kernels/sampler.h"
 #include "render/film.h"
 #include "render/tile_job.h"

@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "kernels/light_paths.h"
+#include "integrator/light_paths.h"
 #include "render/pixel_sample.h"
 #include "render/render_tile.h"
 
@@ -38,7 +38,7 @@ constexpr uint32_t instantiated_spec(uint32_t s) {
 // sample order, and with light-traced caustics one light path per sample
 // whose splats are appended to *splats. ReuseFirstSite: with the neural
 // guide, a pixel's samples share the network's site at their first vertex
-// where they hit the same spot (NeuralFirstSite, kernels/path_guide.h;
+// where they hit the same spot (NeuralFirstSite, guidecache/path_guide.h;
 // the same on any thread and rank: a pixel's samples of a job are traced
 // in order by one thread).
 template <uint32_t Spec, class Tracer, bool ReuseFirstSite = false>

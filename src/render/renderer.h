@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "guidecache/guide_field.h"
-#include "guidecache/neural_guide.h"
+#include "guidecache/table/guide_field.h"
+#include "guidecache/neural/neural_guide.h"
 #include "render/film.h"
 #include "render/guide_trial.h"
 #include "render/render_tile.h"
@@ -40,7 +40,7 @@ struct RenderOptions {
   bool guide_trial = false;
   bool progress = true;
   // Caustics of small lights seen through specular surfaces traced from the
-  // lights (kernels/light_paths.h); scene/light_paths.h decides when.
+  // lights (integrator/light_paths.h); scene/light_paths.h decides when.
   bool light_paths = false;
 };
 

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "guidecache/neural_training_log.h"
+#include "guidecache/neural/neural_training_log.h"
 #include "render/neural_tile_targets.h"
 
 namespace tessera {

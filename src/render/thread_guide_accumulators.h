@@ -11,7 +11,7 @@
 //
 // For the neural guide each thread has a sink for one tile's learning
 // targets instead: begin_tile() empties it, end_tile() hands the tile's
-// targets to the pass's training log (guidecache/neural_training_log.h).
+// targets to the pass's training log (guidecache/neural/neural_training_log.h).
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>

@@ -1,4 +1,4 @@
-// When caustics are traced from the lights (kernels/light_paths.h): pbrt-v4
+// When caustics are traced from the lights (integrator/light_paths.h): pbrt-v4
 // scenes that ask for a bidirectional integrator (bdpt, mlt, sppm,
 // lighttracer) get them by default, because their authors chose those
 // integrators for light a camera path cannot find. The light tracer needs a

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "kernels/bsdf.h"
-#include "kernels/neural_guide.h"
+#include "guidecache/neural/neural_view.h"
 #include "kernels/sampler.h"
 
 #include "cuda_check.h"

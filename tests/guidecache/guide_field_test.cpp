@@ -7,8 +7,8 @@
 #include <sstream>
 #include <vector>
 
-#include "guidecache/guide_field.h"
-#include "kernels/guiding.h"
+#include "guidecache/table/guide_field.h"
+#include "guidecache/table/guiding.h"
 #include "kernels/rng.h"
 
 namespace tessera {

@@ -8,9 +8,9 @@
 #include <cstring>
 #include <sstream>
 
-#include "guidecache/guide_field.h"
-#include "guidecache/neural_guide.h"
-#include "kernels/path_guide.h"
+#include "guidecache/table/guide_field.h"
+#include "guidecache/neural/neural_guide.h"
+#include "guidecache/path_guides.h"
 
 namespace tessera {
 namespace {

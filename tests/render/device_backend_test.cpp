@@ -15,7 +15,7 @@
 #include <memory>
 
 #include "comm/inproc_transport.h"
-#include "guidecache/neural_guide.h"
+#include "guidecache/neural/neural_guide.h"
 #include "guided_helpers.h"
 #include "master/farm_master.h"
 #include "render/image_output.h"

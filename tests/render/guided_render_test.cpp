@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "guided_helpers.h"
-#include "kernels/guide_diagnostic.h"
+#include "guidecache/guide_diagnostic.h"
 #include "scene/builtin_scenes.h"
 
 namespace tessera {
@@ -132,7 +132,7 @@ AttributeEnd
   expect_agree(channel_stats(g.film), channel_stats(u.film), "sky-lit ground");
 }
 
-// guide-viz's greedy paths (kernels/guide_diagnostic.h) pass through
+// guide-viz's greedy paths (guidecache/guide_diagnostic.h) pass through
 // interfaces without a bounce and stop at their depth: with the camera inside
 // an interface sphere in a closed, lit box and depth 0, the old loop counted
 // the interface as the bounce, missed depth == 0 and followed the guide

@@ -1,4 +1,4 @@
-// Light-traced caustics (kernels/light_paths.h): the light tracer and the
+// Light-traced caustics (integrator/light_paths.h): the light tracer and the
 // path tracer split the path space, so together they estimate the same image
 // as path tracing alone; they find what path tracing cannot (a spot light
 // seen in a mirror, against the analytic answer); and the splats add up the

@@ -9,7 +9,7 @@
 #include <set>
 #include <mutex>
 
-#include "guidecache/guide_field.h"
+#include "guidecache/table/guide_field.h"
 #include "render/thread_guide_accumulators.h"
 
 namespace tessera {

@@ -4,9 +4,9 @@
 // medium (PhaseScatter: Henyey-Greenstein). One shadow ray to one light.
 #pragma once
 
-#include "integrator_context.h"
-#include "light_sampling.h"
-#include "volume_transport.h"
+#include "integrator/integrator_context.h"
+#include "kernels/light_sampling.h"
+#include "kernels/volume_transport.h"
 
 namespace tessera {
 

@@ -4,8 +4,8 @@
 // point inside: direct light there, then a direction from the phase function.
 #pragma once
 
-#include "integrator_direct.h"
-#include "integrator_scatter.h"
+#include "integrator/integrator_direct.h"
+#include "integrator/integrator_scatter.h"
 
 namespace tessera {
 
@@ -34,7 +34,7 @@ TESSERA_HOST_DEVICE inline MediumStep scatter_in_medium(Ctx& x, PathState& st, c
   Float direct = 0.f;  // unweighted NEE estimate of light scattered here (guide targets)
   if (x.settings.nee && x.s.num_lights > 0 && !m.subsurface)
     direct = sample_direct(x, st, at, -1, 0.f, u_select, u_light).estimate;
-  if (x.learn) learning_at_medium_vertex(x.guide, direct, st.segment_tr, x.c);
+  if (x.learn) learning_at_medium_vertex(x.guide, direct, st.segment_tr, x.c.guide_updates);
   // Henyey-Greenstein sampling is exact: the weight p / pdf is 1.
   Float phase_pdf = 0.f;
   const Vec3 wi = sample_henyey_greenstein(at.wo, m.g, u_phase, &phase_pdf);

@@ -5,7 +5,7 @@
 // state after it; and Russian roulette, after surfaces and media alike.
 #pragma once
 
-#include "integrator_surface.h"
+#include "integrator/integrator_surface.h"
 
 namespace tessera {
 

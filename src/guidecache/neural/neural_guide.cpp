@@ -1,4 +1,4 @@
-#include "guidecache/neural_guide.h"
+#include "guidecache/neural/neural_guide.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -9,7 +9,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "guidecache/guide_field.h"
+#include "guidecache/table/guide_field.h"
 #include "kernels/effects.h"
 
 namespace tessera {

@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "guidecache/guide.h"
-#include "guidecache/neural_training_log.h"
+#include "guidecache/neural/neural_training_log.h"
 
 namespace tessera {
 
@@ -60,7 +60,7 @@ struct NeuralGuideConfig {
   uint32_t table_log2 = 11;
   uint64_t seed = 1;                 // weight initialisation
   // How far from a pixel's earlier first vertex a later sample's may lie
-  // and reuse its site (NeuralFirstSite, kernels/path_guide.h), in cells of
+  // and reuse its site (NeuralFirstSite, guidecache/path_guide.h), in cells of
   // the hash grid's finest level (0: only at the same point). Behaviour,
   // not learned state: not saved (a loaded guide, a farm worker's and a
   // resumed one have the default; only code sets another).

@@ -5,11 +5,11 @@
 // the CPU keeps it on the stack.
 #pragma once
 
-#include "camera.h"
-#include "guiding.h"
-#include "medium.h"
-#include "neural_guide.h"
-#include "spectral.h"
+#include "kernels/camera.h"
+#include "guidecache/table/guiding.h"
+#include "kernels/medium.h"
+#include "guidecache/neural/neural_view.h"
+#include "kernels/spectral.h"
 
 namespace tessera {
 

@@ -33,11 +33,11 @@
 // carries its own three wavelengths, as a camera path does.
 #pragma once
 
-#include "bsdf_spec.h"
-#include "light_sampling.h"
-#include "material_eval.h"
-#include "path_state.h"
-#include "volume_transport.h"
+#include "kernels/bsdf_spec.h"
+#include "kernels/light_sampling.h"
+#include "kernels/material_eval.h"
+#include "integrator/path_state.h"
+#include "kernels/volume_transport.h"
 
 namespace tessera {
 

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "guidecache/guide.h"
-#include "guidecache/guide_view.h"
+#include "guidecache/table/guide_view.h"
 
 namespace tessera {
 

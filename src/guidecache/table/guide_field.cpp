@@ -1,6 +1,6 @@
-#include "guidecache/guide_field.h"
+#include "guidecache/table/guide_field.h"
 
-#include "guidecache/neural_guide.h"
+#include "guidecache/neural/neural_guide.h"
 #include "kernels/effects.h"
 
 #include <algorithm>

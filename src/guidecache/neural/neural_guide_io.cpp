@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "guidecache/guide_field.h"
-#include "guidecache/neural_guide.h"
+#include "guidecache/table/guide_field.h"
+#include "guidecache/neural/neural_guide.h"
 
 namespace tessera {
 

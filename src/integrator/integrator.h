@@ -25,7 +25,7 @@
 // guide lookup, measured 5 % worse on shelter at equal samples and no faster.)
 #pragma once
 
-#include "integrator_medium.h"
+#include "integrator/integrator_medium.h"
 
 namespace tessera {
 
@@ -63,7 +63,7 @@ TESSERA_HOST_DEVICE inline bool scatter_at_surface(Ctx& x, PathState& st, const 
       mix.guide_pdf = r.guide_density;
       mix.mix_pdf = r.pdf;
     }
-    learning_at_scatter(x.guide, v.cell, r.bin, luminance(weight), mix, st.segment_tr, x.c);
+    learning_at_scatter(x.guide, v.cell, r.bin, luminance(weight), mix, st.segment_tr, x.c.guide_updates);
   }
   move_past_surface(x, st, v, r, weight, guide_p);
   return survives_roulette(x, st, v.cell, r.bin);

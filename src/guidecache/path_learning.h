@@ -12,22 +12,22 @@
 // light that reaches x over several bounces is still learned.
 #pragma once
 
-#include "path_guide.h"
-#include "path_state.h"
+#include "guidecache/path_guide.h"
 
 namespace tessera {
 
 // Sends the pending target (and its mixture statistics) to x's cell, after
 // the medium's weight on the segment (segment_tr). boot: the target's
-// bootstrapped part (the network refreshes it as it trains).
+// bootstrapped part (the network refreshes it as it trains). `updates`
+// counts the targets the guide accepted.
 template <class PG>
 TESSERA_HOST_DEVICE inline void learning_commit(PG& pg, Float target, GuideBootstrap boot, Float segment_tr,
-                                                PathCounters& c) {
+                                                uint64_t& updates) {
   PendingTarget& t = pg.pending;
   target *= segment_tr;
   boot.coef *= segment_tr;
   if (pg.record(t.cell, t.bin, target, boot)) {
-    ++c.guide_updates;
+    ++updates;
     if (t.mix.mix_pdf > 0.f) {
       t.mix.emitted *= segment_tr;
       pg.record_mix(t.cell, t.mix, target);
@@ -50,17 +50,17 @@ TESSERA_HOST_DEVICE inline void learning_note_emission(PG& pg, Float le, Float l
 // The path left the scene: the pending target gets the environment's
 // radiance where NEE could not have delivered it (le_counted), else nothing.
 template <class PG>
-TESSERA_HOST_DEVICE inline void learning_at_escape(PG& pg, Float le_counted, Float segment_tr, PathCounters& c) {
-  if (pg.pending.cell >= 0) learning_commit(pg, le_counted, GuideBootstrap{}, segment_tr, c);
+TESSERA_HOST_DEVICE inline void learning_at_escape(PG& pg, Float le_counted, Float segment_tr, uint64_t& updates) {
+  if (pg.pending.cell >= 0) learning_commit(pg, le_counted, GuideBootstrap{}, segment_tr, updates);
 }
 
 // The guide has no cells in media: a pending target ends at a medium vertex
 // with the light scattered there directly (multiple scattering is not learned).
 template <class PG>
 TESSERA_HOST_DEVICE inline void learning_at_medium_vertex(PG& pg, Float direct_estimate, Float segment_tr,
-                                                          PathCounters& c) {
+                                                          uint64_t& updates) {
   if (pg.pending.cell < 0) return;
-  learning_commit(pg, direct_estimate, GuideBootstrap{}, segment_tr, c);
+  learning_commit(pg, direct_estimate, GuideBootstrap{}, segment_tr, updates);
   pg.pending.cell = -1;
 }
 
@@ -80,11 +80,11 @@ TESSERA_HOST_DEVICE inline void learning_at_surface(PG& pg, int32_t cell, const 
 // mix: the vertex's mixture statistics (mix_pdf 0: it does not inform the weight).
 template <class PG>
 TESSERA_HOST_DEVICE inline void learning_at_scatter(PG& pg, int32_t cell, uint32_t bin, Float weight,
-                                                    const GuideMixSample& mix, Float segment_tr, PathCounters& c) {
+                                                    const GuideMixSample& mix, Float segment_tr, uint64_t& updates) {
   PendingTarget& t = pg.pending;
   if (t.at_delta && t.cell >= 0) {
     const Float value = pg.value(cell, bin);
-    learning_commit(pg, t.le + value * weight, GuideBootstrap{cell, bin, weight, value}, segment_tr, c);
+    learning_commit(pg, t.le + value * weight, GuideBootstrap{cell, bin, weight, value}, segment_tr, updates);
   }
   t.cell = cell;
   t.bin = bin;

@@ -607,7 +607,7 @@ TESSERA_HOST_DEVICE inline Float neural_site_q(const NeuralGuideView& v, const N
 
 #if !TESSERA_IS_GPU_CODE
 // neural_infer for the CPU, compiled for AVX2 where the processor has it
-// (guidecache/neural_infer_cpu.cpp; bit-identical either way).
+// (guidecache/neural/neural_infer_cpu.cpp; bit-identical either way).
 void neural_infer_cpu(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site);
 // Its two copies, for the test that they agree bit for bit.
 void neural_infer_avx2(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site);

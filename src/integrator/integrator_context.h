@@ -4,23 +4,19 @@
 // pass the same as each kernel's launch parameters.
 #pragma once
 
-#include "bsdf_spec.h"
-#include "effects.h"
-#include "path_learning.h"
-#include "path_state.h"
-#include "sampler.h"
+#include "kernels/bsdf_spec.h"
+#include "kernels/effects.h"
+#include "guidecache/path_guides.h"
+#include "guidecache/path_learning.h"
+#include "integrator/path_state.h"
+#include "kernels/sampler.h"
 
 namespace tessera {
 
 // The per-path guide for a specialisation: none, the Q-table or the network.
 template <uint32_t Spec>
 TESSERA_HOST_DEVICE inline auto make_path_guide(const PathSettings& settings) {
-  if constexpr ((Spec & kSpecGuiding) != 0 && (Spec & kSpecNeural) != 0)
-    return NeuralPathGuide(settings.neural, settings.neural_first);
-  else if constexpr ((Spec & kSpecGuiding) != 0)
-    return TablePathGuide(settings.guide);
-  else
-    return NoPathGuide{};
+  return make_path_guide<Spec>(settings.guide, settings.neural, settings.neural_first);
 }
 
 template <uint32_t Spec, class Tracer, class PG>

@@ -1,4 +1,4 @@
-// The CPU's inference entry points (kernels/neural_guide.h: neural_infer_cpu
+// The CPU's inference entry points (guidecache/neural/neural_view.h: neural_infer_cpu
 // and neural_value_cpu): each function body compiled twice, for AVX2 and for the portable
 // x86-64 baseline, and picked once by what the processor supports. The
 // inference is a few thousand independent multiply-adds per vertex; AVX2
@@ -7,7 +7,7 @@
 // copy, and no libm function is called: the results are bit-identical with
 // and without AVX2 (tested). (Elsewhere the renderer calls libm's sin, cos
 // and pow, which glibc may compute differently on machines with FMA.)
-#include "kernels/neural_guide.h"
+#include "guidecache/neural/neural_view.h"
 
 namespace tessera {
 

@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "guidecache/guide_field.h"
+#include "guidecache/table/guide_field.h"
 
 namespace glm {
 template <class Archive>

@@ -7,7 +7,10 @@
 // darkness, the guide points nowhere useful. Not an estimator of anything.
 #pragma once
 
-#include "integrator.h"
+#include "kernels/effects.h"
+#include "kernels/light_sampling.h"
+#include "kernels/material_eval.h"
+#include "kernels/surface.h"
 
 namespace tessera {
 

@@ -2,8 +2,8 @@
 // environment where it leaves the scene (the integrator's escape stage).
 #pragma once
 
-#include "integrator_context.h"
-#include "light_sampling.h"
+#include "integrator/integrator_context.h"
+#include "kernels/light_sampling.h"
 
 namespace tessera {
 
@@ -76,7 +76,7 @@ TESSERA_HOST_DEVICE inline void escape(Ctx& x, PathState& st) {
   }
   if constexpr (Ctx::kGuide) {
     const bool counted = st.specular_bounce || !x.settings.nee;  // else NEE delivers the environment
-    learning_at_escape(x.guide, counted ? luminance(Le_total) : 0.f, st.segment_tr, x.c);
+    learning_at_escape(x.guide, counted ? luminance(Le_total) : 0.f, st.segment_tr, x.c.guide_updates);
   }
 }
 

@@ -10,7 +10,7 @@
 #include <mutex>
 #include <vector>
 
-#include "kernels/neural_guide.h"
+#include "guidecache/neural/neural_view.h"
 
 namespace tessera {
 

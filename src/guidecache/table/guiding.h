@@ -1,13 +1,13 @@
-// What the integrator needs from the guide cache beyond guidecache/guide_view.h:
+// What the integrator needs from the guide cache beyond guidecache/table/guide_view.h:
 // mixture light selection (power-based + learned, with the true mixture pmf)
 // and the learning targets of Dahm & Keller's update rule.
 #pragma once
 
-#include "bsdf.h"
-#include "guidecache/guide_view.h"
-#include "rng.h"
-#include "sampler.h"
-#include "scene_view.h"
+#include "kernels/bsdf.h"
+#include "guidecache/table/guide_view.h"
+#include "kernels/rng.h"
+#include "kernels/sampler.h"
+#include "kernels/scene_view.h"
 
 namespace tessera {
 

@@ -4,9 +4,9 @@
 // path's predicted radiance).
 #pragma once
 
-#include "integrator_emission.h"
-#include "material_eval.h"
-#include "volume_transport.h"
+#include "integrator/integrator_emission.h"
+#include "kernels/material_eval.h"
+#include "kernels/volume_transport.h"
 
 namespace tessera {
 
@@ -118,7 +118,7 @@ TESSERA_HOST_DEVICE inline void guide_vertex_estimate(Ctx& x, PathState& st, con
   // The two shares of the light reflected here, for nee_prob.
   if (records_nee) x.guide.record_nee(v.cell, direct, indirect);
   if (completes_target) {
-    learning_commit(x.guide, pending.le + reflected, boot, st.segment_tr, x.c);
+    learning_commit(x.guide, pending.le + reflected, boot, st.segment_tr, x.c.guide_updates);
     x.guide.pending.cell = -1;
   }
   if (sets_expectation) st.path_expected = luminance(st.beta) * reflected;
