@@ -21,7 +21,7 @@ namespace tessera {
 // bootstrapped part (the network refreshes it as it trains). `updates`
 // counts the targets the guide accepted.
 template <class PG>
-TESSERA_HOST_DEVICE inline void learning_commit(PG& pg, Float target, GuideBootstrap boot, Float segment_tr,
+TESSERA_HOST_DEVICE TESSERA_INLINE void learning_commit(PG& pg, Float target, GuideBootstrap boot, Float segment_tr,
                                                 uint64_t& updates) {
   PendingTarget& t = pg.pending;
   target *= segment_tr;
@@ -39,7 +39,7 @@ TESSERA_HOST_DEVICE inline void learning_commit(PG& pg, Float target, GuideBoots
 // statistics (several environments: their luminances add, and the density
 // is their luminance-weighted mean).
 template <class PG>
-TESSERA_HOST_DEVICE inline void learning_note_emission(PG& pg, Float le, Float light_pdf) {
+TESSERA_HOST_DEVICE TESSERA_INLINE void learning_note_emission(PG& pg, Float le, Float light_pdf) {
   PendingTarget& t = pg.pending;
   if (t.cell < 0 || !(t.mix.mix_pdf > 0.f) || !(le > 0.f)) return;
   const Float total = t.mix.emitted + le;
@@ -50,14 +50,14 @@ TESSERA_HOST_DEVICE inline void learning_note_emission(PG& pg, Float le, Float l
 // The path left the scene: the pending target gets the environment's
 // radiance where NEE could not have delivered it (le_counted), else nothing.
 template <class PG>
-TESSERA_HOST_DEVICE inline void learning_at_escape(PG& pg, Float le_counted, Float segment_tr, uint64_t& updates) {
+TESSERA_HOST_DEVICE TESSERA_INLINE void learning_at_escape(PG& pg, Float le_counted, Float segment_tr, uint64_t& updates) {
   if (pg.pending.cell >= 0) learning_commit(pg, le_counted, GuideBootstrap{}, segment_tr, updates);
 }
 
 // The guide has no cells in media: a pending target ends at a medium vertex
 // with the light scattered there directly (multiple scattering is not learned).
 template <class PG>
-TESSERA_HOST_DEVICE inline void learning_at_medium_vertex(PG& pg, Float direct_estimate, Float segment_tr,
+TESSERA_HOST_DEVICE TESSERA_INLINE void learning_at_medium_vertex(PG& pg, Float direct_estimate, Float segment_tr,
                                                           uint64_t& updates) {
   if (pg.pending.cell < 0) return;
   learning_commit(pg, direct_estimate, GuideBootstrap{}, segment_tr, updates);
@@ -67,7 +67,7 @@ TESSERA_HOST_DEVICE inline void learning_at_medium_vertex(PG& pg, Float direct_e
 // A surface vertex y was located: what its hit tells the pending target.
 // Emission the integrator weights by MIS is NEE's to deliver.
 template <class PG>
-TESSERA_HOST_DEVICE inline void learning_at_surface(PG& pg, int32_t cell, const Vec3& n_side, Float le_unweighted,
+TESSERA_HOST_DEVICE TESSERA_INLINE void learning_at_surface(PG& pg, int32_t cell, const Vec3& n_side, Float le_unweighted,
                                                     bool delta_lobe) {
   pg.note_normal(cell, n_side);
   pg.pending.le = le_unweighted;
@@ -79,7 +79,7 @@ TESSERA_HOST_DEVICE inline void learning_at_surface(PG& pg, int32_t cell, const 
 // the direction it took; the new segment's target becomes the pending one.
 // mix: the vertex's mixture statistics (mix_pdf 0: it does not inform the weight).
 template <class PG>
-TESSERA_HOST_DEVICE inline void learning_at_scatter(PG& pg, int32_t cell, uint32_t bin, Float weight,
+TESSERA_HOST_DEVICE TESSERA_INLINE void learning_at_scatter(PG& pg, int32_t cell, uint32_t bin, Float weight,
                                                     const GuideMixSample& mix, Float segment_tr, uint64_t& updates) {
   PendingTarget& t = pg.pending;
   if (t.at_delta && t.cell >= 0) {

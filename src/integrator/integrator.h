@@ -32,7 +32,7 @@ namespace tessera {
 // One surface vertex after its interaction: direct light, the guide's
 // estimate, the direction, the path's state after it. False: the path ends.
 template <class Ctx>
-TESSERA_HOST_DEVICE inline bool scatter_at_surface(Ctx& x, PathState& st, const SurfaceVertex& v) {
+TESSERA_HOST_DEVICE TESSERA_INLINE bool scatter_at_surface(Ctx& x, PathState& st, const SurfaceVertex& v) {
   const Float guide_p = vertex_guide_probability(x, st, v);
   // The direction's random numbers are drawn before next-event estimation so
   // that the guide's alias entry can be fetched while the shadow ray is traced.

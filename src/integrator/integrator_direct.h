@@ -71,7 +71,7 @@ struct DirectLight {
 // that shadow rays bring little, the vertex traces one with probability
 // p_nee (the same number decides, rescaled).
 template <class Ctx, class Scatter>
-TESSERA_HOST_DEVICE inline DirectLight sample_direct(Ctx& x, PathState& st, const Scatter& at, int32_t cell,
+TESSERA_HOST_DEVICE TESSERA_INLINE DirectLight sample_direct(Ctx& x, PathState& st, const Scatter& at, int32_t cell,
                                                      Float guide_p, Float u_select, Vec2 u_light) {
   DirectLight d;
   bool traced = true;

@@ -10,7 +10,7 @@ namespace tessera {
 // The density MIS weighs the last sampled direction by: taken from the
 // vertex's coated BSDF only now that the direction found a light (MisMemory).
 template <uint32_t Spec>
-TESSERA_HOST_DEVICE inline Float last_direction_mis_pdf(MisMemory& m) {
+TESSERA_HOST_DEVICE TESSERA_INLINE Float last_direction_mis_pdf(MisMemory& m) {
   if constexpr ((Spec & kSpecNonDiffuse) != 0) {
     if (m.pending) {
       const Float mis_bsdf = bsdf_mis_pdf(m.bsdf, m.wo, m.wi);
@@ -27,7 +27,7 @@ TESSERA_HOST_DEVICE inline Float last_direction_mis_pdf(MisMemory& m) {
 // density, light_pdf_of() (the light's density of the direction, without
 // its selection probability; evaluated only here).
 template <class Ctx, class LightPdf>
-TESSERA_HOST_DEVICE inline void add_found_emission(Ctx& x, PathState& st, uint32_t li, const Rgb& Le,
+TESSERA_HOST_DEVICE TESSERA_INLINE void add_found_emission(Ctx& x, PathState& st, uint32_t li, const Rgb& Le,
                                                    const LightPdf& light_pdf_of) {
   if (st.depth == 0 || st.specular_bounce || !x.settings.nee) {
     st.L += st.beta * Le;
@@ -42,7 +42,7 @@ TESSERA_HOST_DEVICE inline void add_found_emission(Ctx& x, PathState& st, uint32
 // vertex (returned: the guide's targets need it), unless the light tracer
 // delivers it (light-traced caustics).
 template <class Ctx>
-TESSERA_HOST_DEVICE inline Rgb add_area_emission(Ctx& x, PathState& st, const SurfaceHit& h, const Vec3& wo,
+TESSERA_HOST_DEVICE TESSERA_INLINE Rgb add_area_emission(Ctx& x, PathState& st, const SurfaceHit& h, const Vec3& wo,
                                                  int32_t light) {
   const Light& l = x.s.lights[light];
   const Float cos_l = glm::dot(h.ng, wo);
@@ -60,7 +60,7 @@ TESSERA_HOST_DEVICE inline Rgb add_area_emission(Ctx& x, PathState& st, const Su
 // Escape stage: the ray left the scene. The environment's lights add their
 // radiance along it, and a pending learning target ends here.
 template <class Ctx>
-TESSERA_HOST_DEVICE inline void escape(Ctx& x, PathState& st) {
+TESSERA_HOST_DEVICE TESSERA_INLINE void escape(Ctx& x, PathState& st) {
   Rgb Le_total(0.f);
   if constexpr ((Ctx::kSpec & kSpecEnvironment) != 0) {
     for (uint32_t k = 0; k < x.s.num_infinite_lights; ++k) {

@@ -17,7 +17,7 @@ enum class MediumStep {
 
 // A scattering event at distance t along the ray in medium m.
 template <class Ctx>
-TESSERA_HOST_DEVICE inline MediumStep scatter_in_medium(Ctx& x, PathState& st, const Medium& m, Float t) {
+TESSERA_HOST_DEVICE TESSERA_INLINE MediumStep scatter_in_medium(Ctx& x, PathState& st, const Medium& m, Float t) {
   if (m.subsurface) {
     if (++st.walk_events > kMaxSubsurfaceEvents) return MediumStep::kEnd;
   } else if (st.depth++ == x.settings.max_depth) {
@@ -53,7 +53,7 @@ TESSERA_HOST_DEVICE inline MediumStep scatter_in_medium(Ctx& x, PathState& st, c
 
 // The segment [0, t_max) of the ray through the path's medium.
 template <class Ctx>
-TESSERA_HOST_DEVICE inline MediumStep medium_interaction(Ctx& x, PathState& st, Float t_max) {
+TESSERA_HOST_DEVICE TESSERA_INLINE MediumStep medium_interaction(Ctx& x, PathState& st, Float t_max) {
   const Medium m = medium_at(x.s, st.medium, st.wl);
   if (medium_absorbs_only(m)) {
     // Its transmittance: no collision to sample, no path ended by absorption.

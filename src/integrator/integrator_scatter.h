@@ -23,7 +23,7 @@ struct ScatterSample {
 // with that probability (one more dimension picks the strategy). False: the
 // path ends (no direction).
 template <class Ctx>
-TESSERA_HOST_DEVICE inline bool sample_scatter(Ctx& x, const PathState& st, const SurfaceVertex& v, Float guide_p,
+TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_scatter(Ctx& x, const PathState& st, const SurfaceVertex& v, Float guide_p,
                                                Float uc, Vec2 u, ScatterSample* out) {
   constexpr uint32_t Spec = Ctx::kSpec;
   ScatterSample& r = *out;
@@ -61,7 +61,7 @@ TESSERA_HOST_DEVICE inline bool sample_scatter(Ctx& x, const PathState& st, cons
 // The path after taking direction r at vertex v: throughputs, the MIS
 // memory, the flags light-traced caustics read, the next ray and medium.
 template <class Ctx>
-TESSERA_HOST_DEVICE inline void move_past_surface(Ctx& x, PathState& st, const SurfaceVertex& v, const ScatterSample& r,
+TESSERA_HOST_DEVICE TESSERA_INLINE void move_past_surface(Ctx& x, PathState& st, const SurfaceVertex& v, const ScatterSample& r,
                                                   const Rgb& weight, Float guide_p) {
   constexpr uint32_t Spec = Ctx::kSpec;
   const BsdfSample& bs = r.bs;
@@ -101,7 +101,7 @@ TESSERA_HOST_DEVICE inline void move_past_surface(Ctx& x, PathState& st, const S
 // bring light along bin `bin` of vertex `cell` survives more often (cell
 // -1: a medium vertex, the throughput rule alone). False: the path ends.
 template <class Ctx>
-TESSERA_HOST_DEVICE inline bool survives_roulette(Ctx& x, PathState& st, int32_t cell, uint32_t bin) {
+TESSERA_HOST_DEVICE TESSERA_INLINE bool survives_roulette(Ctx& x, PathState& st, int32_t cell, uint32_t bin) {
   if (st.depth > 1) {
     Float survive = glm::min(1.f, max_component(st.rr_beta * st.eta_scale));
     if (Ctx::kGuide && cell >= 0 && st.path_expected > 0.f && x.guide.learned(cell)) {

@@ -30,7 +30,7 @@ enum class SurfaceStep {
 // Interaction at the surface the ray hit: emission found there, the BSDF,
 // the guide's vertex; counts the bounce (pbrt-v4's depth).
 template <class Ctx>
-TESSERA_HOST_DEVICE inline SurfaceStep surface_interaction(Ctx& x, PathState& st, const TraceHit& hit, SurfaceVertex* out) {
+TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceStep surface_interaction(Ctx& x, PathState& st, const TraceHit& hit, SurfaceVertex* out) {
   constexpr uint32_t Spec = Ctx::kSpec;
   SurfaceVertex& v = *out;
   ++x.c.vertices;
@@ -87,7 +87,7 @@ TESSERA_HOST_DEVICE inline SurfaceStep surface_interaction(Ctx& x, PathState& st
 // BSDF only); not once guiding has raised the path's weight
 // max_guide_ratio-fold (PathState::guide_ratio).
 template <class Ctx>
-TESSERA_HOST_DEVICE inline Float vertex_guide_probability(Ctx& x, const PathState& st, const SurfaceVertex& v) {
+TESSERA_HOST_DEVICE TESSERA_INLINE Float vertex_guide_probability(Ctx& x, const PathState& st, const SurfaceVertex& v) {
   if (v.delta_lobe) return 0.f;
   Float guide_p = x.guide.probability(v.cell, v.bsdf, !Ctx::kNonDiffuse);
   if (guide_p > 0.f && !(st.guide_ratio <= x.settings.max_guide_ratio)) {
@@ -102,7 +102,7 @@ TESSERA_HOST_DEVICE inline Float vertex_guide_probability(Ctx& x, const PathStat
 // completes the pending target, and gives guide-driven roulette the path's
 // expected radiance.
 template <class Ctx>
-TESSERA_HOST_DEVICE inline void guide_vertex_estimate(Ctx& x, PathState& st, const SurfaceVertex& v, bool nee_vertex,
+TESSERA_HOST_DEVICE TESSERA_INLINE void guide_vertex_estimate(Ctx& x, PathState& st, const SurfaceVertex& v, bool nee_vertex,
                                                       Float direct) {
   const PendingTarget& pending = x.guide.pending;
   const bool completes_target = x.learn && pending.cell >= 0 && !pending.at_delta;
