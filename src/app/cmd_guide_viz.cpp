@@ -13,6 +13,7 @@
 #include "app/guide_setup.h"
 #include "app/scene_loading.h"
 #include "guidecache/guide_diagnostic.h"
+#include "guidecache/guide_kinds.h"
 #include "render/image_output.h"
 #include "render/renderer.h"
 #include "render/embree_backend.h"
@@ -93,9 +94,10 @@ void write_distribution(const VizArgs& a, Guide& guide, const glm::dvec3& render
 
 void write_diagnostic(const VizArgs& a, const SceneData& scene, const EmbreeBackend& embree, Guide& guide) {
   const SceneView& s = scene.view();
-  GuideView g;
-  NeuralGuideView nv;
-  guide.views(&g, &nv);
+  GuideViews views;
+  guide.views(&views);
+  const GuideView& g = views.table;
+  const NeuralGuideView& nv = views.neural;
   const bool neural = guide.mode() == "neural";
   const EmbreeTracer tracer = embree.tracer();
   ImageRgb img;

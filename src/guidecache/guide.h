@@ -20,8 +20,8 @@
 
 namespace tessera {
 
-struct GuideFieldStats;
-struct NeuralGuideStats;
+struct GuideViews;  // guide_kinds.h
+struct GuideStats;
 class NeuralTrainingLog;
 
 class Guide {
@@ -32,8 +32,8 @@ class Guide {
   // Specialisation bits a guided pass adds (kSpecGuiding, and kSpecNeural).
   virtual uint32_t spec_bits() const = 0;
   // The read side for a pass (valid until the next fold): fills the view the
-  // kernels use and leaves the other empty.
-  virtual void views(GuideView* table, NeuralGuideView* neural) = 0;
+  // kernels use and leaves the others empty.
+  virtual void views(GuideViews* out) = 0;
   // Where the CPU backends put the pass's learning targets (network only:
   // the table's go to the accumulators in its view).
   virtual NeuralTrainingLog* training_log() { return nullptr; }
@@ -53,7 +53,8 @@ class Guide {
   virtual void set_guide_prob(Float p) = 0;
   // Versioned binary serialisation tied to a scene fingerprint.
   virtual void save(std::ostream& out, uint64_t scene_fingerprint) const = 0;
-  virtual void fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const = 0;
+  // Its own member of *out; the others empty.
+  virtual void fill_stats(GuideStats* out) const = 0;
   // Same kind and same state, bit for bit.
   virtual bool same_as(const Guide& other) const = 0;
 };

@@ -241,8 +241,9 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
       combine_guide_rounds(*guide, [&](std::vector<uint64_t>& acc) { executor->reduce_guide(acc); });
       pass_guide_seconds = elapsed() - fold_start;
       stats.guide_fold_seconds += pass_guide_seconds;
-      GuideFieldStats table_stats;
-      guide->fill_stats(&table_stats, &stats.neural_guide);
+      GuideStats guide_stats;
+      guide->fill_stats(&guide_stats);
+      stats.neural_guide = std::move(guide_stats.neural);
       if (stats.neural_guide.pass_loss.size() > losses) pass_loss = stats.neural_guide.pass_loss.back();
     }
     spp_done += pass_spp;
@@ -274,7 +275,12 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
   }
   stats.spp = spp_done;
   stats.seconds = elapsed();
-  if (guide) guide->fill_stats(&stats.guide, &stats.neural_guide);
+  if (guide) {
+    GuideStats guide_stats;
+    guide->fill_stats(&guide_stats);
+    stats.guide = guide_stats.table;
+    stats.neural_guide = std::move(guide_stats.neural);
+  }
   progress.finish(samples_done.load(), spp_done);
   return result;
 }

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "../render/guided_helpers.h"
+#include "guidecache/guide_kinds.h"
 #include "../render/render_helpers.h"
 #include "comm/farm_protocol.h"
 #include "comm/inproc_transport.h"
@@ -181,10 +182,9 @@ TEST(FarmProtocol, GuideSyncOffLetsEachRankLearnAlone) {
   // only its own tiles' targets.
   uint64_t alone_updates = 0;
   auto updates = [](const Guide& g) {
-    GuideFieldStats t;
-    NeuralGuideStats n;
-    g.fill_stats(&t, &n);
-    return t.updates;
+    GuideStats s;
+    g.fill_stats(&s);
+    return s.table.updates;
   };
   for (const auto& g : alone.guides) {
     EXPECT_LT(updates(*g), updates(*shared.guides[0]));

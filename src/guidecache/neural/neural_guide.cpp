@@ -9,6 +9,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "guidecache/guide_kinds.h"
 #include "guidecache/table/guide_field.h"
 #include "kernels/effects.h"
 
@@ -182,9 +183,9 @@ NeuralGuideView NeuralGuide::view() const {
   return v;
 }
 
-void NeuralGuide::views(GuideView* table, NeuralGuideView* neural) {
-  *table = GuideView{};
-  *neural = view();
+void NeuralGuide::views(GuideViews* out) {
+  *out = GuideViews{};
+  out->neural = view();
 }
 
 uint32_t NeuralGuide::rounds() const { return 1 + (pass_targets_ > 0 ? config_.steps_per_pass : 0u); }
@@ -527,13 +528,14 @@ NeuralGuideStats NeuralGuide::stats() const {
   return s;
 }
 
-void NeuralGuide::fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const {
-  *table = GuideFieldStats{};
+void NeuralGuide::fill_stats(GuideStats* out) const {
+  out->table = GuideFieldStats{};
+  GuideFieldStats* table = &out->table;
   table->bytes = 3 * params_.size() * sizeof(float);
   table->updates = totals_.targets;
   table->rejected_nonfinite = totals_.rejected_nonfinite;
   table->rejected_large = totals_.rejected_large;
-  *neural = stats();
+  out->neural = stats();
 }
 
 bool NeuralGuide::operator==(const NeuralGuide& o) const {

@@ -106,7 +106,7 @@ class NeuralGuide final : public Guide {
 
   std::string mode() const override { return "neural"; }
   uint32_t spec_bits() const override;
-  void views(GuideView* table, NeuralGuideView* neural) override;
+  void views(GuideViews* out) override;
   NeuralTrainingLog* training_log() override { return &log_; }
   uint32_t rounds() const override;
   std::vector<uint64_t>& round_accumulators(uint32_t round) override;
@@ -123,7 +123,7 @@ class NeuralGuide final : public Guide {
   // Its index among the table's candidates (guide_mix_candidate; -1: none chosen yet).
   int32_t mix_candidate() const { return mix_candidate_; }
   void save(std::ostream& out, uint64_t scene_fingerprint) const override;
-  void fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const override;
+  void fill_stats(GuideStats* out) const override;
   bool same_as(const Guide& other) const override;
 
   static std::unique_ptr<NeuralGuide> load(std::istream& in, uint64_t scene_fingerprint);

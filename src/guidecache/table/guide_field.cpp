@@ -1,5 +1,6 @@
 #include "guidecache/table/guide_field.h"
 
+#include "guidecache/guide_kinds.h"
 #include "guidecache/neural/neural_guide.h"
 #include "kernels/effects.h"
 
@@ -82,14 +83,14 @@ void GuideField::build_bin_dirs() {
 
 uint32_t GuideField::spec_bits() const { return kSpecGuiding; }
 
-void GuideField::views(GuideView* table, NeuralGuideView* neural) {
-  *table = view();
-  *neural = NeuralGuideView{};
+void GuideField::views(GuideViews* out) {
+  *out = GuideViews{};
+  out->table = view();
 }
 
-void GuideField::fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const {
-  *table = stats();
-  *neural = NeuralGuideStats{};
+void GuideField::fill_stats(GuideStats* out) const {
+  *out = GuideStats{};
+  out->table = stats();
 }
 
 bool GuideField::same_as(const Guide& other) const {

@@ -96,11 +96,11 @@ class GuideField final : public Guide {
   // The Guide seam: one round, the accumulators, then fold().
   std::string mode() const override { return config_.target == GuideTarget::QLearning ? "qlearning" : "qtable"; }
   uint32_t spec_bits() const override;
-  void views(GuideView* table, NeuralGuideView* neural) override;
+  void views(GuideViews* out) override;
   uint32_t rounds() const override { return 1; }
   std::vector<uint64_t>& round_accumulators(uint32_t) override { return acc_; }
   void fold_round(uint32_t) override { fold(); }
-  void fill_stats(GuideFieldStats* table, NeuralGuideStats* neural) const override;
+  void fill_stats(GuideStats* out) const override;
   bool same_as(const Guide& other) const override;
 
   // Sampling settings that do not change what was learned.
