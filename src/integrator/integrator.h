@@ -50,8 +50,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE bool scatter_at_surface(Ctx& x, PathState& st
   }
   if constexpr (Ctx::kGuide) guide_vertex_estimate(x, st, v, nee_vertex, direct.estimate);
 
-  BsdfSample bs;
-  ScatterSample r(bs);
+  ScatterSample r;
   if (!sample_scatter(x, st, v, guide_p, uc, u, &r)) return false;
   const Rgb weight = r.bs.f * (abs_cos_theta(r.bs.wi) / r.pdf);
   if (x.learn) {
@@ -86,11 +85,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
     TraceHit hit{};
     ++c.rays;
     st.segment_tr = 1.f;
-    // The ray by value: the tracer takes references, and a PathState whose
-    // address escapes to a call that is not inlined stays in memory whole
-    // (every stage passes copies of its members for the same reason).
-    const Ray ray = st.ray;
-    const bool found = tracer.intersect(ray.o, ray.d, kInfinity, &hit, ray.time);
+    const bool found = tracer.intersect(st.ray.o, st.ray.d, kInfinity, &hit, st.ray.time);
     if constexpr ((Spec & kSpecMedia) != 0) {
       if (st.medium >= 0) {
         const MediumStep m = medium_interaction(x, st, found ? hit.t : kInfinity);
@@ -102,8 +97,7 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       escape(x, st);
       break;
     }
-    BsdfParams bsdf;
-    SurfaceVertex v(bsdf);
+    SurfaceVertex v;
     const SurfaceStep step = surface_interaction(x, st, hit, &v);
     if (step == SurfaceStep::kPass) continue;
     if (step == SurfaceStep::kEnd || !scatter_at_surface(x, st, v)) break;

@@ -52,10 +52,8 @@ TESSERA_HOST_DEVICE TESSERA_INLINE Rgb add_area_emission(Ctx& x, PathState& st, 
     return Rgb(0.f);
   }
   const Rgb Le = light_emission(x.s, st.wl, l, area_light_radiance(x.s, l, h.uv));
-  const Vec3 prev_p = st.mis.p;  // (a copy: PathState stays out of memory; integrator.h)
-  const bool prev_in_medium = st.mis.in_medium;
   add_found_emission(x, st, static_cast<uint32_t>(light), Le,
-                     [&] { return area_light_pdf_from(x.s, l, prev_p, h.p, cos_l, prev_in_medium); });
+                     [&] { return area_light_pdf_from(x.s, l, st.mis.p, h.p, cos_l, st.mis.in_medium); });
   return Le;
 }
 
@@ -70,11 +68,10 @@ TESSERA_HOST_DEVICE TESSERA_INLINE void escape(Ctx& x, PathState& st) {
       // A portal's sky is seen through its rectangle from the last scattering point (where NEE
       // sampled it; the camera's position for camera rays): not from an interface the ray crossed since.
       const Vec3 from = st.depth == 0 ? st.ray.o : st.mis.p;
-      const Vec3 dir = st.ray.d;  // (a copy: PathState stays out of memory; integrator.h)
       const Light& l = x.s.lights[li];
-      const Rgb Le = light_emission(x.s, st.wl, l, environment_radiance(x.s, l, from, dir));
+      const Rgb Le = light_emission(x.s, st.wl, l, environment_radiance(x.s, l, from, st.ray.d));
       Le_total += Le;
-      add_found_emission(x, st, li, Le, [&] { return environment_pdf(x.s, li, from, dir); });
+      add_found_emission(x, st, li, Le, [&] { return environment_pdf(x.s, li, from, st.ray.d); });
     }
   }
   if constexpr (Ctx::kGuide) {

@@ -55,19 +55,16 @@ TESSERA_HOST_DEVICE TESSERA_INLINE MediumStep scatter_in_medium(Ctx& x, PathStat
 template <class Ctx>
 TESSERA_HOST_DEVICE TESSERA_INLINE MediumStep medium_interaction(Ctx& x, PathState& st, Float t_max) {
   const Medium m = medium_at(x.s, st.medium, st.wl);
-  const Vec3 o = st.ray.o, d = st.ray.d;  // (copies: PathState stays out of memory; integrator.h)
   if (medium_absorbs_only(m)) {
     // Its transmittance: no collision to sample, no path ended by absorption.
-    const Rgb T = medium_transmittance(x.s, m, o, d, t_max, st.wl);
+    const Rgb T = medium_transmittance(x.s, m, st.ray.o, st.ray.d, t_max, st.wl);
     st.beta *= T;
     st.rr_beta *= T;
     st.segment_tr = luminance(T);
   } else {
     const Float u_channel = x.rng.uniform();
     const Float u_dist = x.rng.uniform();
-    HeroChannels heroes = st.heroes;
-    const MediumSegment seg = sample_medium(x.s, m, o, d, t_max, u_channel, u_dist, st.wl, heroes);
-    st.heroes = heroes;
+    const MediumSegment seg = sample_medium(x.s, m, st.ray.o, st.ray.d, t_max, u_channel, u_dist, st.wl, st.heroes);
     if (st.depth < x.settings.max_depth) st.L += st.beta * seg.emitted;
     st.beta *= seg.weight;
     st.rr_beta *= seg.weight;

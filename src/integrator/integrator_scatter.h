@@ -10,10 +10,8 @@
 namespace tessera {
 
 // The direction a vertex took and its densities.
-// (bs is a reference to a variable of the caller's, as SurfaceVertex::bsdf is.)
 struct ScatterSample {
-  TESSERA_HOST_DEVICE explicit ScatterSample(BsdfSample& b) : bs(b) {}
-  BsdfSample& bs;              // in the shading frame; bs.pdf is the BSDF's
+  BsdfSample bs;               // in the shading frame; bs.pdf is the BSDF's
   Vec3 wi;                     // world space
   Float pdf = 0.f;             // the density it was drawn with (the mixture's where guided)
   Float bsdf_pdf = 0.f;        // the BSDF's own density of it (for roulette)

@@ -10,15 +10,11 @@
 
 namespace tessera {
 
-// The BSDF is a reference to a variable of the caller's: resolve_bsdf
-// takes its address, and an aggregate whose address escapes stays in
-// memory whole (the rest of the vertex can then live in registers).
 struct SurfaceVertex {
-  TESSERA_HOST_DEVICE explicit SurfaceVertex(BsdfParams& b) : bsdf(b) {}
-  BsdfParams& bsdf;
   SurfaceHit h;
   Vec3 wo;         // towards the previous vertex, world space
   Vec3 wo_l;       // ... in the shading frame
+  BsdfParams bsdf;
   Frame frame;
   uint32_t lobes = 0;
   bool delta_lobe = false;  // a specular lobe: no guiding here
@@ -52,9 +48,8 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceStep surface_interaction(Ctx& x, PathS
     // Interface: continue through without counting a bounce (pbrt's SkipIntersection).
     ++x.c.interface_skips;
     if (++st.interface_skips > 256) return SurfaceStep::kEnd;
-    const Vec3 d = st.ray.d;  // (a copy: PathState stays out of memory; integrator.h)
-    if constexpr (Ctx::kMedia) st.medium = medium_after(x.s, hit.triangle, v.h.ng, d, st.medium);
-    st.ray.o = offset_ray_origin(v.h, d);
+    if constexpr (Ctx::kMedia) st.medium = medium_after(x.s, hit.triangle, v.h.ng, st.ray.d, st.medium);
+    st.ray.o = offset_ray_origin(v.h, st.ray.d);
     return SurfaceStep::kPass;
   }
   if (st.wl && st.wl->single != single_before) {
