@@ -5,8 +5,7 @@ screen or two (docs/architecture.md).
 
   scripts/check_function_length.py [--limit 100] [FILES...]
 
-Default files: src/integrator/*.h but light_paths.h (the caustic light tracer's walk, 186
-lines, is not in stages yet), the guides' per-path hooks (src/guidecache/**/*path_guide*.h)
+Default files: src/integrator/*.h, the guides' per-path hooks (src/guidecache/**/*path_guide*.h)
 and src/guidecache/path_learning.h.
 Counts the lines of each brace block opened at namespace scope (comments
 and strings are not parsed: braces in them would miscount, so keep them out).
@@ -58,7 +57,6 @@ def main():
     args = p.parse_args()
     files = [pathlib.Path(f) for f in args.files] or sorted((ROOT / "src/integrator").glob("*.h")) + sorted(
         (ROOT / "src/guidecache").glob("**/*path_guide*.h")) + [ROOT / "src/guidecache/path_learning.h"]
-    files = [f for f in files if f.name != "light_paths.h" or args.files]  # the caustic light tracer: not yet in stages
     too_long = 0
     for f in files:
         for line, head, length in blocks(f.read_text()):

@@ -158,26 +158,17 @@ TESSERA_HOST_DEVICE inline void connect_to_camera(const SceneView& s, const Trac
   c.light_splats += splat_filtered(s, fp.raster, value, sink);
 }
 
-// One light path for the caustic strategy (wl: its wavelengths in spectral
-// transport, else null).
-template <uint32_t Spec, class Tracer, class Sink>
-TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Tracer& tracer, PixelSampler& rng,
-                                                  const PathSettings& settings, Wavelengths* wl, PathCounters& c,
-                                                  Sink&& sink) {
+// Where a light path for the caustic strategy starts: a point and direction
+// on light l (selected with probability pmf) from (u_pos, u_dir), its weight
+// *beta and the medium it leaves into. False: a light the path tracer
+// delivers alone (distant, infinite) or no direction.
+template <uint32_t Spec>
+TESSERA_HOST_DEVICE inline bool start_light_path(const SceneView& s, const Light& l, Float pmf, Vec2 u_pos, Vec2 u_dir,
+                                                 Wavelengths* wl, Ray* ray_out, Rgb* beta_out, int32_t* medium_out) {
   constexpr bool kMedia = (Spec & kSpecMedia) != 0;
-  if (s.num_lights == 0) return;
-  ++c.light_paths;
-  const Float u_select = rng.uniform();
-  const Vec2 u_pos = rng.uniform2();
-  const Vec2 u_dir = rng.uniform2();
-  Float pmf = 0.f;
-  const uint32_t li = s.light_select.sample_discrete(u_select, &pmf);
-  if (!(pmf > 0.f)) return;
-  const Light& l = s.lights[li];
-  Ray ray;
-  Rgb beta(0.f);
-  int32_t medium = kMedia ? l.medium : -1;  // point and spot lights: where they were defined
-  HeroChannels heroes;  // the channel media sample distances with (medium.h)
+  Ray& ray = *ray_out;
+  Rgb& beta = *beta_out;
+  int32_t& medium = *medium_out;
   switch (l.type) {
     case LightType::Area: {
       const Vec3 b = sample_uniform_triangle(u_pos);
@@ -196,7 +187,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
         u.x = glm::min(u.x, 0x1.fffffep-1f);
       }
       const Vec3 local = sample_cosine_hemisphere(u);
-      if (!(local.z > 0.f)) return;
+      if (!(local.z > 0.f)) return false;
       ray.d = Frame::from_z(n).to_world(local);
       ray.o = offset_ray_origin(h, ray.d);
       // Le cos / (pmf * (1 / area) * (cos / pi) / sides)
@@ -229,14 +220,17 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
       break;
     }
     default:
-      return;  // distant and infinite lights: the path tracer's
+      return false;  // distant and infinite lights: the path tracer's
   }
-  if (is_black(beta)) return;
+  return true;
+}
 
-  // The walk: first the chain of delta-only surfaces (at least one), then y,
-  // the first vertex that scatters non-specularly, then on as a random walk;
-  // y and every later vertex that can scatter non-specularly is connected to
-  // the camera, as long as the path's vertex count stays within max_depth.
+// The walk's bookkeeping: first the chain of delta-only surfaces (at least
+// one), then y, the first vertex that scatters non-specularly, then on as a
+// random walk; y and every later vertex that can scatter non-specularly is
+// connected to the camera, as long as the path's vertex count stays within
+// max_depth.
+struct LightWalk {
   int32_t vertices = 0;      // scattering vertices so far (pbrt-v4's depth)
   bool past_chain = false;   // y reached
   Float beta_at_y = 0.f;     // roulette after y compares with this
@@ -244,23 +238,64 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
   // A vertex that can scatter non-specularly: y if none came before (one
   // reached straight from the light is next-event estimation's), counted
   // against max_depth. False ends the walk.
-  auto reach_scattering_vertex = [&]() {
+  TESSERA_HOST_DEVICE bool reach_scattering_vertex(const Rgb& beta, int32_t max_depth) {
     if (!past_chain) {
       if (vertices == 0) return false;
       beta_at_y = max_component(beta);
       past_chain = true;
     }
-    return ++vertices <= settings.max_depth;
-  };
+    return ++vertices <= max_depth;
+  }
   // Continues the walk from a scattering vertex past y; false ends it.
-  auto roulette = [&]() {
+  TESSERA_HOST_DEVICE bool roulette(Rgb& beta, PixelSampler& rng) const {
     if (vertices < 3) return true;
     const Float survive = glm::min(1.f, max_component(beta) / beta_at_y);
     if (survive >= 1.f) return true;
     if (!(survive > 0.f) || rng.uniform() >= survive) return false;
     beta /= survive;
     return true;
-  };
+  }
+};
+
+// A surface vertex that can scatter non-specularly, connected to the camera:
+// the path tracer's f(to camera, to light) |cos to light| in area measure.
+template <uint32_t Spec, class Tracer, class Sink>
+TESSERA_HOST_DEVICE inline void connect_surface_to_camera(const SceneView& s, const Tracer& tracer, const SurfaceHit& h,
+                                                          const BsdfParams& bsdf, const Frame& frame, const Vec3& wo,
+                                                          const Rgb& beta, Wavelengths* wl, PathCounters& c, Sink&& sink) {
+  FilmProjection fp;
+  const Float cos_ng_l = glm::abs(glm::dot(h.ng, wo));
+  if (cos_ng_l > 0.f && project_to_film(s.camera, h.p, &fp)) {
+    const Rgb f = eval_f<Spec>(bsdf, frame.to_local(fp.to_camera), frame.to_local(wo));
+    const Float cosines = glm::abs(glm::dot(h.ns, wo)) * glm::abs(glm::dot(h.ng, fp.to_camera)) / cos_ng_l;
+    connect_to_camera<(Spec & kSpecMedia) != 0>(s, tracer, fp, beta * f * cosines, wl, c, sink);
+  }
+}
+
+// One light path for the caustic strategy (wl: its wavelengths in spectral
+// transport, else null).
+template <uint32_t Spec, class Tracer, class Sink>
+TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Tracer& tracer, PixelSampler& rng,
+                                                  const PathSettings& settings, Wavelengths* wl, PathCounters& c,
+                                                  Sink&& sink) {
+  constexpr bool kMedia = (Spec & kSpecMedia) != 0;
+  if (s.num_lights == 0) return;
+  ++c.light_paths;
+  const Float u_select = rng.uniform();
+  const Vec2 u_pos = rng.uniform2();
+  const Vec2 u_dir = rng.uniform2();
+  Float pmf = 0.f;
+  const uint32_t li = s.light_select.sample_discrete(u_select, &pmf);
+  if (!(pmf > 0.f)) return;
+  const Light& l = s.lights[li];
+  Ray ray;
+  Rgb beta(0.f);
+  int32_t medium = kMedia ? l.medium : -1;  // point and spot lights: where they were defined
+  HeroChannels heroes;  // the channel media sample distances with (medium.h)
+  if (!start_light_path<Spec>(s, l, pmf, u_pos, u_dir, wl, &ray, &beta, &medium)) return;
+  if (is_black(beta)) return;
+
+  LightWalk walk;
   for (;;) {
     TraceHit hit;
     ++c.rays;
@@ -277,14 +312,14 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
           const MediumSegment seg = sample_medium(s, m, ray.o, ray.d, t_max, u_channel, u_dist, wl, heroes);
           beta *= seg.weight;
           if (seg.scattered) {
-            if (!reach_scattering_vertex() || is_black(beta)) return;
+            if (!walk.reach_scattering_vertex(beta, settings.max_depth) || is_black(beta)) return;
             const Vec3 p = ray.o + seg.t * ray.d;
             FilmProjection fp;
             if (project_to_film(s.camera, p, &fp)) {
               const Float phase = henyey_greenstein(glm::dot(-ray.d, fp.to_camera), m.g);
               connect_to_camera<kMedia>(s, tracer, fp, beta * phase, wl, c, sink);
             }
-            if (vertices == settings.max_depth || !roulette()) return;
+            if (walk.vertices == settings.max_depth || !walk.roulette(beta, rng)) return;
             Float phase_pdf = 0.f;
             const Vec3 wi = sample_henyey_greenstein(-ray.d, m.g, rng.uniform2(), &phase_pdf);
             if (!(phase_pdf > 0.f)) return;  // exact sampling: the weight is 1
@@ -303,7 +338,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
     BsdfParams bsdf;
     const int32_t single_before = wl ? wl->single : -1;
     if (!resolve_bsdf<Spec>(s, s.triangles[hit.triangle].material, h, wo, &bsdf, wl)) {
-      if (++interface_skips > 256) return;
+      if (++walk.interface_skips > 256) return;
       if constexpr (kMedia) medium = medium_after(s, hit.triangle, h.ng, ray.d, medium);
       ray.o = offset_ray_origin(h, ray.d);
       continue;
@@ -314,20 +349,13 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
     }
     const Frame frame = shading_frame<Spec>(s, bsdf, h);
     if (lobes_have_non_specular(lobes_of<Spec>(bsdf))) {
-      if (!reach_scattering_vertex()) return;
-      FilmProjection fp;
-      const Float cos_ng_l = glm::abs(glm::dot(h.ng, wo));
-      if (cos_ng_l > 0.f && project_to_film(s.camera, h.p, &fp)) {
-        // The path tracer's f(to camera, to light) |cos to light| in area measure at this vertex.
-        const Rgb f = eval_f<Spec>(bsdf, frame.to_local(fp.to_camera), frame.to_local(wo));
-        const Float cosines = glm::abs(glm::dot(h.ns, wo)) * glm::abs(glm::dot(h.ng, fp.to_camera)) / cos_ng_l;
-        connect_to_camera<kMedia>(s, tracer, fp, beta * f * cosines, wl, c, sink);
-      }
-      if (vertices == settings.max_depth || !roulette()) return;
+      if (!walk.reach_scattering_vertex(beta, settings.max_depth)) return;
+      connect_surface_to_camera<Spec>(s, tracer, h, bsdf, frame, wo, beta, wl, c, sink);
+      if (walk.vertices == settings.max_depth || !walk.roulette(beta, rng)) return;
     } else {
       // Only delta lobes: a chain vertex, or one on the walk after y; a
       // camera connection needs one more vertex.
-      if (++vertices + 1 > settings.max_depth) return;
+      if (++walk.vertices + 1 > settings.max_depth) return;
     }
     const Vec3 wo_l = frame.to_local(wo);
     BsdfSample bs;
