@@ -36,7 +36,7 @@ timed() {  # $1: step name; the rest: the command, run in the current folder
   "$@" >"$TMP/$name.log" 2>&1 || status="FAILED (log: kept in out/bench-build-$name.log)"
   t1=$(date +%s.%N)
   [ "$status" = ok ] || cp "$TMP/$name.log" "out/bench-build-$name.log"
-  printf '%-12s %7.0f s  %s\n' "$name" "$(echo "$t1 - $t0" | bc)" "$status" | tee -a "$ROOT/$RESULTS"
+  printf '%-12s %7.0f s  %s\n' "$name" "$(awk "BEGIN { print $t1 - $t0 }")" "$status" | tee -a "$ROOT/$RESULTS"
 }
 
 for step in "${STEPS[@]}"; do

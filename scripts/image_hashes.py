@@ -101,6 +101,8 @@ def main():
         print(f"{len(hashes) - len(differ)} of {len(hashes)} images identical to {args.compare}")
         for key in differ:
             print(f"differs: {key}")
+    for key in failed:
+        print(f"did not render: {key}: {hashes[key]}")
     return 1 if differ else 0
 
 
