@@ -74,9 +74,8 @@ template <uint32_t Spec, class Tracer>
 TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray ray, PixelSampler& rng,
                                    const PathSettings& settings, PathCounters& c, Wavelengths* wl = nullptr) {
   auto guide = make_path_guide<Spec>(settings);
-  constexpr bool kGuide = (Spec & kSpecGuiding) != 0;
-  PathContext<Spec, Tracer, decltype(guide)> x{s, tracer, settings, rng, guide, c,
-                                               kGuide && settings.learn, kGuide && settings.guided_roulette};
+  using Ctx = PathContext<Spec, Tracer, decltype(guide)>;
+  Ctx x{s, tracer, settings, rng, guide, c, Ctx::kGuide && settings.learn, Ctx::kGuide && settings.guided_roulette};
   PathState st;
   st.ray = ray;
   st.wl = wl;

@@ -4,11 +4,11 @@
 // pass the same as each kernel's launch parameters.
 #pragma once
 
-#include "kernels/bsdf_spec.h"
-#include "kernels/effects.h"
 #include "guidecache/path_guides.h"
 #include "guidecache/path_learning.h"
 #include "integrator/path_state.h"
+#include "kernels/bsdf_spec.h"
+#include "kernels/effects.h"
 #include "kernels/sampler.h"
 
 namespace tessera {

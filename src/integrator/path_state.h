@@ -5,10 +5,10 @@
 // the CPU keeps it on the stack.
 #pragma once
 
-#include "kernels/camera.h"
-#include "guidecache/table/guiding.h"
-#include "kernels/medium.h"
 #include "guidecache/neural/neural_view.h"
+#include "guidecache/table/guiding.h"
+#include "kernels/camera.h"
+#include "kernels/medium.h"
 #include "kernels/spectral.h"
 
 namespace tessera {

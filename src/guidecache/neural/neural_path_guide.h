@@ -66,7 +66,6 @@ TESSERA_HOST_DEVICE inline bool neural_site_reusable(const NeuralGuideView& v, c
 }
 
 struct NeuralPathGuide {
-  static constexpr bool kLearns = true;
   const NeuralGuideView& v;
   PendingTarget pending;
   NeuralSite site[2];

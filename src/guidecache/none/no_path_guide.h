@@ -8,7 +8,6 @@ namespace tessera {
 // No guiding: every hook is the unguided integrator's choice (light
 // selection by power, next-event estimation everywhere, the BSDF alone).
 struct NoPathGuide {
-  static constexpr bool kLearns = false;
   PendingTarget pending;  // never filled
   TESSERA_HOST_DEVICE Float nee_probability(int32_t) const { return 1.f; }
   TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, int32_t, uint32_t li) const {

@@ -7,7 +7,6 @@
 namespace tessera {
 
 struct TablePathGuide {
-  static constexpr bool kLearns = true;
   const GuideView& g;
   PendingTarget pending;
   TESSERA_HOST_DEVICE explicit TablePathGuide(const GuideView& view) : g(view) {}
