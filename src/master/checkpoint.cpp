@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "comm/wire.h"
+#include "kernels/fnv1a.h"
 
 namespace tessera {
 namespace {
@@ -17,11 +18,7 @@ constexpr char kMagic[] = "tessera-checkpoint";
 constexpr uint32_t kVersion = 10;
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.
-uint64_t fnv1a(const std::string& s) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
-  return h;
-}
+uint64_t fnv1a(const std::string& s) { return tessera::fnv1a(s.data(), s.size()); }
 
 struct CheckpointBody {
   Checkpoint* c;

@@ -8,6 +8,7 @@
 
 #include "kernels/effects.h"
 #include "kernels/equal_area.h"
+#include "kernels/fnv1a.h"
 #include "kernels/vecmath.h"
 #include "scene/scene_effects.h"
 #include "scene/named_spectra.h"
@@ -415,12 +416,7 @@ void SceneData::build_view() {
 namespace {
 
 // FNV-1a over raw bytes: stable across runs and machines of one endianness.
-struct Fnv1a {
-  uint64_t h = 0xcbf29ce484222325ull;
-  void add(const void* data, size_t n) {
-    const auto* b = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 0x100000001b3ull;
-  }
+struct SceneHash : Fnv1a {
   template <class T>
   void add_vector(const std::vector<T>& v) {
     uint64_t n = v.size();
@@ -432,7 +428,7 @@ struct Fnv1a {
 }  // namespace
 
 uint64_t SceneData::fingerprint() const {
-  Fnv1a f;
+  SceneHash f;
   f.add_vector(positions_);
   f.add_vector(indices_);
   if (!positions_end_.empty()) f.add_vector(positions_end_);
@@ -495,7 +491,7 @@ uint64_t SceneData::film_fingerprint() const {
                         view_.layered_mis_balance && camera_.projection == CameraProjection::Perspective &&
                         !desc_.camera.has_screen_window && desc_.camera.frame_aspect_ratio == 0.f;
   if (defaults) return 0;
-  Fnv1a f;
+  SceneHash f;
   f.add(&camera_.pixel_from_radiance, sizeof camera_.pixel_from_radiance);
   f.add(&camera_.sensor_from_radiance, sizeof camera_.sensor_from_radiance);
   f.add(&camera_.max_component_value, sizeof camera_.max_component_value);
