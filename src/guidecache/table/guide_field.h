@@ -114,9 +114,13 @@ class GuideField final : public Guide {
   int32_t find_cell(const Vec3& p, const Vec3& n) const;
   const Float* cell_values(int32_t cell) const { return &value_[static_cast<size_t>(cell) * stride()]; }
 
-  // Versioned binary serialisation (cereal). scene_fingerprint ties a cache to
-  // the scene it was learned on; load() throws std::runtime_error when the
-  // stream is not a guide cache, has another version, or another fingerprint.
+  // Versioned binary serialisation (cereal), with a checksum (guide_file.h).
+  // scene_fingerprint ties a cache to the scene it was learned on; load()
+  // throws std::runtime_error (one line) when the stream is not a guide
+  // cache, has another version, is truncated or damaged (its checksum), has
+  // another fingerprint, or holds a field no learning could have made: a
+  // value that is negative or not finite, a probability outside [0, 1],
+  // counts and octrees that disagree.
   void save(std::ostream& out, uint64_t scene_fingerprint) const override;
   static GuideField load(std::istream& in, uint64_t scene_fingerprint);
 
@@ -145,6 +149,13 @@ class GuideField final : public Guide {
   size_t acc_normal_offset() const { return 2 * num_cells() * size_t(stride()); }
   size_t acc_rejected_offset() const { return acc_normal_offset() + 3 * size_t(num_cells()); }
   void resize_accumulators();
+  // What makes a loaded field unusable, "" if nothing (guide_io.cpp): its
+  // settings, its octrees and array sizes, its values, and (once built) its
+  // sampling distributions.
+  std::string settings_problem() const;
+  std::string tree_problem() const;
+  std::string values_problem() const;
+  std::string distributions_problem() const;
 
   GuideConfig config_;
   Vec3 lo_{0.f};
