@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <numeric>
@@ -28,6 +29,16 @@ struct VizArgs {
   int64_t train_spp = 64, max_depth = 16, seed = 0;
   GuideArgs guide;
 };
+
+// An image that would hold NaN or Inf is not written: it would draw nothing
+// a reader can trust, and say nothing of why.
+void refuse_nonfinite(const std::vector<Float>& values, const std::string& what, const std::string& path) {
+  size_t bad = 0;
+  for (Float v : values) bad += std::isfinite(v) ? 0 : 1;
+  if (bad > 0)
+    throw std::runtime_error("guide-viz: " + std::to_string(bad) + " of " + std::to_string(values.size()) + " " + what +
+                             " are not finite; " + path + " not written");
+}
 
 // The learned radiance per bin at a point: a table cell's values, or the network's answer there.
 std::vector<Float> guide_values_at(Guide& guide, const Vec3& p, const Vec3& n, std::string* where, uint32_t* grid) {
@@ -64,6 +75,7 @@ void write_distribution(const VizArgs& a, Guide& guide, const glm::dvec3& render
   const std::vector<Float> values = guide_values_at(guide, p, n, &where, &grid);
   const uint32_t bins = grid * grid;
   const Float* q = values.data();
+  refuse_nonfinite(values, "values at " + where, a.distribution);
   // Each bin becomes a block of pixels; the image is the equal-area square
   // (the centre is +z, the corners -z).
   const int32_t scale = std::max<int32_t>(1, 256 / static_cast<int32_t>(grid));
@@ -118,6 +130,7 @@ void write_diagnostic(const VizArgs& a, const SceneData& scene, const EmbreeBack
       for (int c = 0; c < 3; ++c) img.rgb[(size_t(y) * img.width + x) * 3 + c] = L[c];
     }
   });
+  refuse_nonfinite(img.rgb, "greedy paths", a.diagnostic);
   ExrMetadata meta;
   meta.strings["content"] = "greedy paths along the highest learned Q (diagnostic, not a rendering)";
   write_exr(a.diagnostic, img, nullptr, meta);
@@ -151,6 +164,7 @@ int run_guide_viz(VizArgs a) {
   }
   if (!a.distribution.empty()) write_distribution(a, *field, scene.desc().render_origin);
   if (!a.diagnostic.empty()) write_diagnostic(a, scene, embree, *field);
+  save_guide(a.guide, *field, scene);
   return 0;
 }
 

@@ -151,6 +151,8 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
     throw std::runtime_error(a.neural_given[0] + " is for --guide neural; the guide is " + mode + " (" + *why + ")");
   if (mode == "none") {
     if (!a.in.empty()) throw std::runtime_error("--guide none and --guide-in " + a.in + " contradict each other");
+    // The file asked for would not be written: refused before rendering, not found missing after.
+    if (!a.out.empty()) throw std::runtime_error("--guide-out " + a.out + ": no guide is learned to save (" + *why + ")");
     return nullptr;
   }
   if (!a.in.empty()) {
@@ -212,6 +214,14 @@ void save_guide(const GuideArgs& a, const Guide& guide, const SceneData& scene) 
 }
 
 void check_guide_fits_scene(const Guide& guide, const SceneData& scene) {
+  // A table learns selection over every light of the scene, or none.
+  if (const auto* f = dynamic_cast<const GuideField*>(&guide)) {
+    const uint32_t lights = scene.view().num_lights;
+    if (f->learned_lights() != 0 && f->learned_lights() != lights)
+      throw std::runtime_error("the table learns selection over " + std::to_string(f->learned_lights()) +
+                               " lights, the scene has " + std::to_string(lights));
+    return;
+  }
   const auto* n = dynamic_cast<const NeuralGuide*>(&guide);
   if (!n) return;
   const uint32_t expected = NeuralGuide::learned_lights_for(scene.view().num_lights);

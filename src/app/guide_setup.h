@@ -64,7 +64,8 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& args, const SceneData& scene,
 void check_guide_options(const GuideArgs& args, const Guide& guide);
 
 // Throws std::runtime_error where a loaded guide does not fit the scene in a
-// way the scene fingerprint cannot tell (a network's light outputs).
+// way the scene fingerprint cannot tell (a crafted file: the lights a table
+// or a network learns selection over).
 void check_guide_fits_scene(const Guide& guide, const SceneData& scene);
 
 // Writes the cache to --guide-out when given (temp file + rename: never a torn file).
