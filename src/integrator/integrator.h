@@ -96,7 +96,9 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       escape(x, st);
       break;
     }
-    SurfaceVertex v;
+    SurfaceHit h;
+    BsdfParams bsdf;
+    SurfaceVertex v(h, bsdf);
     const SurfaceStep step = surface_interaction(x, st, hit, &v);
     if (step == SurfaceStep::kPass) continue;
     if (step == SurfaceStep::kEnd || !scatter_at_surface(x, st, v)) break;

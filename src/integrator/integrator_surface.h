@@ -10,11 +10,15 @@
 
 namespace tessera {
 
+// The hit and the BSDF are the caller's: their addresses go to out-of-line
+// code (the material, the general BSDF), and a vertex holding them would
+// have to live in memory as a whole; apart, the rest stays in registers.
 struct SurfaceVertex {
-  SurfaceHit h;
+  TESSERA_HOST_DEVICE SurfaceVertex(SurfaceHit& hit, BsdfParams& b) : h(hit), bsdf(b) {}
+  SurfaceHit& h;
+  BsdfParams& bsdf;
   Vec3 wo;         // towards the previous vertex, world space
   Vec3 wo_l;       // ... in the shading frame
-  BsdfParams bsdf;
   Frame frame;
   uint32_t lobes = 0;
   bool delta_lobe = false;  // a specular lobe: no guiding here
@@ -36,7 +40,8 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceStep surface_interaction(Ctx& x, PathS
   ++x.c.vertices;
   const RayPoint from_ray{st.ray.o, st.ray.d, hit.t};
   v.h = make_surface_hit(x.s, hit.triangle, hit.b1, hit.b2, st.ray.time, &from_ray);
-  v.wo = -st.ray.d;
+  const Vec3 wo = -st.ray.d;  // (a copy goes to the out-of-line material code, not v's address)
+  v.wo = wo;
   const TriangleInfo& info = x.s.triangles[hit.triangle];
 
   Rgb Le_hit(0.f);  // radiance emitted at this vertex towards the previous one
@@ -44,7 +49,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceStep surface_interaction(Ctx& x, PathS
     if (info.light >= 0) Le_hit = add_area_emission(x, st, v.h, v.wo, info.light);
 
   const int32_t single_before = st.wl ? st.wl->single : -1;
-  if (!resolve_bsdf<Spec>(x.s, info.material, v.h, v.wo, &v.bsdf, st.wl)) {
+  if (!resolve_bsdf<Spec>(x.s, info.material, v.h, wo, &v.bsdf, st.wl)) {
     // Interface: continue through without counting a bounce (pbrt's SkipIntersection).
     ++x.c.interface_skips;
     if (++st.interface_skips > 256) return SurfaceStep::kEnd;
@@ -112,8 +117,9 @@ TESSERA_HOST_DEVICE TESSERA_INLINE void guide_vertex_estimate(Ctx& x, PathState&
   if (!(completes_target || sets_expectation || records_nee)) return;
   const bool lambertian = !Ctx::kNonDiffuse || v.bsdf.type == BsdfType::Diffuse;
   GuideBootstrap boot;
+  const Frame frame = v.frame;  // not the vertex: its address would leave the stage
   const Float indirect = x.guide.bins_integral(v.cell, v.bsdf, lambertian, v.wo_l,
-                                               [&](const Vec3& w) { return v.frame.to_local(w); }, x.rng, &boot);
+                                               [&frame](const Vec3& w) { return frame.to_local(w); }, x.rng, &boot);
   const Float reflected = direct + indirect;
   // The two shares of the light reflected here, for nee_prob.
   if (records_nee) x.guide.record_nee(v.cell, direct, indirect);

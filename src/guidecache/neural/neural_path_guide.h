@@ -155,7 +155,7 @@ struct NeuralPathGuide {
   // Expected SARSA's integral of Q f |cos| over y's bins (guide_bins_integral).
   // It is coef x one value of y's, which *boot records.
   template <class ToLocal>
-  TESSERA_HOST_DEVICE Float bins_integral(int32_t s, const BsdfParams& b, bool lambertian, const Vec3& wo_local,
+  TESSERA_HOST_DEVICE Float bins_integral(int32_t s, const BsdfParams& b, bool lambertian, Vec3 wo_local,
                                           const ToLocal& to_local, PixelSampler& rng, GuideBootstrap* boot) {
     NeuralSite& y = site[s];
     *boot = GuideBootstrap{};
