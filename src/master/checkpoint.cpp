@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "comm/wire.h"
+#include "render/output_file.h"
 
 namespace tessera {
 namespace {
@@ -70,8 +71,7 @@ void write_checkpoint(const std::string& path, const RenderResult& so_far, const
   }
   const Bytes body = encode(CheckpointBody{&c});
   const std::string payload(body.begin(), body.end());
-  const std::string tmp = path + ".tmp";
-  {
+  write_output(path, [&](const std::string& tmp) {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
     if (!f) throw std::runtime_error("--checkpoint: cannot write " + tmp);
     cereal::BinaryOutputArchive ar(f);
@@ -80,8 +80,7 @@ void write_checkpoint(const std::string& path, const RenderResult& so_far, const
     f.write(payload.data(), static_cast<std::streamsize>(payload.size()));
     f.close();
     if (!f) throw std::runtime_error("--checkpoint: cannot write " + tmp);
-  }
-  std::filesystem::rename(tmp, path);
+  });
 }
 
 Checkpoint read_checkpoint(const std::string& path, uint64_t scene_fingerprint, uint64_t options_fingerprint) {

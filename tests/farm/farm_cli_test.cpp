@@ -142,9 +142,14 @@ TEST_F(FarmCliTest, InterruptedFarmWritesTheImageSoFarAndResumes) {
   RunResult interrupted = run_shell(
       "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe --mca odls_base_sigkill_timeout 5 -np 2 " +
       std::string(TESSERA_BINARY) + " render " + args + " --time 120 -o " + path("interrupted.exr") + " --stats " +
-      path("interrupted.json") + " --checkpoint " + ck + " --sampler zsobol --threads 1 & P=$!; sleep 3; kill -INT $P; " +
+      path("interrupted.json") + " --checkpoint " + ck + " --sampler zsobol --threads 1 2>&1 & P=$!; sleep 3; kill -INT $P; " +
       "sleep 2; test -f " + path("interrupted.json") + " && echo written-early; wait $P; echo done=$?");
   ASSERT_NE(interrupted.output.find("done="), std::string::npos) << interrupted.output;
+  // Every rank gets the signal; the farm says once that it is stopping.
+  const std::string say = "writing the image so far";
+  const size_t first = interrupted.output.find(say);
+  EXPECT_NE(first, std::string::npos) << interrupted.output;
+  EXPECT_EQ(interrupted.output.find(say, first + 1), std::string::npos) << interrupted.output;
   // Open MPI sends the ranks SIGCONT at once and SIGTERM only after the kill
   // timeout (5 s here): the ranks stop on the SIGCONT, so the image is
   // written well before the SIGTERM.
