@@ -97,6 +97,29 @@ TESSERA_HOST_DEVICE TESSERA_INLINE Float vertex_guide_probability(Ctx& x, const 
   return guide_p;
 }
 
+// guide_vertex_estimate's work where the vertex has any: out of line on the
+// GPU (learning paths, and a path's first learned vertex under guided
+// roulette).
+template <class Ctx>
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline void guide_vertex_estimate_at(Ctx& x, PathState& st,
+                                                                                 const SurfaceVertex& v, Float direct,
+                                                                                 bool completes_target,
+                                                                                 bool sets_expectation, bool records_nee) {
+  const PendingTarget& pending = x.guide.pending;
+  const bool lambertian = !Ctx::kNonDiffuse || v.bsdf.type == BsdfType::Diffuse;
+  GuideBootstrap boot;
+  const Float indirect = x.guide.bins_integral(v.cell, v.bsdf, lambertian, v.wo_l,
+                                               [&](const Vec3& w) { return v.frame.to_local(w); }, x.rng, &boot);
+  const Float reflected = direct + indirect;
+  // The two shares of the light reflected here, for nee_prob.
+  if (records_nee) x.guide.record_nee(v.cell, direct, indirect);
+  if (completes_target) {
+    learning_commit(x.guide, pending.le + reflected, boot, st.segment_tr, x.c.guide_updates);
+    x.guide.pending.cell = -1;
+  }
+  if (sets_expectation) st.path_expected = luminance(st.beta) * reflected;
+}
+
 // Radiance the guide expects the vertex to reflect towards the previous
 // one: NEE's unweighted estimate (direct) plus the learned integral. It
 // completes the pending target, and gives guide-driven roulette the path's
@@ -110,18 +133,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE void guide_vertex_estimate(Ctx& x, PathState&
       x.guide_roulette && !(st.path_expected > 0.f) && !v.delta_lobe && x.guide.learned(v.cell);
   const bool records_nee = x.learn && nee_vertex;
   if (!(completes_target || sets_expectation || records_nee)) return;
-  const bool lambertian = !Ctx::kNonDiffuse || v.bsdf.type == BsdfType::Diffuse;
-  GuideBootstrap boot;
-  const Float indirect = x.guide.bins_integral(v.cell, v.bsdf, lambertian, v.wo_l,
-                                               [&](const Vec3& w) { return v.frame.to_local(w); }, x.rng, &boot);
-  const Float reflected = direct + indirect;
-  // The two shares of the light reflected here, for nee_prob.
-  if (records_nee) x.guide.record_nee(v.cell, direct, indirect);
-  if (completes_target) {
-    learning_commit(x.guide, pending.le + reflected, boot, st.segment_tr, x.c.guide_updates);
-    x.guide.pending.cell = -1;
-  }
-  if (sets_expectation) st.path_expected = luminance(st.beta) * reflected;
+  guide_vertex_estimate_at(x, st, v, direct, completes_target, sets_expectation, records_nee);
 }
 
 }  // namespace tessera

@@ -676,9 +676,11 @@ TESSERA_HOST_DEVICE inline void neural_sink_start_path(NeuralSampleSink* sink, u
 }
 
 // Records a learning target for the site's bin into the calling thread's
-// sink. Returns false (and counts it) when the target is rejected.
-TESSERA_HOST_DEVICE inline bool neural_record(const NeuralGuideView& v, const NeuralSite& site, uint32_t bin, Float target,
-                                              const NeuralBootstrap& boot = NeuralBootstrap{}) {
+// sink. Returns false (and counts it) when the target is rejected. Out of
+// line on the GPU (learning only).
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool neural_record(const NeuralGuideView& v, const NeuralSite& site,
+                                                                      uint32_t bin, Float target,
+                                                                      const NeuralBootstrap& boot = NeuralBootstrap{}) {
   NeuralSampleSink* sink = v.sink;
   if (!sink) return false;
   if (!(target >= 0.f) || !(target <= 3.4e38f)) {
