@@ -61,15 +61,14 @@ TESSERA_HOST_DEVICE inline Rgb hair_f(const HairFiber& fiber, const Vec3& wo, co
 TESSERA_HOST_DEVICE inline Float hair_pdf(const HairFiber& fiber, const Vec3& wo, const Vec3& wi);
 // hair_f and hair_pdf at once (they share every transcendental). It and
 // hair_sample are out of line on the GPU (device.h): hair is rare and large.
-TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Rgb hair_f_pdf(const HairFiber& fiber, const Vec3& wo, const Vec3& wi,
-                                                                  Float* pdf);
+TESSERA_HOST_DEVICE inline Rgb hair_f_pdf(const HairFiber& fiber, const Vec3& wo, const Vec3& wi, Float* pdf);
 // Picks a lobe (R, TT, TRT, residual) with uc in proportion to the channel
 // averages of the Ap terms, theta_i from that lobe's Mp (u) and phi_i from
 // its Np (uc's remainder; uniform for the residual). *f and *pdf are
 // hair_f and the full mixture's hair_pdf at *wi. False when the pdf is 0 or
 // not finite, or wi.z == 0 (where f * |cos| would be 0 anyway).
-TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool hair_sample(const HairFiber& fiber, const Vec3& wo, Float uc, Vec2 u,
-                                                                    Vec3* wi, Rgb* f, Float* pdf);
+TESSERA_HOST_DEVICE inline bool hair_sample(const HairFiber& fiber, const Vec3& wo, Float uc, Vec2 u, Vec3* wi, Rgb* f,
+                                            Float* pdf);
 
 // pbrt-v4's absorption of the eumelanin and pheomelanin concentrations (d'Eon et al. 2011).
 TESSERA_HOST_DEVICE inline Rgb hair_sigma_a_from_concentration(Float eumelanin, Float pheomelanin);
