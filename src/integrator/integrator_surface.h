@@ -102,19 +102,15 @@ TESSERA_HOST_DEVICE TESSERA_INLINE Float vertex_guide_probability(Ctx& x, const 
   return guide_p;
 }
 
-// Radiance the guide expects the vertex to reflect towards the previous
-// one: NEE's unweighted estimate (direct) plus the learned integral. It
-// completes the pending target, and gives guide-driven roulette the path's
-// expected radiance.
+// guide_vertex_estimate's work where the vertex has any: out of line on the
+// GPU (learning paths, and a path's first learned vertex under guided
+// roulette).
 template <class Ctx>
-TESSERA_HOST_DEVICE TESSERA_INLINE void guide_vertex_estimate(Ctx& x, PathState& st, const SurfaceVertex& v, bool nee_vertex,
-                                                      Float direct) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline void guide_vertex_estimate_at(Ctx& x, PathState& st,
+                                                                                 const SurfaceVertex& v, Float direct,
+                                                                                 bool completes_target,
+                                                                                 bool sets_expectation, bool records_nee) {
   const PendingTarget& pending = x.guide.pending;
-  const bool completes_target = x.learn && pending.cell >= 0 && !pending.at_delta;
-  const bool sets_expectation =
-      x.guide_roulette && !(st.path_expected > 0.f) && !v.delta_lobe && x.guide.learned(v.cell);
-  const bool records_nee = x.learn && nee_vertex;
-  if (!(completes_target || sets_expectation || records_nee)) return;
   const bool lambertian = !Ctx::kNonDiffuse || v.bsdf.type == BsdfType::Diffuse;
   GuideBootstrap boot;
   const Frame frame = v.frame;  // not the vertex: its address would leave the stage
@@ -128,6 +124,22 @@ TESSERA_HOST_DEVICE TESSERA_INLINE void guide_vertex_estimate(Ctx& x, PathState&
     x.guide.pending.cell = -1;
   }
   if (sets_expectation) st.path_expected = luminance(st.beta) * reflected;
+}
+
+// Radiance the guide expects the vertex to reflect towards the previous
+// one: NEE's unweighted estimate (direct) plus the learned integral. It
+// completes the pending target, and gives guide-driven roulette the path's
+// expected radiance.
+template <class Ctx>
+TESSERA_HOST_DEVICE TESSERA_INLINE void guide_vertex_estimate(Ctx& x, PathState& st, const SurfaceVertex& v, bool nee_vertex,
+                                                      Float direct) {
+  const PendingTarget& pending = x.guide.pending;
+  const bool completes_target = x.learn && pending.cell >= 0 && !pending.at_delta;
+  const bool sets_expectation =
+      x.guide_roulette && !(st.path_expected > 0.f) && !v.delta_lobe && x.guide.learned(v.cell);
+  const bool records_nee = x.learn && nee_vertex;
+  if (!(completes_target || sets_expectation || records_nee)) return;
+  guide_vertex_estimate_at(x, st, v, direct, completes_target, sets_expectation, records_nee);
 }
 
 }  // namespace tessera

@@ -9,6 +9,10 @@
 #define TESSERA_INLINE __forceinline__
 // A large function called from many places: one copy in the device code,
 // not one per call site (ptxas time grows faster than the kernel's size).
+// Also a large path that few samples take (layered BSDFs, hair, guide
+// learning, spectral transport), as Cycles keeps such code out of line
+// (ccl_device_noinline): ptxas compiles it apart, and the hot loop's
+// registers are not allocated around it. On the host it is plain inline.
 #define TESSERA_DEVICE_NOINLINE __noinline__
 #else
 #define TESSERA_HOST_DEVICE

@@ -15,8 +15,9 @@ namespace tessera {
 // vertex's sum over the candidates is capped at kNeuralMixVertexCap (its
 // candidates keep their proportions): a few fireflies do not decide the
 // scene's weight alone, and the integer sums stay far from overflow. A NaN
-// or an overflow is left out and counted.
-TESSERA_HOST_DEVICE inline void neural_record_mix(const NeuralGuideView& v, const GuideMixSample& m, Float target) {
+// or an overflow is left out and counted. Out of line on the GPU (learning only).
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline void neural_record_mix(const NeuralGuideView& v, const GuideMixSample& m,
+                                                                          Float target) {
   static_assert(kNeuralMixFirstCandidate + kNeuralMixCandidates <= kGuideMixEntries, "the table's candidates");
   NeuralSampleSink* sink = v.sink;
   if (!sink || !(m.mix_pdf > 0.f)) return;
