@@ -34,9 +34,9 @@ namespace tessera {
 // (direct: next-event estimation's share). Out of line on the GPU, as
 // learning is (path_learning.h).
 template <class Ctx>
-TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline void learn_at_scatter(Ctx& x, const PathState& st, const SurfaceVertex& v,
-                                                                         const ScatterSample& r, Float guide_p,
-                                                                         const GuideMixSample& direct, const Rgb& weight) {
+TESSERA_HOST_DEVICE TESSERA_COLD_STAGE void learn_at_scatter(Ctx& x, const PathState& st, const SurfaceVertex& v,
+                                                             const ScatterSample& r, Float guide_p,
+                                                             const GuideMixSample& direct, const Rgb& weight) {
   // Only vertices that sample with the cell's own weight (not faded by a
   // glossy lobe) inform it.
   GuideMixSample mix = direct;

@@ -106,10 +106,9 @@ TESSERA_HOST_DEVICE TESSERA_INLINE Float vertex_guide_probability(Ctx& x, const 
 // GPU (learning paths, and a path's first learned vertex under guided
 // roulette).
 template <class Ctx>
-TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline void guide_vertex_estimate_at(Ctx& x, PathState& st,
-                                                                                 const SurfaceVertex& v, Float direct,
-                                                                                 bool completes_target,
-                                                                                 bool sets_expectation, bool records_nee) {
+TESSERA_HOST_DEVICE TESSERA_COLD_STAGE void guide_vertex_estimate_at(Ctx& x, PathState& st, const SurfaceVertex& v,
+                                                                     Float direct, bool completes_target,
+                                                                     bool sets_expectation, bool records_nee) {
   const PendingTarget& pending = x.guide.pending;
   const bool lambertian = !Ctx::kNonDiffuse || v.bsdf.type == BsdfType::Diffuse;
   GuideBootstrap boot;
