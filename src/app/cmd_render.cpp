@@ -330,6 +330,9 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
   if (c.rejected_nonfinite || c.rejected_negative)
     std::fprintf(stderr, "; rejected %llu NaN/Inf and %llu negative samples",
                  static_cast<unsigned long long>(c.rejected_nonfinite), static_cast<unsigned long long>(c.rejected_negative));
+  if (c.path.untraceable_rays)
+    std::fprintf(stderr, "; %llu rays beyond the tracer's reach taken as misses",
+                 static_cast<unsigned long long>(c.path.untraceable_rays));
   std::fputc('\n', stderr);
   if (m.guide && m.guide->mode() == "neural") {
     const NeuralGuideStats& n = r.stats.neural_guide;

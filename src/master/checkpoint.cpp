@@ -15,7 +15,7 @@ constexpr char kMagic[] = "tessera-checkpoint";
 // vertex counter, --guide auto's trial; 5: guide cache v4; 6: light-path splats;
 // 7: splats summed per light path, lights in their own medium; 8: counter of
 // vertices the guide ratio left to the BSDF; 9: the guide's loss and learning time per pass
-constexpr uint32_t kVersion = 10;
+constexpr uint32_t kVersion = 11;
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.
 uint64_t fnv1a(const std::string& s) {

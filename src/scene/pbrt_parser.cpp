@@ -17,29 +17,12 @@
 #include "scene/pbrt_shapes.h"
 #include "scene/pbrt_textures.h"
 #include "scene/sampler_setup.h"
+#include "scene/scene_limits.h"
 #include "scene/named_spectra.h"
 #include "scene/spectrum_file.h"
 
 namespace tessera {
 namespace {
-
-// Embree traces rays whose origins lie within +-1.844e18 (FLT_LARGE) and
-// asserts beyond; past about 1e18 single-precision hit points are off by
-// more than 1e11 anyway. Coordinates beyond this are an error at load.
-constexpr Float kMaxCoordinate = 1e18f;
-
-bool representable(const Vec3& p) {
-  return std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate && std::abs(p.z) <= kMaxCoordinate;
-}
-
-// `p` in render space, reported in the scene file's world (render space's origin added).
-std::string describe_far(const Vec3& p, const glm::dvec3& origin = glm::dvec3(0.0)) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "at (%g, %g, %g): beyond +-%g (or not finite), where single-precision ray tracing cannot go",
-                double(p.x) + origin.x + 0.0, double(p.y) + origin.y + 0.0, double(p.z) + origin.z + 0.0,
-                kMaxCoordinate);  // + 0: no "-0"
-  return buf;
-}
 
 constexpr int kMaxIncludeDepth = 32;
 
