@@ -16,6 +16,7 @@
 #include "guidecache/guide_diagnostic.h"
 #include "guidecache/guide_kinds.h"
 #include "render/image_output.h"
+#include "render/output_file.h"
 #include "render/renderer.h"
 #include "render/embree_backend.h"
 #include "scene/sampler_setup.h"
@@ -91,7 +92,7 @@ void write_distribution(const VizArgs& a, Guide& guide, const glm::dvec3& render
   ExrMetadata meta;
   meta.strings["content"] = "learned incident radiance Q per direction bin (equal-area octahedral square)";
   meta.strings["guide"] = guide.mode() + " (" + where + ")";
-  write_exr(a.distribution, img, nullptr, meta);
+  write_output(a.distribution, [&](const std::string& p) { write_exr(p, img, nullptr, meta); });
   std::vector<uint32_t> order(bins);
   std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(), [&](uint32_t i, uint32_t j) { return q[i] > q[j] || (q[i] == q[j] && i < j); });
@@ -133,15 +134,23 @@ void write_diagnostic(const VizArgs& a, const SceneData& scene, const EmbreeBack
   refuse_nonfinite(img.rgb, "greedy paths", a.diagnostic);
   ExrMetadata meta;
   meta.strings["content"] = "greedy paths along the highest learned Q (diagnostic, not a rendering)";
-  write_exr(a.diagnostic, img, nullptr, meta);
-  write_png_preview(std::filesystem::path(a.diagnostic).replace_extension(".png").string(), img);
+  write_output(a.diagnostic, [&](const std::string& p) { write_exr(p, img, nullptr, meta); });
+  write_output(std::filesystem::path(a.diagnostic).replace_extension(".png").string(),
+               [&](const std::string& p) { write_png_preview(p, img); });
   std::printf("wrote %s\n", a.diagnostic.c_str());
 }
 
 int run_guide_viz(VizArgs a) {
   if (a.distribution.empty() && a.diagnostic.empty())
     throw std::runtime_error("guide-viz: nothing to do; give --distribution FILE.exr and/or --diagnostic FILE.exr");
+  check_output_path(a.distribution, "--distribution");
+  check_output_path(a.diagnostic, "--diagnostic");
   SceneData scene(load_scene_or_builtin(a.scene));
+  std::vector<NamedPath> inputs = {{"--guide-in", a.guide.in}};
+  for (const std::string& f : scene.desc().files_read) inputs.push_back({"a file the scene reads", f});
+  const std::string png = a.diagnostic.empty() ? "" : std::filesystem::path(a.diagnostic).replace_extension(".png").string();
+  check_output_collisions({{"--distribution", a.distribution}, {"--diagnostic", a.diagnostic}, {"--diagnostic's PNG", png}},
+                          inputs);
   EmbreeBackend embree(scene);
   // Without a file to load, something must be learned: the table unless
   // --guide neural, or --neural-* options, ask for the network.

@@ -3,13 +3,10 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <regex>
 #include <sstream>
-
-#include <unistd.h>
 
 #include "app/commands.h"
 #include "app/guide_setup.h"
@@ -21,6 +18,7 @@
 #include "master/farm_master.h"
 #include "render/image_output.h"
 #include "render/interrupt.h"
+#include "render/output_file.h"
 #include "render/renderer.h"
 #include "render/snapshots.h"
 #include "render/stats_json.h"
@@ -40,7 +38,7 @@ namespace {
 struct RenderArgs {
   std::string scene, output, preview, stats, res;
   int64_t spp = -1, max_depth = -1, threads = 0, tile = 16;
-  int64_t seed = -1;
+  std::string seed;  // "": the scene's; any 64-bit value (parse_seed)
   std::string sampler;  // "" = the scene's
   std::string spectral = "auto";
   std::string backend = "auto";  // auto, embree, bvh, cuda
@@ -55,12 +53,25 @@ struct RenderArgs {
   GuideArgs guide;
 };
 
+// Every 64-bit seed is its own: a value out of range is an error, not
+// clamped (which would give two seeds one image).
+uint64_t parse_seed(const std::string& text) {
+  static const std::regex re("^[0-9]{1,20}$");
+  errno = 0;
+  char* end = nullptr;
+  const unsigned long long v = std::regex_match(text, re) ? std::strtoull(text.c_str(), &end, 10) : 0;
+  if (!std::regex_match(text, re) || errno == ERANGE)
+    throw std::runtime_error("--seed: expected an integer from 0 to 18446744073709551615, got '" + text + "'");
+  return static_cast<uint64_t>(v);
+}
+
 void parse_resolution(const std::string& res, SceneDesc& d) {
   std::smatch m;
-  static const std::regex re("^([0-9]{1,5})x([0-9]{1,5})$");
-  if (!std::regex_match(res, m, re) || std::stoi(m[1]) <= 0 || std::stoi(m[2]) <= 0)
+  // Up to 9 digits each (an int), so that a size too large is named as such.
+  static const std::regex re("^([0-9]{1,9})x([0-9]{1,9})$");
+  if (!std::regex_match(res, m, re) || std::stoll(m[1]) <= 0 || std::stoll(m[2]) <= 0)
     throw std::runtime_error("--res: expected WxH with positive integers, got '" + res + "'");
-  const int64_t w = std::stoi(m[1]), h = std::stoi(m[2]);
+  const int64_t w = std::stoll(m[1]), h = std::stoll(m[2]);
   if (w > kMaxFilmDimension || h > kMaxFilmDimension || w * h > kMaxFilmPixels)
     throw std::runtime_error("--res: " + res + " is larger than supported (" + std::to_string(kMaxFilmPixels) + " pixels)");
   d.film.xres = static_cast<int32_t>(w);
@@ -73,7 +84,7 @@ SceneDesc load_desc(const RenderArgs& a) {
   if (!a.res.empty()) parse_resolution(a.res, desc);
   if (a.max_depth >= 0) desc.max_depth = static_cast<int32_t>(a.max_depth);
   if (a.spp >= 0) desc.spp = static_cast<int32_t>(a.spp);
-  if (a.seed >= 0) desc.seed = static_cast<uint64_t>(a.seed);
+  if (!a.seed.empty()) desc.seed = parse_seed(a.seed);
   if (!a.sampler.empty()) desc.sampler = sampler_kind_named(a.sampler).value();  // CLI11 checked the name
   desc.spectral = a.spectral == "on" || (a.spectral == "auto" && !spectral_reason(desc).empty());
   return desc;
@@ -117,29 +128,6 @@ OutputPaths output_paths(const RenderArgs& a, const SceneDesc& desc) {
   return o;
 }
 
-// Fails before the render, not after it, when `path` (given by `option`)
-// cannot be written: its folder must exist and be writable, and the path
-// must not be a folder.
-void check_writable(const std::string& path, const char* option) {
-  if (path.empty()) return;
-  namespace fs = std::filesystem;
-  fs::path dir = fs::path(path).parent_path();
-  if (dir.empty()) dir = ".";
-  std::error_code ec;
-  const std::string what = std::string(option) + " '" + path + "': ";
-  if (!fs::is_directory(dir, ec)) throw std::runtime_error(what + "folder '" + dir.string() + "' does not exist");
-  if (access(dir.c_str(), W_OK) != 0) throw std::runtime_error(what + "folder '" + dir.string() + "' is not writable");
-  if (fs::is_directory(path, ec)) throw std::runtime_error(what + "is a folder");
-  // Permission bits do not say everything (root passes access() for /proc or
-  // a read-only mount): create a file there, as the outputs will be.
-  std::string probe = (dir / ".tessera-write-check-XXXXXX").string();
-  const int fd = mkstemp(probe.data());
-  if (fd < 0)
-    throw std::runtime_error(what + "folder '" + dir.string() + "' is not writable (" + std::strerror(errno) + ")");
-  close(fd);
-  unlink(probe.c_str());
-}
-
 Bytes guide_bytes(const Guide& guide, const SceneData& scene) {
   std::ostringstream s(std::ios::binary);
   guide.save(s, scene.fingerprint());
@@ -157,6 +145,18 @@ std::unique_ptr<Guide> guide_from_bytes(const Bytes& bytes, const SceneData& sce
 // An exception's message for the one-line error ("std::bad_alloc" says little).
 const char* error_text(const std::exception& e) {
   return dynamic_cast<const std::bad_alloc*>(&e) ? "out of memory" : e.what();
+}
+
+// No output may overwrite another or anything the render reads (the scene's
+// files, --guide-in, --resume); a checkpoint may continue the one it resumes.
+void check_outputs_apart(const RenderArgs& a, const OutputPaths& out, const SceneDesc& desc) {
+  const std::vector<NamedPath> outputs = {
+      {"-o", out.exr}, {"--preview", out.preview}, {"--stats", a.stats}, {"--checkpoint", a.checkpoint}, {"--guide-out", a.guide.out}};
+  std::vector<NamedPath> inputs = {{"--guide-in", a.guide.in}, {"--resume", a.resume}};
+  for (const std::string& f : desc.files_read) inputs.push_back({f == desc.source ? "the scene file" : "a file the scene reads", f});
+  check_output_collisions(outputs, inputs, [](const NamedPath& o, const NamedPath& in) {
+    return o.what == "--checkpoint" && in.what == "--resume";
+  });
 }
 
 // Everything rank 0 (or a local run) decides before rendering.
@@ -177,11 +177,12 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   SceneDesc desc = load_desc(a);
   m.opt = make_options(a, desc);
   m.out = output_paths(a, desc);
-  check_writable(m.out.exr, "-o");
-  check_writable(m.out.preview, "--preview");
-  check_writable(a.stats, "--stats");
-  check_writable(a.checkpoint, "--checkpoint");
-  check_writable(a.guide.out, "--guide-out");
+  check_output_path(m.out.exr, "-o");
+  check_output_path(m.out.preview, "--preview");
+  check_output_path(a.stats, "--stats", /*stdout_ok=*/true);
+  check_output_path(a.checkpoint, "--checkpoint");
+  check_output_path(a.guide.out, "--guide-out");
+  check_outputs_apart(a, m.out, desc);
   // A resume holds the checkpoint's film twice more; --guide auto's trial one more.
   const PixelBounds crop = film_pixel_bounds(desc.film);
   check_film_memory(crop.width(), crop.height(), m.opt.light_paths, !a.checkpoint.empty(),
@@ -263,14 +264,6 @@ void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks, int32_t machi
                  m.resume->so_far.stats.passes);
 }
 
-// Temp file + rename: a failed or killed write never replaces a good file.
-template <class Write>
-void write_atomically(const std::string& path, Write write) {
-  const std::string tmp = std::filesystem::path(path).replace_extension(".partial" + std::filesystem::path(path).extension().string()).string();
-  write(tmp);
-  std::filesystem::rename(tmp, path);
-}
-
 // What every image of this render records, final or snapshot.
 ExrMetadata base_metadata(const MasterSetup& m, uint32_t spec) {
   ExrMetadata meta;
@@ -323,10 +316,10 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
                  "more): stored as the largest float; the stats' estimated relMSE (in double) stays valid\n",
                  static_cast<unsigned long long>(saturated));
   }
-  write_atomically(m.out.exr, [&](const std::string& p) { write_exr(p, mean, &var, meta); });
+  write_output(m.out.exr, [&](const std::string& p) { write_exr(p, mean, &var, meta); });
   std::printf("wrote %s\n", m.out.exr.c_str());
   if (!m.out.preview.empty()) {
-    write_atomically(m.out.preview, [&](const std::string& p) { write_png_preview(p, mean); });
+    write_output(m.out.preview, [&](const std::string& p) { write_png_preview(p, mean); });
     std::printf("wrote %s\n", m.out.preview.c_str());
   }
   const TileCounters& c = r.stats.counters;
@@ -337,6 +330,9 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
   if (c.rejected_nonfinite || c.rejected_negative)
     std::fprintf(stderr, "; rejected %llu NaN/Inf and %llu negative samples",
                  static_cast<unsigned long long>(c.rejected_nonfinite), static_cast<unsigned long long>(c.rejected_negative));
+  if (c.path.untraceable_rays)
+    std::fprintf(stderr, "; %llu rays beyond the tracer's reach taken as misses",
+                 static_cast<unsigned long long>(c.path.untraceable_rays));
   std::fputc('\n', stderr);
   if (m.guide && m.guide->mode() == "neural") {
     const NeuralGuideStats& n = r.stats.neural_guide;
@@ -366,10 +362,10 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
                    100.0 * r.stats.guide_sync_seconds / std::max(r.stats.seconds, 1e-9));
   }
   if (!a.stats.empty()) {
-    write_atomically(a.stats, [&](const std::string& p) {
+    write_output(a.stats, [&](const std::string& p) {
       write_text_file(p, stats_to_json(r.stats, scene.desc().source, mean.width, mean.height, m.opt.seed, snapshots));
     });
-    std::printf("wrote %s\n", a.stats.c_str());
+    if (a.stats != "-") std::printf("wrote %s\n", a.stats.c_str());
   }
 }
 
@@ -519,7 +515,8 @@ int run_render_farm(const RenderArgs& a) {
 // (render/interrupt.h); the exit status then says it was interrupted.
 int run_render(const RenderArgs& a) {
   // Open MPI's launcher (not srun) starts its kill sequence with SIGCONT.
-  install_interrupt_handlers(std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr);
+  const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
+  install_interrupt_handlers(std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr, rank == nullptr || std::string(rank) == "0");
   const int rc = launched_by_mpirun() ? run_render_farm(a) : run_render_local(a);
   return rc == 0 && interrupt_requested() ? 130 : rc;
 }
@@ -545,7 +542,7 @@ CommandRunner add_render_command(CLI::App& app) {
                 "Write the image so far every SECONDS, or at doubling sample counts ('doubling'), into <output>-snapshots/");
   c->add_option("--res", a->res, "Resolution WxH (overrides the scene's Film)");
   c->add_option("--max-depth", a->max_depth, "Maximum path depth, counted as pbrt-v4 does (overrides the Integrator)")->check(CLI::Range(0, 1 << 20));
-  c->add_option("--seed", a->seed, "Random seed (same seed -> bit-identical image)")->check(CLI::NonNegativeNumber);
+  c->add_option("--seed", a->seed, "Random seed, 0 to 2^64-1 (same seed -> bit-identical image)");
   c->add_option("--sampler", a->sampler,
                 "zsobol | paddedsobol | sobol | stratified | independent | halton (pbrt-v4's samplers; sobol is drawn as paddedsobol); default: the scene's Sampler")
       ->check(CLI::IsMember({"zsobol", "paddedsobol", "sobol", "stratified", "independent", "halton"}));

@@ -11,6 +11,7 @@
 
 #include "app/commands.h"
 #include "kernels/effects.h"
+#include "render/output_file.h"
 #include "render/renderer.h"
 
 namespace tessera {
@@ -202,15 +203,13 @@ std::unique_ptr<Guide> make_guide(const GuideArgs& a, const SceneData& scene, st
 
 void save_guide(const GuideArgs& a, const Guide& guide, const SceneData& scene) {
   if (a.out.empty()) return;
-  const std::string tmp = a.out + ".tmp";
-  {
+  write_output(a.out, [&](const std::string& tmp) {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
     if (!f) throw std::runtime_error("--guide-out: cannot write " + tmp);
     guide.save(f, scene.fingerprint());
     f.close();
     if (!f) throw std::runtime_error("--guide-out: cannot write " + tmp);
-  }
-  std::filesystem::rename(tmp, a.out);
+  });
 }
 
 void check_guide_fits_scene(const Guide& guide, const SceneData& scene) {

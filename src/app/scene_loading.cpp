@@ -1,16 +1,53 @@
 #include "app/scene_loading.h"
 
 #include <cstdio>
+#include <map>
+#include <regex>
 
 #include "scene/builtin_scenes.h"
 #include "scene/pbrt_loader.h"
 
 namespace tessera {
+namespace {
+
+// A scene can warn about every one of its 100,000 curves: each distinct
+// warning is printed a few times (with its file:line), then counted.
+constexpr int kShownPerWarning = 3;
+constexpr int kShownInAll = 50;
+
+void print_warnings(const std::vector<std::string>& warnings) {
+  static const std::regex located("^(.*?:[0-9]+): (.*)$");
+  std::map<std::string, int> seen;  // by message without its location
+  std::vector<std::string> order;
+  int shown = 0, hidden = 0;
+  for (const std::string& w : warnings) {
+    std::smatch m;
+    const std::string message = std::regex_match(w, m, located) ? m[2].str() : w;
+    const int n = ++seen[message];
+    if (n == 1) order.push_back(message);
+    if (n <= kShownPerWarning && shown < kShownInAll) {
+      std::fprintf(stderr, "tessera: warning: %s\n", w.c_str());
+      ++shown;
+    } else {
+      ++hidden;
+    }
+  }
+  if (hidden == 0) return;
+  int summaries = 0;
+  for (const std::string& message : order) {
+    if (seen[message] <= kShownPerWarning || summaries == kShownInAll) continue;
+    std::fprintf(stderr, "tessera: warning: %d times in all: %s\n", seen[message], message.c_str());
+    ++summaries;
+  }
+  std::fprintf(stderr, "tessera: warning: %zu warnings in all, %d of them shown\n", warnings.size(), shown);
+}
+
+}  // namespace
 
 SceneDesc load_scene_or_builtin(const std::string& path) {
   SceneDesc d = path.empty() ? load_builtin_cornell_box() : load_pbrt_file(path);
   if (d.source.empty()) d.source = path;
-  for (const std::string& w : d.warnings) std::fprintf(stderr, "tessera: warning: %s\n", w.c_str());
+  print_warnings(d.warnings);
   return d;
 }
 

@@ -77,7 +77,7 @@ struct TileWork {
 // their size: a counter added there stops to_wire and from_wire compiling
 // until kWords follows (the farm's messages and checkpoints change with it).
 struct WireCounters {
-  static constexpr size_t kWords = 19;
+  static constexpr size_t kWords = 20;
   uint64_t words[kWords] = {};
 
   template <class Counters>

@@ -10,6 +10,11 @@
 // Guided directions then go where indirect light comes from instead of
 // duplicating the light samples; Q stays the full reflected radiance, so
 // light that reaches x over several bounces is still learned.
+//
+// Learning runs in some passes only, and mostly writes to memory: the
+// hooks that record (learning_commit, learning_at_surface,
+// learning_at_scatter) are out of line on the GPU (device.h), outside the
+// path loop's register allocation.
 #pragma once
 
 #include "guidecache/path_guide.h"
@@ -21,8 +26,8 @@ namespace tessera {
 // bootstrapped part (the network refreshes it as it trains). `updates`
 // counts the targets the guide accepted.
 template <class PG>
-TESSERA_HOST_DEVICE TESSERA_INLINE void learning_commit(PG& pg, Float target, GuideBootstrap boot, Float segment_tr,
-                                                uint64_t& updates) {
+TESSERA_HOST_DEVICE TESSERA_COLD_STAGE void learning_commit(PG& pg, Float target, GuideBootstrap boot, Float segment_tr,
+                                                            uint64_t& updates) {
   PendingTarget& t = pg.pending;
   target *= segment_tr;
   boot.coef *= segment_tr;
@@ -67,8 +72,8 @@ TESSERA_HOST_DEVICE TESSERA_INLINE void learning_at_medium_vertex(PG& pg, Float 
 // A surface vertex y was located: what its hit tells the pending target.
 // Emission the integrator weights by MIS is NEE's to deliver.
 template <class PG>
-TESSERA_HOST_DEVICE TESSERA_INLINE void learning_at_surface(PG& pg, int32_t cell, const Vec3& n_side, Float le_unweighted,
-                                                    bool delta_lobe) {
+TESSERA_HOST_DEVICE TESSERA_COLD_STAGE void learning_at_surface(PG& pg, int32_t cell, const Vec3& n_side,
+                                                                Float le_unweighted, bool delta_lobe) {
   pg.note_normal(cell, n_side);
   pg.pending.le = le_unweighted;
   pg.pending.at_delta = delta_lobe;
@@ -79,8 +84,9 @@ TESSERA_HOST_DEVICE TESSERA_INLINE void learning_at_surface(PG& pg, int32_t cell
 // the direction it took; the new segment's target becomes the pending one.
 // mix: the vertex's mixture statistics (mix_pdf 0: it does not inform the weight).
 template <class PG>
-TESSERA_HOST_DEVICE TESSERA_INLINE void learning_at_scatter(PG& pg, int32_t cell, uint32_t bin, Float weight,
-                                                    const GuideMixSample& mix, Float segment_tr, uint64_t& updates) {
+TESSERA_HOST_DEVICE TESSERA_COLD_STAGE void learning_at_scatter(PG& pg, int32_t cell, uint32_t bin, Float weight,
+                                                                const GuideMixSample& mix, Float segment_tr,
+                                                                uint64_t& updates) {
   PendingTarget& t = pg.pending;
   if (t.at_delta && t.cell >= 0) {
     const Float value = pg.value(cell, bin);

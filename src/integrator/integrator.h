@@ -29,6 +29,26 @@
 
 namespace tessera {
 
+// A learning path's vertex took direction r (BSDF weight `weight`): its
+// target becomes the pending one, with the vertex's mixture statistics
+// (direct: next-event estimation's share). Out of line on the GPU, as
+// learning is (path_learning.h).
+template <class Ctx>
+TESSERA_HOST_DEVICE TESSERA_COLD_STAGE void learn_at_scatter(Ctx& x, const PathState& st, const SurfaceVertex& v,
+                                                             const ScatterSample& r, Float guide_p,
+                                                             const GuideMixSample& direct, const Rgb& weight) {
+  // Only vertices that sample with the cell's own weight (not faded by a
+  // glossy lobe) inform it.
+  GuideMixSample mix = direct;
+  if (guide_p > 0.f && x.guide.learns_mix(v.cell, guide_p)) {
+    mix.fcos = luminance(r.bs.f) * abs_cos_theta(r.bs.wi);
+    mix.bsdf_pdf = r.bsdf_pdf;
+    mix.guide_pdf = r.guide_density;
+    mix.mix_pdf = r.pdf;
+  }
+  learning_at_scatter(x.guide, v.cell, r.bin, luminance(weight), mix, st.segment_tr, x.c.guide_updates);
+}
+
 // One surface vertex after its interaction: direct light, the guide's
 // estimate, the direction, the path's state after it. False: the path ends.
 template <class Ctx>
@@ -53,18 +73,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE bool scatter_at_surface(Ctx& x, PathState& st
   ScatterSample r;
   if (!sample_scatter(x, st, v, guide_p, uc, u, &r)) return false;
   const Rgb weight = r.bs.f * (abs_cos_theta(r.bs.wi) / r.pdf);
-  if (x.learn) {
-    // Only vertices that sample with the cell's own weight (not faded by a
-    // glossy lobe) inform it.
-    GuideMixSample mix = direct.mix;
-    if (guide_p > 0.f && x.guide.learns_mix(v.cell, guide_p)) {
-      mix.fcos = luminance(r.bs.f) * abs_cos_theta(r.bs.wi);
-      mix.bsdf_pdf = r.bsdf_pdf;
-      mix.guide_pdf = r.guide_density;
-      mix.mix_pdf = r.pdf;
-    }
-    learning_at_scatter(x.guide, v.cell, r.bin, luminance(weight), mix, st.segment_tr, x.c.guide_updates);
-  }
+  if (Ctx::kGuide && x.learn) learn_at_scatter(x, st, v, r, guide_p, direct.mix, weight);
   move_past_surface(x, st, v, r, weight, guide_p);
   return survives_roulette(x, st, v.cell, r.bin);
 }
@@ -96,7 +105,9 @@ TESSERA_HOST_DEVICE Rgb trace_path(const SceneView& s, const Tracer& tracer, Ray
       escape(x, st);
       break;
     }
-    SurfaceVertex v;
+    SurfaceHit h;
+    BsdfParams bsdf;
+    SurfaceVertex v(h, bsdf);
     const SurfaceStep step = surface_interaction(x, st, hit, &v);
     if (step == SurfaceStep::kPass) continue;
     if (step == SurfaceStep::kEnd || !scatter_at_surface(x, st, v)) break;

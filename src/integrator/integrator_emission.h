@@ -13,7 +13,11 @@ template <uint32_t Spec>
 TESSERA_HOST_DEVICE TESSERA_INLINE Float last_direction_mis_pdf(MisMemory& m) {
   if constexpr ((Spec & kSpecNonDiffuse) != 0) {
     if (m.pending) {
-      const Float mis_bsdf = bsdf_mis_pdf(m.bsdf, m.wo, m.wi);
+      // Copies: the coated BSDF's code is out of line, and the path state's
+      // address must not reach it (the state would then live in memory).
+      const BsdfParams bsdf = m.bsdf;
+      const Vec3 wo = m.wo, wi = m.wi;
+      const Float mis_bsdf = bsdf_mis_pdf(bsdf, wo, wi);
       m.pdf = m.guide_p * m.guide_density + (1.f - m.guide_p) * mis_bsdf;
       m.pending = false;
     }

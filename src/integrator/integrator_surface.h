@@ -10,11 +10,15 @@
 
 namespace tessera {
 
+// The hit and the BSDF are the caller's: their addresses go to out-of-line
+// code (the material, the general BSDF), and a vertex holding them would
+// have to live in memory as a whole; apart, the rest stays in registers.
 struct SurfaceVertex {
-  SurfaceHit h;
+  TESSERA_HOST_DEVICE SurfaceVertex(SurfaceHit& hit, BsdfParams& b) : h(hit), bsdf(b) {}
+  SurfaceHit& h;
+  BsdfParams& bsdf;
   Vec3 wo;         // towards the previous vertex, world space
   Vec3 wo_l;       // ... in the shading frame
-  BsdfParams bsdf;
   Frame frame;
   uint32_t lobes = 0;
   bool delta_lobe = false;  // a specular lobe: no guiding here
@@ -36,7 +40,8 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceStep surface_interaction(Ctx& x, PathS
   ++x.c.vertices;
   const RayPoint from_ray{st.ray.o, st.ray.d, hit.t};
   v.h = make_surface_hit(x.s, hit.triangle, hit.b1, hit.b2, st.ray.time, &from_ray);
-  v.wo = -st.ray.d;
+  const Vec3 wo = -st.ray.d;  // (a copy goes to the out-of-line material code, not v's address)
+  v.wo = wo;
   const TriangleInfo& info = x.s.triangles[hit.triangle];
 
   Rgb Le_hit(0.f);  // radiance emitted at this vertex towards the previous one
@@ -44,7 +49,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceStep surface_interaction(Ctx& x, PathS
     if (info.light >= 0) Le_hit = add_area_emission(x, st, v.h, v.wo, info.light);
 
   const int32_t single_before = st.wl ? st.wl->single : -1;
-  if (!resolve_bsdf<Spec>(x.s, info.material, v.h, v.wo, &v.bsdf, st.wl)) {
+  if (!resolve_bsdf<Spec>(x.s, info.material, v.h, wo, &v.bsdf, st.wl)) {
     // Interface: continue through without counting a bounce (pbrt's SkipIntersection).
     ++x.c.interface_skips;
     if (++st.interface_skips > 256) return SurfaceStep::kEnd;
@@ -97,6 +102,29 @@ TESSERA_HOST_DEVICE TESSERA_INLINE Float vertex_guide_probability(Ctx& x, const 
   return guide_p;
 }
 
+// guide_vertex_estimate's work where the vertex has any: out of line on the
+// GPU (learning paths, and a path's first learned vertex under guided
+// roulette).
+template <class Ctx>
+TESSERA_HOST_DEVICE TESSERA_COLD_STAGE void guide_vertex_estimate_at(Ctx& x, PathState& st, const SurfaceVertex& v,
+                                                                     Float direct, bool completes_target,
+                                                                     bool sets_expectation, bool records_nee) {
+  const PendingTarget& pending = x.guide.pending;
+  const bool lambertian = !Ctx::kNonDiffuse || v.bsdf.type == BsdfType::Diffuse;
+  GuideBootstrap boot;
+  const Frame frame = v.frame;  // not the vertex: its address would leave the stage
+  const Float indirect = x.guide.bins_integral(v.cell, v.bsdf, lambertian, v.wo_l,
+                                               [&frame](const Vec3& w) { return frame.to_local(w); }, x.rng, &boot);
+  const Float reflected = direct + indirect;
+  // The two shares of the light reflected here, for nee_prob.
+  if (records_nee) x.guide.record_nee(v.cell, direct, indirect);
+  if (completes_target) {
+    learning_commit(x.guide, pending.le + reflected, boot, st.segment_tr, x.c.guide_updates);
+    x.guide.pending.cell = -1;
+  }
+  if (sets_expectation) st.path_expected = luminance(st.beta) * reflected;
+}
+
 // Radiance the guide expects the vertex to reflect towards the previous
 // one: NEE's unweighted estimate (direct) plus the learned integral. It
 // completes the pending target, and gives guide-driven roulette the path's
@@ -110,18 +138,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE void guide_vertex_estimate(Ctx& x, PathState&
       x.guide_roulette && !(st.path_expected > 0.f) && !v.delta_lobe && x.guide.learned(v.cell);
   const bool records_nee = x.learn && nee_vertex;
   if (!(completes_target || sets_expectation || records_nee)) return;
-  const bool lambertian = !Ctx::kNonDiffuse || v.bsdf.type == BsdfType::Diffuse;
-  GuideBootstrap boot;
-  const Float indirect = x.guide.bins_integral(v.cell, v.bsdf, lambertian, v.wo_l,
-                                               [&](const Vec3& w) { return v.frame.to_local(w); }, x.rng, &boot);
-  const Float reflected = direct + indirect;
-  // The two shares of the light reflected here, for nee_prob.
-  if (records_nee) x.guide.record_nee(v.cell, direct, indirect);
-  if (completes_target) {
-    learning_commit(x.guide, pending.le + reflected, boot, st.segment_tr, x.c.guide_updates);
-    x.guide.pending.cell = -1;
-  }
-  if (sets_expectation) st.path_expected = luminance(st.beta) * reflected;
+  guide_vertex_estimate_at(x, st, v, direct, completes_target, sets_expectation, records_nee);
 }
 
 }  // namespace tessera

@@ -32,6 +32,7 @@ struct PathCounters {
   uint64_t light_splats = 0;       // pixel contributions they made
   uint64_t caustic_emission_skipped = 0;  // emitter hits left to the light tracer
   uint64_t neural_sites_reused = 0;       // vertices that reused their pixel's first site (NeuralFirstSite)
+  uint64_t untraceable_rays = 0;          // rays the tracer refused (kernels/ray_guard.h): misses or occluded
 };
 
 struct PathSettings {

@@ -21,26 +21,29 @@ TESSERA_HOST_DEVICE inline Rgb diffuse_eval(const BsdfParams& b, const Vec3& wo,
 
 }  // namespace detail
 
+// Directions are taken by value: the general BSDF's code is out of line, and
+// a reference would hand it the address of the caller's vertex, which the
+// compiler must then keep in memory instead of registers.
 template <uint32_t Spec>
-TESSERA_HOST_DEVICE inline Rgb eval_f(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+TESSERA_HOST_DEVICE inline Rgb eval_f(const BsdfParams& b, Vec3 wo, Vec3 wi) {
   if constexpr ((Spec & kSpecNonDiffuse) != 0) return bsdf_eval(b, wo, wi);
   else return detail::diffuse_eval(b, wo, wi);
 }
 // For light samples (next-event estimation): see bsdf_eval_light.
 template <uint32_t Spec>
-TESSERA_HOST_DEVICE inline Rgb eval_f_light(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+TESSERA_HOST_DEVICE inline Rgb eval_f_light(const BsdfParams& b, Vec3 wo, Vec3 wi) {
   if constexpr ((Spec & kSpecNonDiffuse) != 0) return bsdf_eval_light(b, wo, wi);
   else return detail::diffuse_eval(b, wo, wi);
 }
 template <uint32_t Spec>
-TESSERA_HOST_DEVICE inline Float eval_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi) {
+TESSERA_HOST_DEVICE inline Float eval_pdf(const BsdfParams& b, Vec3 wo, Vec3 wi) {
   if constexpr ((Spec & kSpecNonDiffuse) != 0) return bsdf_pdf(b, wo, wi);
   else return same_hemisphere(wo, wi) ? abs_cos_theta(wi) * kInvPi : 0.f;
 }
 // The density MIS weighs the BSDF's strategy by (bsdf_mis_pdf), and whether
 // the balance heuristic applies (the coated BSDFs under volpath).
 template <uint32_t Spec>
-TESSERA_HOST_DEVICE inline Float eval_mis_pdf(const BsdfParams& b, const Vec3& wo, const Vec3& wi, Float pdf) {
+TESSERA_HOST_DEVICE inline Float eval_mis_pdf(const BsdfParams& b, Vec3 wo, Vec3 wi, Float pdf) {
   if constexpr ((Spec & kSpecNonDiffuse) != 0) return bsdf_mis_estimated(b) ? bsdf_mis_pdf(b, wo, wi) : pdf;
   else return pdf;
 }
@@ -50,7 +53,7 @@ TESSERA_HOST_DEVICE inline bool mis_balance(const SceneView& s, const BsdfParams
   else return false;
 }
 template <uint32_t Spec>
-TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, const Vec3& wo, Float uc, Vec2 u, BsdfSample* bs) {
+TESSERA_HOST_DEVICE inline bool sample_f(const BsdfParams& b, Vec3 wo, Float uc, Vec2 u, BsdfSample* bs) {
   if constexpr ((Spec & kSpecNonDiffuse) != 0) {
     return bsdf_sample(b, wo, uc, u, bs);
   } else {

@@ -35,7 +35,10 @@ TESSERA_HOST_DEVICE inline Vec3 faced_shading_normal(Vec3 n, const SurfaceHit& h
   return glm::dot(n, h.ng) < 0.f ? -n : n;
 }
 
-TESSERA_HOST_DEVICE inline Vec3 bumped_shading_normal(const SceneView& s, int32_t bump, const SurfaceHit& h) {
+// Bump and normal maps are out of line on the GPU (device.h): only their
+// materials take them.
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Vec3 bumped_shading_normal(const SceneView& s, int32_t bump,
+                                                                          const SurfaceHit& h) {
   constexpr Float kDelta = 0.0005f;
   Vec3 dpdu, dpdv;
   shading_derivatives(s, h, &dpdu, &dpdv);
@@ -49,7 +52,8 @@ TESSERA_HOST_DEVICE inline Vec3 bumped_shading_normal(const SceneView& s, int32_
   return faced_shading_normal(glm::cross(bu, bv), h);
 }
 
-TESSERA_HOST_DEVICE inline Vec3 normal_mapped_shading_normal(const SceneView& s, int32_t image, const SurfaceHit& h) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Vec3 normal_mapped_shading_normal(const SceneView& s, int32_t image,
+                                                                                 const SurfaceHit& h) {
   Vec3 dpdu, dpdv;
   shading_derivatives(s, h, &dpdu, &dpdv);
   const Rgb rgb = image_lookup(s.images[image], h.uv);

@@ -10,6 +10,7 @@
 #pragma once
 
 #include "hit_filter.h"
+#include "ray_guard.h"
 #include "surface.h"
 
 namespace tessera {
@@ -105,8 +106,7 @@ TESSERA_HOST_DEVICE inline bool hits_triangle(const Vec3& p0, const Vec3& p1, co
 // rays). Candidates the scene filters (alpha, one-way faces) are skipped.
 TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool bvh_trace(const BvhView& bvh, const SceneView& s, const Vec3& o, const Vec3& d,
                                           Float tmax, Float time, bool any_hit, TraceHit* hit) {
-  // A non-finite ray would pass every box (NaN slabs are dropped): none is traced.
-  if (bvh.num_nodes == 0 || !(tmax > 0.f) || !is_finite(o) || !is_finite(d)) return false;
+  if (bvh.num_nodes == 0 || !(tmax > 0.f)) return false;
   const Vec3 inv_d(1.f / d.x, 1.f / d.y, 1.f / d.z);
   const bool filtered = s.triangle_alpha || s.has_one_way_faces;
   uint32_t stack[kBvhStackSize];
@@ -146,15 +146,20 @@ TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool bvh_trace(const BvhView&
   }
 }
 
-// The ray query interface the integrator takes (EmbreeTracer's), over a BVH.
+// The ray query interface the integrator takes (EmbreeTracer's), over a
+// BVH, for the rays Embree takes (ray_guard.h: a non-finite ray would pass
+// every box, as NaN slabs are dropped).
 struct BvhTracer {
   BvhView bvh;
   const SceneView* scene = nullptr;
+  uint64_t* untraceable = nullptr;  // where refused rays are counted; null: not counted
 
   TESSERA_HOST_DEVICE bool intersect(const Vec3& o, const Vec3& d, Float tmax, TraceHit* hit, Float time = 0.f) const {
+    if (!ray_traceable(o, d, tmax)) return refuse_ray(untraceable, false);
     return bvh_trace(bvh, *scene, o, d, tmax, time, false, hit);
   }
   TESSERA_HOST_DEVICE bool occluded(const Vec3& o, const Vec3& d, Float tmax, Float time = 0.f) const {
+    if (!ray_traceable(o, d, tmax)) return refuse_ray(untraceable, true);
     TraceHit hit;
     return bvh_trace(bvh, *scene, o, d, tmax, time, true, &hit);
   }

@@ -9,11 +9,20 @@
 #define TESSERA_INLINE __forceinline__
 // A large function called from many places: one copy in the device code,
 // not one per call site (ptxas time grows faster than the kernel's size).
+// Also a large path that few samples take (layered BSDFs, hair, guide
+// learning, spectral transport), as Cycles keeps such code out of line
+// (ccl_device_noinline): ptxas compiles it apart, and the hot loop's
+// registers are not allocated around it. On the host it is plain inline.
 #define TESSERA_DEVICE_NOINLINE __noinline__
+// Cold code of the integrator's stages: out of line on the GPU as above,
+// always inline on the CPU, where a call would take the address of the
+// caller's path state and keep it out of registers (docs/development.md).
+#define TESSERA_COLD_STAGE __noinline__
 #else
 #define TESSERA_HOST_DEVICE
 #define TESSERA_INLINE inline __attribute__((always_inline))
 #define TESSERA_DEVICE_NOINLINE
+#define TESSERA_COLD_STAGE inline __attribute__((always_inline))
 #endif
 
 // TESSERA_PREFETCH hints that memory will be read soon: a no-op on the GPU,

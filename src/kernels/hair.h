@@ -59,7 +59,8 @@ TESSERA_HOST_DEVICE inline Float hair_offset(const Vec3& wo);
 TESSERA_HOST_DEVICE inline Rgb hair_f(const HairFiber& fiber, const Vec3& wo, const Vec3& wi);
 // Solid-angle density with which hair_sample produces wi.
 TESSERA_HOST_DEVICE inline Float hair_pdf(const HairFiber& fiber, const Vec3& wo, const Vec3& wi);
-// hair_f and hair_pdf at once (they share every transcendental).
+// hair_f and hair_pdf at once (they share every transcendental). It and
+// hair_sample are out of line on the GPU (device.h): hair is rare and large.
 TESSERA_HOST_DEVICE inline Rgb hair_f_pdf(const HairFiber& fiber, const Vec3& wo, const Vec3& wi, Float* pdf);
 // Picks a lobe (R, TT, TRT, residual) with uc in proportion to the channel
 // averages of the Ap terms, theta_i from that lobe's Mp (u) and phi_i from
@@ -306,7 +307,8 @@ TESSERA_HOST_DEVICE inline Float hair_offset(const Vec3& wo) {
   return h;
 }
 
-TESSERA_HOST_DEVICE inline Rgb hair_f_pdf(const HairFiber& fiber, const Vec3& wo, const Vec3& wi, Float* pdf) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Rgb hair_f_pdf(const HairFiber& fiber, const Vec3& wo, const Vec3& wi,
+                                                                  Float* pdf) {
   *pdf = 0.f;
   hair_detail::Outgoing t;
   Vec3 w;
@@ -325,8 +327,8 @@ TESSERA_HOST_DEVICE inline Float hair_pdf(const HairFiber& fiber, const Vec3& wo
   return pdf;
 }
 
-TESSERA_HOST_DEVICE inline bool hair_sample(const HairFiber& fiber, const Vec3& wo, Float uc, Vec2 u, Vec3* wi, Rgb* f,
-                                            Float* pdf) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool hair_sample(const HairFiber& fiber, const Vec3& wo, Float uc, Vec2 u,
+                                                                    Vec3* wi, Rgb* f, Float* pdf) {
   using namespace hair_detail;
   constexpr Float kOneMinusEpsilon = 0x1.fffffep-1f;
   *pdf = 0.f;

@@ -173,9 +173,11 @@ struct ConductorBase {
 // LayeredBxDF<DielectricBxDF, Base, twoSided = true>::f for reflection (wo
 // and wi in the same hemisphere; neither coated BSDF transmits). b is the
 // coat (its roughness, ior, and the layer's thickness, maxdepth, nsamples).
+// Out of line on the GPU (device.h), like layered_pdf_estimate: a long walk
+// that only coated surfaces take, once per BSDF entry point that reaches it.
 template <class Base>
-TESSERA_HOST_DEVICE inline Rgb layered_f(const BsdfParams& b, const Base& base, Vec3 wo, Vec3 wi,
-                                         layered::LayerWeights weights) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Rgb layered_f(const BsdfParams& b, const Base& base, Vec3 wo, Vec3 wi,
+                                                                 layered::LayerWeights weights) {
   if (!same_hemisphere(wo, wi)) return Rgb(0.f);
   if (wo.z < 0.f) {  // two-sided
     wo = -wo;
@@ -297,7 +299,8 @@ TESSERA_HOST_DEVICE inline Rgb layered_f(const BsdfParams& b, const Base& base, 
 // mean, reproduces them. Seeded by (wi, wo), as pbrt-v4 seeds it, so it is a
 // pure function of the two directions, independent of layered_f's numbers.
 template <class Base>
-TESSERA_HOST_DEVICE inline Float layered_pdf_estimate(const BsdfParams& b, const Base& base, Vec3 wo, Vec3 wi) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Float layered_pdf_estimate(const BsdfParams& b, const Base& base, Vec3 wo,
+                                                                            Vec3 wi) {
   constexpr Float kUniformSphere = 1.f / (4.f * kPi);
   if (!same_hemisphere(wo, wi)) return 0.1f * kUniformSphere;  // an opaque base: no TT term
   if (wo.z < 0.f) {  // two-sided

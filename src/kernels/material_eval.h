@@ -53,10 +53,12 @@ TESSERA_HOST_DEVICE inline void textured_alpha(const SceneView& s, const Materia
 }
 
 // A coated material's layer medium, clamped as pbrt-v4 clamps it (albedo
-// to [0, 1], g to [-1, 1]: here just inside).
+// to [0, 1], g to [-1, 1]: here just inside). Out of line on the GPU
+// (device.h), as hair_params: rare materials.
 template <uint32_t Spec>
-TESSERA_HOST_DEVICE inline void layer_medium(const SceneView& s, const Material& m, const SurfaceHit& h,
-                                             const Wavelengths* wl, BsdfParams* b) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline void layer_medium(const SceneView& s, const Material& m,
+                                                                     const SurfaceHit& h, const Wavelengths* wl,
+                                                                     BsdfParams* b) {
   const Rgb albedo = (Spec & kSpecTextures) ? eval_slot(s, m.layer_albedo, texture_point(h)) : m.layer_albedo.value;
   const Float g = (Spec & kSpecTextures) ? eval_slot(s, m.layer_g, texture_point(h)).x : m.layer_g.value.x;
   b->layer_albedo = glm::clamp(spectral_albedo(s.spectral, wl, albedo), Rgb(0.f), Rgb(1.f));
@@ -70,8 +72,9 @@ TESSERA_HOST_DEVICE inline void layer_medium(const SceneView& s, const Material&
 // keeps it above 0.01), absorption from sigma_a, the colour (refl) or the
 // melanins, each read per wavelength in spectral transport.
 template <uint32_t Spec>
-TESSERA_HOST_DEVICE inline void hair_params(const SceneView& s, const Material& m, const SurfaceHit& h, const Rgb& refl,
-                                            const Wavelengths* wl, BsdfParams* b) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline void hair_params(const SceneView& s, const Material& m,
+                                                                    const SurfaceHit& h, const Rgb& refl,
+                                                                    const Wavelengths* wl, BsdfParams* b) {
   auto value = [&](const TextureSlot& slot) {
     return (Spec & kSpecTextures) ? eval_slot(s, slot, texture_point(h)).x : slot.value.x;
   };

@@ -149,10 +149,8 @@ struct PixelSampler {
     switch (kind) {
       case SamplerKind::Independent:
         return rng.uniform();
-      case SamplerKind::Sobol: {
-        const uint64_t h = dimension_hash();
-        return scrambled_dim0(nested_uniform_scramble(index, static_cast<uint32_t>(h)), static_cast<uint32_t>(h >> 32));
-      }
+      case SamplerKind::Sobol:
+        return sobol_uniform();
       case SamplerKind::ZSobol: {
         // One Owen scramble per request for each aligned 8 x 8 block of
         // pixels (the bits above them): pbrt-v4 shares one over the whole
@@ -162,15 +160,10 @@ struct PixelSampler {
         const uint64_t i = zsobol_detail::permuted_index(morton, index, log2_spp, key);
         return scrambled_dim0(static_cast<uint32_t>(i), static_cast<uint32_t>(mix_bits(key ^ (i >> (log2_spp + 6)))));
       }
-      case SamplerKind::Stratified: {
-        const uint64_t key = dimension_hash();
-        const uint32_t n = strata_x * strata_y;
-        const uint32_t stratum = permutation_element(index, n, key);
-        return glm::min((static_cast<Float>(stratum) + jitter_value(key, 0)) / static_cast<Float>(n), 0x1.fffffep-1f);
-      }
+      case SamplerKind::Stratified:
+        return stratified_uniform();
       case SamplerKind::Halton:
-        if (dimension >= halton_detail::kPrimeCount) dimension = 2;
-        return halton_dimension(dimension++);
+        return halton_uniform();
     }
     return 0.f;
   }
@@ -180,29 +173,17 @@ struct PixelSampler {
     switch (kind) {
       case SamplerKind::Independent:
         return rng.uniform2();
-      case SamplerKind::Sobol: {
-        const uint64_t h = dimension_hash();
-        const uint64_t h2 = mix_bits(h);
-        return scrambled_dims01(nested_uniform_scramble(index, static_cast<uint32_t>(h)), (h >> 32) | (h2 << 32));
-      }
+      case SamplerKind::Sobol:
+        return sobol_uniform2();
       case SamplerKind::ZSobol: {
         const uint64_t key = dimension_hash();
         const uint64_t i = zsobol_detail::permuted_index(morton, index, log2_spp, key);
         return scrambled_dims01(static_cast<uint32_t>(i), mix_bits(key ^ (i >> (log2_spp + 6))));
       }
-      case SamplerKind::Stratified: {
-        const uint64_t key = dimension_hash();
-        const uint32_t stratum = permutation_element(index, strata_x * strata_y, key);
-        const Float sx = static_cast<Float>(stratum % strata_x), sy = static_cast<Float>(stratum / strata_x);
-        return Vec2(glm::min((sx + jitter_value(key, 0)) / static_cast<Float>(strata_x), 0x1.fffffep-1f),
-                    glm::min((sy + jitter_value(key, 1)) / static_cast<Float>(strata_y), 0x1.fffffep-1f));
-      }
-      case SamplerKind::Halton: {
-        if (dimension + 1 >= halton_detail::kPrimeCount) dimension = 2;
-        const uint32_t d = dimension;
-        dimension += 2;
-        return Vec2(halton_dimension(d), halton_dimension(d + 1));
-      }
+      case SamplerKind::Stratified:
+        return stratified_uniform2();
+      case SamplerKind::Halton:
+        return halton_uniform2();
     }
     return Vec2(0.f);
   }
@@ -217,6 +198,42 @@ struct PixelSampler {
   }
 
  private:
+  // The kinds other than Independent and ZSobol (pbrt-v4's default): out of
+  // line on the GPU (device.h), one copy each instead of one per request.
+  TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE Float sobol_uniform() {
+    using namespace sobol_detail;
+    const uint64_t h = dimension_hash();
+    return scrambled_dim0(nested_uniform_scramble(index, static_cast<uint32_t>(h)), static_cast<uint32_t>(h >> 32));
+  }
+  TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE Vec2 sobol_uniform2() {
+    using namespace sobol_detail;
+    const uint64_t h = dimension_hash();
+    const uint64_t h2 = mix_bits(h);
+    return scrambled_dims01(nested_uniform_scramble(index, static_cast<uint32_t>(h)), (h >> 32) | (h2 << 32));
+  }
+  TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE Float stratified_uniform() {
+    const uint64_t key = dimension_hash();
+    const uint32_t n = strata_x * strata_y;
+    const uint32_t stratum = permutation_element(index, n, key);
+    return glm::min((static_cast<Float>(stratum) + jitter_value(key, 0)) / static_cast<Float>(n), 0x1.fffffep-1f);
+  }
+  TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE Vec2 stratified_uniform2() {
+    const uint64_t key = dimension_hash();
+    const uint32_t stratum = permutation_element(index, strata_x * strata_y, key);
+    const Float sx = static_cast<Float>(stratum % strata_x), sy = static_cast<Float>(stratum / strata_x);
+    return Vec2(glm::min((sx + jitter_value(key, 0)) / static_cast<Float>(strata_x), 0x1.fffffep-1f),
+                glm::min((sy + jitter_value(key, 1)) / static_cast<Float>(strata_y), 0x1.fffffep-1f));
+  }
+  TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE Float halton_uniform() {
+    if (dimension >= halton_detail::kPrimeCount) dimension = 2;
+    return halton_dimension(dimension++);
+  }
+  TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE Vec2 halton_uniform2() {
+    if (dimension + 1 >= halton_detail::kPrimeCount) dimension = 2;
+    const uint32_t d = dimension;
+    dimension += 2;
+    return Vec2(halton_dimension(d), halton_dimension(d + 1));
+  }
   // The hash of this request's dimension (and epoch), then advances it.
   TESSERA_HOST_DEVICE uint64_t dimension_hash() {
     const uint64_t d = static_cast<uint64_t>(dimension++) | (static_cast<uint64_t>(epoch) << 32);

@@ -64,7 +64,7 @@ TESSERA_HOST_DEVICE inline Float sample_visible_wavelength(Float u) {
 }
 
 // Three wavelengths from one number: u, u + 1/3, u + 2/3 (mod 1).
-TESSERA_HOST_DEVICE inline Wavelengths sample_wavelengths(Float u) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Wavelengths sample_wavelengths(Float u) {
   Wavelengths wl;
   for (int i = 0; i < 3; ++i) {
     Float ui = u + static_cast<Float>(i) / 3.f;
@@ -126,7 +126,9 @@ TESSERA_HOST_DEVICE inline Float sigmoid(Float x) {
 // Sigmoid-polynomial coefficients (c0 lambda^2 + c1 lambda + c2) of the
 // smooth reflectance whose colour is rgb, each component in [0, 1]: trilinear
 // in the table, indexed by the largest component and the other two relative to it.
-TESSERA_HOST_DEVICE inline Vec3 rgb_sigmoid_coefficients(const SpectralView& v, Rgb rgb) {
+// Out of line on the GPU (device.h), like the other spectral-only functions
+// the path calls (sample_wavelengths, spectral_to_rgb): RGB scenes never call them.
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Vec3 rgb_sigmoid_coefficients(const SpectralView& v, Rgb rgb) {
   if (rgb.x == rgb.y && rgb.y == rgb.z) {  // a constant spectrum
     const Float c = rgb.x;
     if (!(c > 0.f)) return Vec3(0.f, 0.f, -INFINITY);
@@ -202,7 +204,7 @@ TESSERA_HOST_DEVICE inline Rgb sample_spectrum(const Float* table, const Wavelen
 
 // Linear sRGB of one sample's radiance at the path's wavelengths (pbrt-v4's
 // cie1931 sensor: the Monte Carlo estimate of XYZ, then the colour space's matrix).
-TESSERA_HOST_DEVICE inline Rgb spectral_to_rgb(const SpectralView& v, const Wavelengths& wl, Rgb L) {
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline Rgb spectral_to_rgb(const SpectralView& v, const Wavelengths& wl, Rgb L) {
   Vec3 xyz(0.f);
   for (int i = 0; i < 3; ++i) {
     if (!(wl.pdf[i] > 0.f) || L[i] == 0.f) continue;

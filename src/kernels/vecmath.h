@@ -59,8 +59,8 @@ struct Frame {
     f.t = glm::cross(n, f.s);
     return f;
   }
-  TESSERA_HOST_DEVICE Vec3 to_local(const Vec3& v) const { return Vec3(glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)); }
-  TESSERA_HOST_DEVICE Vec3 to_world(const Vec3& v) const { return s * v.x + t * v.y + n * v.z; }
+  TESSERA_HOST_DEVICE TESSERA_INLINE Vec3 to_local(const Vec3& v) const { return Vec3(glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)); }
+  TESSERA_HOST_DEVICE TESSERA_INLINE Vec3 to_world(const Vec3& v) const { return s * v.x + t * v.y + n * v.z; }
 };
 
 // Local shading-frame trigonometry (z is the normal), as in pbrt.

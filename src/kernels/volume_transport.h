@@ -6,6 +6,7 @@
 
 #include "material_eval.h"
 #include "medium.h"
+#include "ray_guard.h"
 #include "scene_view.h"
 #include "surface.h"
 
@@ -61,6 +62,12 @@ TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& t
   for (int32_t crossing = 0; crossing < 256; ++crossing) {
     TraceHit hit;
     ++c.shadow_rays;
+    // A ray the tracer refuses (ray_guard.h) is blocked, as occluded() answers
+    // for it (and counts it); intersect() would call it a miss: light through.
+    if (!ray_traceable(o, d, t_max)) {
+      (void)tracer.occluded(o, d, t_max, time);
+      return Rgb(0.f);
+    }
     if (!tracer.intersect(o, d, t_max, &hit, time)) {
       if (medium >= 0) tr *= medium_transmittance(s, medium_at(s, medium, wl), o, d, t_max, wl);
       return tr;

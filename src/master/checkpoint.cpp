@@ -6,6 +6,7 @@
 
 #include "comm/wire.h"
 #include "kernels/fnv1a.h"
+#include "render/output_file.h"
 
 namespace tessera {
 namespace {
@@ -15,7 +16,7 @@ constexpr char kMagic[] = "tessera-checkpoint";
 // vertex counter, --guide auto's trial; 5: guide cache v4; 6: light-path splats;
 // 7: splats summed per light path, lights in their own medium; 8: counter of
 // vertices the guide ratio left to the BSDF; 9: the guide's loss and learning time per pass
-constexpr uint32_t kVersion = 10;
+constexpr uint32_t kVersion = 11;
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.
 uint64_t fnv1a(const std::string& s) { return tessera::fnv1a(s.data(), s.size()); }
@@ -67,8 +68,7 @@ void write_checkpoint(const std::string& path, const RenderResult& so_far, const
   }
   const Bytes body = encode(CheckpointBody{&c});
   const std::string payload(body.begin(), body.end());
-  const std::string tmp = path + ".tmp";
-  {
+  write_output(path, [&](const std::string& tmp) {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
     if (!f) throw std::runtime_error("--checkpoint: cannot write " + tmp);
     cereal::BinaryOutputArchive ar(f);
@@ -77,8 +77,7 @@ void write_checkpoint(const std::string& path, const RenderResult& so_far, const
     f.write(payload.data(), static_cast<std::streamsize>(payload.size()));
     f.close();
     if (!f) throw std::runtime_error("--checkpoint: cannot write " + tmp);
-  }
-  std::filesystem::rename(tmp, path);
+  });
 }
 
 Checkpoint read_checkpoint(const std::string& path, uint64_t scene_fingerprint, uint64_t options_fingerprint) {

@@ -114,11 +114,11 @@ TESSERA_HOST_DEVICE inline void trace_device_sample(const DeviceLaunch& launch, 
   const int32_t w = t.job.x1 - t.job.x0, h = t.job.y1 - t.job.y0;
   if (pixel >= static_cast<uint32_t>(w * h) || sample >= tile_samples(t)) return;
   const SceneView& s = *launch.scene;
-  const BvhTracer tracer{launch.bvh, launch.scene};
   const int32_t x = t.job.x0 + static_cast<int32_t>(pixel % static_cast<uint32_t>(w));
   const int32_t y = t.job.y0 + static_cast<int32_t>(pixel / static_cast<uint32_t>(w));
   PathSettings path = launch.settings.path;
   TileCounters tc;
+  const BvhTracer tracer{launch.bvh, launch.scene, &tc.path.untraceable_rays};
   const uint32_t si = t.job.sample_begin + sample;
   // The neural guide's learning targets: a sink of the path's own.
   NeuralSampleSink sink;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "integrator/integrator.h"
+#include "kernels/ray_guard.h"
 #include "render/cpu_tile_backend.h"
 #include "render/scene_data.h"
 
@@ -16,9 +17,12 @@ namespace tessera {
 
 struct EmbreeTracer {
   RTCScene scene = nullptr;
+  // Where rays this tracer refuses are counted (kernels/ray_guard.h); null: not counted.
+  uint64_t* untraceable = nullptr;
 
   // time: where in the transform interval, for moving shapes (0..1).
   bool intersect(const Vec3& o, const Vec3& d, Float tmax, TraceHit* hit, Float time = 0.f) const {
+    if (!ray_traceable(o, d, tmax)) return refuse_ray(untraceable, false);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
@@ -43,6 +47,7 @@ struct EmbreeTracer {
   }
 
   bool occluded(const Vec3& o, const Vec3& d, Float tmax, Float time = 0.f) const {
+    if (!ray_traceable(o, d, tmax)) return refuse_ray(untraceable, true);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;

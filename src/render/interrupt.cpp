@@ -16,8 +16,10 @@ std::atomic<int> g_signals{0};
 // worker's report. It never makes a later signal the second one.
 std::atomic<bool> g_stop_asked{false};
 static_assert(std::atomic<int>::is_always_lock_free);
+std::atomic<bool> g_announce{true};
 
 void say_interrupted() {
+  if (!g_announce.load()) return;
   static const char msg[] =
       "\ntessera: interrupted: finishing this pass and writing the image so far (again to quit at once)\n";
   const int saved = errno;  // the interrupted code may be reading errno
@@ -41,7 +43,8 @@ extern "C" void on_mpirun_continue(int, siginfo_t* info, void*) {
 
 }  // namespace
 
-void install_interrupt_handlers(bool open_mpi) {
+void install_interrupt_handlers(bool open_mpi, bool announce) {
+  g_announce.store(announce);
   struct sigaction sa {};
   sa.sa_handler = on_interrupt;
   sigemptyset(&sa.sa_mask);

@@ -18,8 +18,10 @@
 
 namespace tessera {
 
-// open_mpi: started by Open MPI's mpirun, whose SIGCONT asks for the stop (see above).
-void install_interrupt_handlers(bool open_mpi);
+// open_mpi: started by Open MPI's mpirun, whose SIGCONT asks for the stop
+// (see above). announce: this process says on stderr that it is stopping
+// (rank 0 only: every rank of a farm gets the signal).
+void install_interrupt_handlers(bool open_mpi, bool announce = true);
 // A first signal here, or a worker's (note_worker_interrupt).
 bool interrupt_requested();
 // A farm worker was signalled: stop after the pass, without counting as a

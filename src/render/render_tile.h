@@ -84,6 +84,7 @@ struct TileCounters {
     path.light_splats += o.path.light_splats;
     path.caustic_emission_skipped += o.path.caustic_emission_skipped;
     path.neural_sites_reused += o.path.neural_sites_reused;
+    path.untraceable_rays += o.path.untraceable_rays;
     samples += o.samples;
     zero_radiance += o.zero_radiance;
     rejected_nonfinite += o.rejected_nonfinite;

@@ -42,9 +42,11 @@ constexpr uint32_t instantiated_spec(uint32_t s) {
 // the same on any thread and rank: a pixel's samples of a job are traced
 // in order by one thread).
 template <uint32_t Spec, class Tracer, bool ReuseFirstSite = false>
-TileCounters render_tile_spec(const SceneView& s, const Tracer& tracer, const TileSettings& settings,
+TileCounters render_tile_spec(const SceneView& s, const Tracer& scene_tracer, const TileSettings& settings,
                               const TileJob& job, TilePixels pixels, std::vector<Splat>* splats) {
   TileCounters tc;
+  Tracer tracer = scene_tracer;  // counting the rays it refuses in the tile's counters
+  tracer.untraceable = &tc.path.untraceable_rays;
   PathSettings path = settings.path;
   NeuralFirstSite first_site;
   constexpr bool kReuse = ReuseFirstSite && (Spec & kSpecNeural) != 0;

@@ -10,6 +10,7 @@
 #include "kernels/equal_area.h"
 #include "kernels/fnv1a.h"
 #include "kernels/vecmath.h"
+#include "render/camera_limits.h"
 #include "scene/scene_effects.h"
 #include "scene/named_spectra.h"
 #include "scene/rgb_spectrum_fit.h"
@@ -314,6 +315,7 @@ void SceneData::build_camera() {
   camera_.shutter_close = desc_.camera.shutter_close;
   camera_.transform_start_time = desc_.camera.transform_start_time;
   camera_.transform_end_time = desc_.camera.transform_end_time;
+  check_camera_limits(camera_, desc_.camera.where.empty() ? desc_.source : desc_.camera.where, desc_.render_origin);
 }
 
 void SceneData::build_filter() {

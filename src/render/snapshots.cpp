@@ -6,6 +6,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "render/output_file.h"
 #include "render/renderer.h"
 
 namespace tessera {
@@ -71,7 +72,7 @@ void SnapshotWriter::on_pass_end(const RenderResult& so_far) {
   meta.numbers["render_seconds"] = r.render_seconds;
   const ImageRgb mean = film_mean(so_far.film), var = film_variance_of_mean(so_far.film);
   add_variance_metadata(&meta, var);
-  write_exr(r.file, mean, &var, meta);
+  write_output(r.file, [&](const std::string& p) { write_exr(p, mean, &var, meta); });
 
   const std::string csv = (std::filesystem::path(dir_) / "snapshots.csv").string();
   const bool fresh = !std::filesystem::exists(csv);

@@ -54,6 +54,9 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
   j["nonfinite_samples_rejected"] = (c.rejected_nonfinite);
   j["negative_samples_clamped"] = (c.rejected_negative);
   j["interface_crossings"] = (c.path.interface_skips);
+  // Rays the tracer refused (kernels/ray_guard.h: beyond +-1.844e18 or not
+  // finite), answered as misses or as occluded.
+  j["untraceable_rays"] = (c.path.untraceable_rays);
   j["effects"] = (describe_effects(s.effects));
   j["specialisation"] = (describe_specialisation(s.specialisation));
   j["transport"] = (s.spectral ? "spectral" : "rgb");

@@ -4,6 +4,7 @@
 
 #include "kernels/equal_area.h"
 #include "scene/pbrt_textures.h"
+#include "scene/scene_limits.h"
 
 namespace tessera {
 namespace {
@@ -72,6 +73,19 @@ void read_portal(Light& l, const std::vector<Vec3>& p, const Mat4& render_from_w
   l.portal_t = e03;
   l.portal_n = glm::normalize(glm::cross(p03, p01));
   l.portal_area = glm::length(glm::cross(e01, e03));
+}
+
+// Light paths start at a light's position (Embree takes no ray from beyond
+// 1.8e18), and pbrt-v4's I / d^2 overflows to black past 1.8e19: a light
+// is placed as a vertex is (scene_limits.h). A direction from "from" to "to"
+// that overflows single precision, or an emission that does, gives nothing
+// meaningful in pbrt-v4 either.
+void check_light_limits(const Light& l, const DirectiveContext& ctx) {
+  if (l.type != LightType::Distant && l.type != LightType::Infinite && !representable(l.position))
+    ctx.fail("the light is " + describe_far(l.position, ctx.scene.render_origin));
+  if (!(glm::length(l.direction) > 0.5f))
+    ctx.fail("the light's direction from \"from\" to \"to\" overflows single precision");
+  if (!is_finite(l.L)) ctx.fail("the light's emission (times \"scale\" and \"power\") is not finite");
 }
 
 }  // namespace
@@ -200,6 +214,7 @@ std::optional<Light> make_light(const std::string& type, const ParamSet& params,
     params.mark_all_used();
     return std::nullopt;
   }
+  check_light_limits(l, ctx);
   return l;
 }
 
@@ -218,6 +233,7 @@ AreaLightDesc make_area_light(const std::string& type, const ParamSet& params, c
     require_finite_texels(ctx.scene.images[a.image], ctx);
     a.L = Rgb(scale);
   }
+  if (!is_finite(a.L)) ctx.fail("area light \"L\" times \"scale\" is not finite");
   const Float power = params.get_float("power", -1.f);
   if (!std::isfinite(power)) ctx.fail("area light \"power\" must be finite");
   a.power = power > 0.f ? power : 0.f;  // pbrt-v4: only a positive power rescales

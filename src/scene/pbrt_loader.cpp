@@ -1,10 +1,10 @@
 #include "scene/pbrt_loader.h"
 
-#include <fstream>
 #include <sstream>
 
 #include "scene/pbrt_parser.h"
 #include "scene/pbrt_paths.h"
+#include "scene/scene_file.h"
 
 namespace tessera {
 namespace {
@@ -25,9 +25,11 @@ SceneDesc load_pbrt_string(const std::string& text, const std::string& name_for_
 }
 
 SceneDesc load_pbrt_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path + ":1: cannot open scene file");
-  return load_pbrt_stream(in, path, directory_of(path));
+  std::unique_ptr<std::istream> in = open_scene_file(path);
+  if (!in || !*in) throw SceneError(path + ":1: cannot open scene file");
+  SceneDesc desc = load_pbrt_stream(*in, path, directory_of(path));
+  desc.files_read.insert(desc.files_read.begin(), path);
+  return desc;
 }
 
 }  // namespace tessera

@@ -262,6 +262,7 @@ int32_t read_nanovdb(const ParamSet& params, const Mat4& world_from_medium, Medi
   const std::string filename = params.get_string("filename", "");
   if (filename.empty()) ctx.fail("nanovdb medium needs \"string filename\"");
   const std::string path = resolve_scene_path(filename, ctx.including_dir, ctx.search_dir);
+  ctx.scene.files_read.push_back(path);
   const std::string density_name = params.get_string("gridname", "density");
   const std::string temperature_name = params.get_string("temperaturename", "temperature");
   const Mat4 medium_from_world = medium_from_world_of(world_from_medium, ctx);
@@ -273,6 +274,8 @@ int32_t read_nanovdb(const ParamSet& params, const Mat4& world_from_medium, Medi
     if (!density.found) ctx.fail(path + ": no grid named \"" + density_name + "\"");
     // (As in pbrt-v4, a medium whose Lescale is 0 does not glow; its temperatures are not read.)
     if (le_scale > 0.f) temperature = read_nanovdb_grid(path, temperature_name, false);
+  } catch (const SceneError&) {
+    throw;  // located already (ctx.fail above): not a second "file:line: " prefix
   } catch (const std::runtime_error& e) {
     ctx.fail(e.what());
   } catch (const std::bad_alloc&) {

@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -14,32 +13,16 @@
 #include "scene/pbrt_materials.h"
 #include "scene/pbrt_media.h"
 #include "scene/pbrt_paths.h"
+#include "scene/scene_file.h"
 #include "scene/pbrt_shapes.h"
 #include "scene/pbrt_textures.h"
 #include "scene/sampler_setup.h"
+#include "scene/scene_limits.h"
 #include "scene/named_spectra.h"
 #include "scene/spectrum_file.h"
 
 namespace tessera {
 namespace {
-
-// Embree traces rays whose origins lie within +-1.844e18 (FLT_LARGE) and
-// asserts beyond; past about 1e18 single-precision hit points are off by
-// more than 1e11 anyway. Coordinates beyond this are an error at load.
-constexpr Float kMaxCoordinate = 1e18f;
-
-bool representable(const Vec3& p) {
-  return std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate && std::abs(p.z) <= kMaxCoordinate;
-}
-
-// `p` in render space, reported in the scene file's world (render space's origin added).
-std::string describe_far(const Vec3& p, const glm::dvec3& origin = glm::dvec3(0.0)) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "at (%g, %g, %g): beyond +-%g (or not finite), where single-precision ray tracing cannot go",
-                double(p.x) + origin.x + 0.0, double(p.y) + origin.y + 0.0, double(p.z) + origin.z + 0.0,
-                kMaxCoordinate);  // + 0: no "-0"
-  return buf;
-}
 
 constexpr int kMaxIncludeDepth = 32;
 
@@ -94,10 +77,12 @@ void skip_arguments(TokenStream& tokens, size_t& pos) {
 // A spectrum named by a string that is not one of pbrt's named spectra is a
 // file of wavelength/value pairs (pbrt-v4: relative to the scene's
 // directory); it is read here, so the parameter holds its pairs from now on.
-void read_spectrum_files(std::vector<Param>& params, const std::string& including_dir, const std::string& search_dir) {
+void read_spectrum_files(std::vector<Param>& params, const std::string& including_dir, const std::string& search_dir,
+                         std::vector<std::string>* files_read) {
   for (Param& p : params) {
     if (p.type != "spectrum" || p.strings.size() != 1 || named_spectrum_rgb(p.strings[0])) continue;
     const std::string path = resolve_scene_path(p.strings[0], including_dir, search_dir);
+    files_read->push_back(path);
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec))
       throw SceneError(p.where + ": unknown named spectrum \"" + p.strings[0] + "\" (and no spectrum file '" + path +
@@ -114,9 +99,10 @@ void read_spectrum_files(std::vector<Param>& params, const std::string& includin
 }
 
 ParamSet read_params(TokenStream& tokens, size_t& pos, std::string owner, std::vector<std::string>& warnings,
-                     const std::string& including_dir, const std::string& search_dir) {
+                     const std::string& including_dir, const std::string& search_dir,
+                     std::vector<std::string>* files_read) {
   std::vector<Param> params = parse_param_list(tokens, pos);
-  read_spectrum_files(params, including_dir, search_dir);
+  read_spectrum_files(params, including_dir, search_dir, files_read);
   ParamSet ps(std::move(params), std::move(owner));
   ps.warnings = &warnings;
   return ps;
@@ -236,6 +222,10 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     // pbrt-v4 reads the 16 numbers row-major and transposes: they are the
     // matrix's columns, exactly glm's storage order.
     std::vector<double> v = read_numbers(tokens, pos, 16, at);
+    // The last row makes w: all zero, every point maps to infinity (pbrt-v4
+    // divides by w), which would put the shapes anywhere, the camera too.
+    if (v[3] == 0.0 && v[7] == 0.0 && v[11] == 0.0 && v[15] == 0.0)
+      fail(at, d + ": the matrix's last row (its 4th, 8th, 12th and 16th numbers) is zero: every point would map to infinity");
     const DMat4 m = glm::make_mat4(v.data());
     if (d == "ConcatTransform") post_multiply(m);
     else if (world_begun_) set_active(render_from_world_ * m, render_from_world_ * m);  // m is world-space
@@ -276,11 +266,12 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
   } else if (d == "Include" || d == "Import") {
     std::string name = read_string(tokens, pos, at);
     std::string path = resolve_scene_path(name, including_dir, search_dir_);
-    std::ifstream in(path, std::ios::binary);
-    if (!in) fail(at, d + " file '" + path + "' not found or unreadable");
+    scene_.files_read.push_back(path);
+    std::unique_ptr<std::istream> in = open_scene_file(path);
+    if (!in || !*in) fail(at, d + " file '" + path + "' not found or unreadable");
     if (include_depth_ >= kMaxIncludeDepth) fail(at, d + " nested too deeply (recursive include?)");
     ++include_depth_;
-    parse_stream(in, path, directory_of(path));
+    parse_stream(*in, path, directory_of(path));
     --include_depth_;
   } else if (d == "WorldBegin") {
     if (world_begun_) fail(at, "WorldBegin appears twice");
@@ -292,15 +283,15 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     warn("WorldEnd is pbrt-v3 syntax; ignored");
   } else if (d == "Camera") {
     std::string type = read_string(tokens, pos, at);
-    camera(at, type, read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_));
+    camera(at, type, read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_, &scene_.files_read));
   } else if (d == "Film") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_, &scene_.files_read);
     read_film(type, ps, at.where(), scene_.film, warnings);
     ps.report_unused(warnings);
   } else if (d == "Sampler") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_, &scene_.files_read);
     scene_.spp = ps.get_int("pixelsamples", 16);
     if (scene_.spp <= 0) fail(at, "pixelsamples must be positive");
     scene_.seed = static_cast<uint64_t>(ps.get_int("seed", static_cast<int>(scene_.seed)));
@@ -340,7 +331,7 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     ps.report_unused(warnings);
   } else if (d == "Integrator") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_, &scene_.files_read);
     scene_.integrator = type;
     if (bidirectional_integrator(type))
       warn("integrator \"" + type + "\" is rendered as \"volpath\" plus caustics traced from the lights (--light-paths)");
@@ -352,18 +343,18 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     ps.report_unused(warnings);
   } else if (d == "PixelFilter") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_, &scene_.files_read);
     scene_.filter = read_filter(type, ps, at.where(), warnings);
     ps.report_unused(warnings);
   } else if (d == "Material") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_, &scene_.files_read);
     scene_.materials.push_back(make_material(type, ps, context(at, including_dir)));
     state_.material = static_cast<int32_t>(scene_.materials.size() - 1);
     ps.report_unused(warnings);
   } else if (d == "MakeNamedMaterial") {
     std::string name = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_);
+    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_, &scene_.files_read);
     std::string type = ps.get_string("type", "");
     if (type.empty()) fail(at, "MakeNamedMaterial \"" + name + "\" needs \"string type\"");
     if (names_.materials.count(name)) warn("named material \"" + name + "\" redefined");
@@ -379,14 +370,14 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     std::string name = read_string(tokens, pos, at);
     std::string kind = read_string(tokens, pos, at);
     std::string cls = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_);
+    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_, &scene_.files_read);
     // Before WorldBegin the CTM is world-space: the texture's space goes to render space too.
     const DMat4 render_from_texture = world_begun_ ? state_.ctm : render_from_world_ * state_.ctm;
     make_named_texture(name, kind, cls, ps, render_from_texture, context(at, including_dir));
     ps.report_unused(warnings);
   } else if (d == "LightSource") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_, &scene_.files_read);
     if (state_.ctm_end != state_.ctm) warn("a moving light stays where it starts (pbrt-v4 uses its start transform too)");
     if (auto light = make_light(type, ps, ctm, Mat4(render_from_world_), context(at, including_dir))) {
       if (!open_instance_.empty()) warn("lights inside ObjectBegin are not instanced; added once");
@@ -396,13 +387,13 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     ps.report_unused(warnings);
   } else if (d == "AreaLightSource") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_, &scene_.files_read);
     scene_.area_lights.push_back(make_area_light(type, ps, context(at, including_dir)));
     state_.area_light = static_cast<int32_t>(scene_.area_lights.size() - 1);
     ps.report_unused(warnings);
   } else if (d == "Shape") {
     std::string type = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_);
+    ParamSet ps = read_params(tokens, pos, quoted(d, type), warnings, including_dir, search_dir_, &scene_.files_read);
     shape(at, type, ps, including_dir);
     ps.report_unused(warnings);
   } else if (d == "ObjectBegin") {
@@ -454,7 +445,7 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
     scene_.camera.transform_end_time = static_cast<Float>(v[1]);
   } else if (d == "MakeNamedMedium") {
     std::string name = read_string(tokens, pos, at);
-    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_);
+    ParamSet ps = read_params(tokens, pos, quoted(d, name), warnings, including_dir, search_dir_, &scene_.files_read);
     std::string type = ps.get_string("type", "");
     if (type.empty()) fail(at, "MakeNamedMedium \"" + name + "\" needs \"string type\"");
     if (names_.media.count(name)) warn("named medium \"" + name + "\" redefined");
@@ -577,7 +568,8 @@ void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet
 
 void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet& params,
                        const std::string& including_dir) {
-  ShapeContext ctx{at.where(), including_dir, search_dir_, Mat4(state_.ctm), state_.reverse_orientation, &scene_.warnings, {}};
+  ShapeContext ctx{at.where(), including_dir,     search_dir_,         Mat4(state_.ctm),
+                   state_.reverse_orientation, &scene_.warnings, &scene_.files_read, {}};
   ctx.float_texture = [this, &at](const std::string& name) -> DisplacementFn {
     auto it = names_.float_textures.find(name);
     if (it == names_.float_textures.end()) fail(at, "unknown float texture \"" + name + "\" for \"displacement\"");

@@ -92,6 +92,7 @@ MeshDesc ply_mesh(const ParamSet& params, const ShapeContext& ctx) {
   std::string name = params.get_string("filename", "");
   if (name.empty()) fail(ctx, "plymesh needs \"string filename\"");
   std::string path = resolve_scene_path(name, ctx.including_dir, ctx.search_dir);
+  if (ctx.files_read) ctx.files_read->push_back(path);
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail(ctx, "plymesh file '" + path + "' not found");
   PlyMesh ply;

@@ -19,6 +19,7 @@ struct ShapeContext {
   Mat4 world_from_object{1.f};
   bool reverse_orientation = false;
   std::vector<std::string>* warnings = nullptr;
+  std::vector<std::string>* files_read = nullptr;  // the mesh files it reads are added here
   // A named float texture as a function of uv (plymesh displacement);
   // throws SceneError for an unknown name. Unset: displacement is an error.
   std::function<DisplacementFn(const std::string& name)> float_texture;

@@ -110,6 +110,7 @@ void read_image_lookup(Texture& t, const ParamSet& params, const DirectiveContex
 int32_t image_index(const std::string& filename, const std::string& encoding_name, bool grey,
                     const DirectiveContext& ctx) {
   std::string path = resolve_scene_path(filename, ctx.including_dir, ctx.search_dir);
+  ctx.scene.files_read.push_back(path);
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) ctx.fail("image file '" + path + "' not found");
   std::optional<ColorEncoding> encoding = parse_color_encoding(encoding_name);

@@ -192,6 +192,9 @@ struct SceneDesc {
   std::vector<GridDesc> grids;      // of the grid media (uniformgrid, rgbgrid, nanovdb, cloud)
   int32_t camera_medium = -1;       // the medium the camera sits in (pbrt-v4: the outside medium at Camera)
   std::vector<std::string> warnings;  // "file:line: message", in order of appearance
+  // Every file the scene was read from (the scene file, Includes, meshes,
+  // images, volumes, spectra): a render's outputs must not overwrite them.
+  std::vector<std::string> files_read;
   std::string source;               // file name, or "<builtin:cornell-box>"
 };
 

@@ -142,9 +142,14 @@ TEST_F(FarmCliTest, InterruptedFarmWritesTheImageSoFarAndResumes) {
   RunResult interrupted = run_shell(
       "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe --mca odls_base_sigkill_timeout 5 -np 2 " +
       std::string(TESSERA_BINARY) + " render " + args + " --time 120 -o " + path("interrupted.exr") + " --stats " +
-      path("interrupted.json") + " --checkpoint " + ck + " --sampler zsobol --threads 1 & P=$!; sleep 3; kill -INT $P; " +
+      path("interrupted.json") + " --checkpoint " + ck + " --sampler zsobol --threads 1 2>&1 & P=$!; sleep 3; kill -INT $P; " +
       "sleep 2; test -f " + path("interrupted.json") + " && echo written-early; wait $P; echo done=$?");
   ASSERT_NE(interrupted.output.find("done="), std::string::npos) << interrupted.output;
+  // Every rank gets the signal; the farm says once that it is stopping.
+  const std::string say = "writing the image so far";
+  const size_t first = interrupted.output.find(say);
+  EXPECT_NE(first, std::string::npos) << interrupted.output;
+  EXPECT_EQ(interrupted.output.find(say, first + 1), std::string::npos) << interrupted.output;
   // Open MPI sends the ranks SIGCONT at once and SIGTERM only after the kill
   // timeout (5 s here): the ranks stop on the SIGCONT, so the image is
   // written well before the SIGTERM.
@@ -227,6 +232,39 @@ TEST_F(FarmCliTest, BadCheckpointsAreRefusedAndLeaveOutputsAlone) {
     EXPECT_NE(r.output.find(c.expect), std::string::npos) << r.output;
     EXPECT_EQ(read_text(path("out.exr")), "a good image");
   }
+}
+
+// Scenes that made Embree abort every rank (issue 48): a camera whose rays
+// start beyond the tracer's reach is refused on the master in one line and
+// the farm ends cleanly; a scene in a medium thin enough to scatter rays
+// beyond it renders the local image, the refused rays counted alike.
+TEST_F(FarmCliTest, RaysBeyondTheTracersReachNeitherAbortNorDiffer) {
+  const std::string head = "LookAt 0 0 -5  0 0 0  0 1 0\n";
+  const std::string world =
+      "Film \"rgb\" \"integer xresolution\" [ 16 ] \"integer yresolution\" [ 12 ]\nWorldBegin\n"
+      "LightSource \"point\" \"rgb I\" [ 10 10 10 ] \"point3 from\" [ 0 0 -2 ]\n"
+      "Shape \"trianglemesh\" \"point3 P\" [ -10 -10 0  10 -10 0  10 10 0  -10 10 0 ] \"integer indices\" [ 0 1 2 0 2 3 ]\n";
+  std::ofstream(path("lens.pbrt")) << head << "Camera \"perspective\" \"float lensradius\" [ 2e18 ]\n" << world;
+  RunResult r = run_mpi(3, "render " + path("lens.pbrt") + " -q -o " + path("lens.exr"));
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("lens.pbrt:2: the camera's rays start at ("), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("ray.valid"), std::string::npos) << r.output;  // Embree's assertion
+  EXPECT_EQ(r.output.find("signal"), std::string::npos) << r.output;     // mpirun on a rank that aborted
+  EXPECT_FALSE(fs::exists(path("lens.exr")));
+
+  std::ofstream(path("thin.pbrt")) << "MakeNamedMedium \"thin\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ 0 0 0 ] "
+                                      "\"rgb sigma_s\" [ 1e-18 1e-18 1e-18 ]\nMediumInterface \"\" \"thin\"\n"
+                                   << head << "Camera \"perspective\" \"float fov\" [ 90 ]\n"
+                                   << std::regex_replace(world, std::regex("WorldBegin\n"), "WorldBegin\nMediumInterface \"thin\"\n");
+  const std::string args = path("thin.pbrt") + " -q --no-preview --spp 4 --seed 2";
+  RunResult local = run("render " + args + " -o " + path("local.exr") + " --stats " + path("local.json"));
+  ASSERT_EQ(local.exit_code, 0) << local.output;
+  RunResult farm = run_mpi(3, "render " + args + " -o " + path("farm.exr") + " --stats " + path("farm.json"));
+  ASSERT_EQ(farm.exit_code, 0) << farm.output;
+  EXPECT_TRUE(exr_channels(path("farm.exr")) == exr_channels(path("local.exr")));
+  const double refused = json_number(read_text(path("local.json")), "untraceable_rays");
+  EXPECT_GT(refused, 0.0);
+  EXPECT_EQ(json_number(read_text(path("farm.json")), "untraceable_rays"), refused);
 }
 
 TEST_F(FarmCliTest, MissingSceneStopsEveryRank) {

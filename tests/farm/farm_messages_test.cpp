@@ -1,7 +1,8 @@
-// The farm's messages byte for byte: a tile request and a batch of jobs
-// encode to the bytes that commit 4b06cf9 (before the schema stopped
-// including the integrator) recorded, so ranks of either build and the
-// counters inside a request agree.
+// The farm's messages byte for byte: a batch of jobs encodes to the bytes
+// that commit 4b06cf9 (before the schema stopped including the integrator)
+// recorded, a tile request to those recorded when its counters last grew
+// (PathCounters::untraceable_rays: 20 words), so ranks of one build agree
+// on them and on the counters inside a request.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -52,8 +53,8 @@ TEST(FarmMessages, TileRequestBytesAreUnchanged) {
   req.counters = WireCounters::to_wire(numbered_counters());
   req.interrupted = true;
   const Bytes b = encode(req);
-  EXPECT_EQ(b.size(), 481u);
-  EXPECT_EQ(fnv1a(b), 0xec43037f2ca593d5ull);
+  EXPECT_EQ(b.size(), 489u);
+  EXPECT_EQ(fnv1a(b), 0xd3a67b79bf2f6e27ull);
 }
 
 TEST(FarmMessages, TileJobsBytesAreUnchanged) {
@@ -68,8 +69,9 @@ TEST(FarmMessages, CountersComeBackFieldByField) {
   const TileCounters c = decode<TileRequest>(encode(req)).counters.from_wire<TileCounters>();
   EXPECT_EQ(c.path.rays, 1000u);
   EXPECT_EQ(c.path.neural_sites_reused, 1014u);
-  EXPECT_EQ(c.samples, 1015u);
-  EXPECT_EQ(c.rejected_negative, 1018u);
+  EXPECT_EQ(c.path.untraceable_rays, 1015u);
+  EXPECT_EQ(c.samples, 1016u);
+  EXPECT_EQ(c.rejected_negative, 1019u);
 }
 
 }  // namespace

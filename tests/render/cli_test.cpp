@@ -16,6 +16,7 @@
 
 #include "../test_dir.h"
 #include "../cli_run.h"
+#include "../exr_read.h"
 #include "../json_read.h"
 #include "render_helpers.h"
 #include "render/device_api.h"
@@ -485,6 +486,56 @@ TEST_F(CliTest, SceneTooLargeForMemoryFailsBeforeBuilding) {
   expect_one_line_error(r, "the scene's 7992002 triangles need about");
   EXPECT_NE(r.output.find("of memory this process may use"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// Every 64-bit seed is its own (CLI11's int64 clamped seeds from 2^63 up,
+// so those all gave one image); a seed or a size out of range is named as such.
+TEST_F(CliTest, SeedsAndSizesOutOfRangeAreNamed) {
+  auto image = [&](const std::string& seed) {
+    const std::string out = (dir_ / ("s" + seed + ".exr")).string();
+    const RunResult r = run("render -q --spp 2 --res 8x8 --no-preview --seed " + seed + " -o " + out);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return testing::exr_channels(out);
+  };
+  const std::vector<float> a = image("9223372036854775808"), b = image("18446744073709551615");
+  EXPECT_NE(a, b);
+  expect_one_line_error(run("render -q --spp 1 --res 8x8 --seed 18446744073709551616"), "--seed: expected an integer");
+  expect_one_line_error(run("render -q --spp 1 --seed -3"), "--seed");
+  expect_one_line_error(run("render -q --spp 1 --res 100000x1"), "--res: 100000x1 is larger than supported");
+}
+
+// A scene that warns thousands of times (a curve per hair, say) prints each
+// distinct warning a few times and then counts it: not megabytes of log.
+TEST_F(CliTest, RepeatedWarningsAreCountedNotPrintedEachTime) {
+  std::string text = kHeader;
+  for (int i = 0; i < 2000; ++i) text += "TransformBegin\nTransformEnd\n";
+  text += "Shape \"sphere\"\n";
+  const std::string scene = write("many-warnings.pbrt", text);
+  const RunResult r = run("render -q --spp 1 --no-preview -o " + (dir_ / "m.exr").string() + " " + scene);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("2000 times in all: TransformBegin is deprecated"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("4000 warnings in all, 6 of them shown"), std::string::npos) << r.output;
+  size_t warning_lines = 0;
+  for (size_t at = r.output.find("warning:"); at != std::string::npos; at = r.output.find("warning:", at + 1)) ++warning_lines;
+  EXPECT_EQ(warning_lines, 9u) << r.output;  // 3 of each, a count of each, the total
+}
+
+// pbrt-v4 reads gzip-compressed scene files and Includes (scene.pbrt.gz):
+// the same picture as from the plain files.
+TEST_F(CliTest, GzippedScenesAndIncludesRenderAsPlainOnes) {
+  write("geometry.pbrt", "Material \"diffuse\"\nShape \"sphere\" \"float radius\" [ 0.8 ]\n");
+  write("plain.pbrt", std::string(kHeader) + "Include \"geometry.pbrt\"\n");
+  write("packed.pbrt", std::string(kHeader) + "Include \"geometry.pbrt.gz\"\n");
+  ASSERT_EQ(testing::run_shell("cd " + dir_.string() + " && gzip -k geometry.pbrt && gzip packed.pbrt").exit_code, 0);
+  auto render = [&](const std::string& scene) {
+    const std::string out = (dir_ / (scene + ".exr")).string();
+    const RunResult r = run("render -q --spp 4 --no-preview --seed 2 -o " + out + " " + (dir_ / scene).string());
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return testing::exr_channels(out);
+  };
+  const std::vector<float> plain = render("plain.pbrt"), packed = render("packed.pbrt.gz");
+  ASSERT_FALSE(plain.empty());
+  EXPECT_TRUE(plain == packed);
 }
 
 }  // namespace

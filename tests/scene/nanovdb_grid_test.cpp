@@ -15,6 +15,7 @@ using nanovdb::is_floating_point;
 #include "kernels/sparse_grid.h"
 #include "nanovdb_test_writer.h"
 #include "scene/nanovdb_grid.h"
+#include "scene/pbrt_loader.h"
 #include "scene_test_helpers.h"
 
 namespace tessera {
@@ -187,6 +188,29 @@ TEST(NanoVdb, MediumReadsDensityTemperatureAndParameters) {
       "\"string gridname\" \"smoke\"\n", dir.path());
   EXPECT_NE(e2.find("bad.pbrt:2"), std::string::npos) << e2;
   EXPECT_NE(e2.find("smoke"), std::string::npos) << e2;
+}
+
+}  // namespace
+}  // namespace tessera
+
+namespace tessera {
+namespace {
+
+// A grid the file does not hold is named once with the directive's file:line
+// (not "scene.pbrt:2: scene.pbrt:2: ...").
+TEST(NanoVdb, AMissingGridIsOneLocatedError) {
+  const std::string nvdb = std::string(TESSERA_SOURCE_DIR) + "/tests/fuzz/nvdb_corpus/fire-zip.nvdb";
+  const std::string text = "WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"" + nvdb +
+                           "\" \"string gridname\" \"nosuch\"\n";
+  try {
+    load_pbrt_string(text, "scene.pbrt", ".");
+    ADD_FAILURE() << "a missing grid was accepted";
+  } catch (const SceneError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("scene.pbrt:2: ", 0), 0u) << what;
+    EXPECT_EQ(what.find("scene.pbrt", 1), std::string::npos) << what;
+    EXPECT_NE(what.find("no grid named \"nosuch\""), std::string::npos) << what;
+  }
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // Hostile but well-formed input that the kernels cannot render as written:
-// coordinates beyond single-precision ray tracing, textures nested deeper
+// coordinates beyond single-precision ray tracing (vertices, the camera,
+// lights), textures nested deeper
 // than the kernels' recursion, mixes of mixes deeper than their loop. Each is
 // a one-line "file:line: problem" at load, never a crash or a silent default.
 #include <string>
@@ -50,6 +51,27 @@ TEST(PbrtExtremes, FarVerticesAreAnError) {
                                "WorldBegin\nObjectBegin \"o\"\n" + test::kTriangle + "ObjectEnd\nTranslate 5e18 0 0\n"
                                "ObjectInstance \"o\"\n";
   EXPECT_ERROR_CONTAINS(load_error(instance), "a vertex of the shape is at (5e+18");
+}
+
+// Light paths start at a light's position, where Embree refuses rays past
+// 1.8e18; pbrt-v4's falloff overflows to black past 1.8e19.
+TEST(PbrtExtremes, FarLightsAreAnError) {
+  const std::string world = std::string(kCamera) + "WorldBegin\n";
+  EXPECT_ERROR_CONTAINS(load_error(world + "LightSource \"point\" \"rgb I\" [ 1e38 1e38 1e38 ] \"point3 from\" [ 2e19 0 0 ]\n"),
+                        "bad.pbrt:4: the light is at (2e+19, 0, 0): beyond +-1e+18");
+  EXPECT_ERROR_CONTAINS(load_error(world + "Translate 0 -3e18 0\nLightSource \"spot\"\n"),
+                        "bad.pbrt:5: the light is at (0, -3e+18, 0)");
+  EXPECT_ERROR_CONTAINS(load_error(world + "Translate 0 0 1.5e18\nLightSource \"goniometric\"\n"),
+                        "bad.pbrt:5: the light is at (0, 0, 1.5e+18)");
+  EXPECT_ERROR_CONTAINS(load_error(world + "LightSource \"spot\" \"point3 to\" [ 3e38 3e38 3e38 ]\n"),
+                        "bad.pbrt:4: the light's direction from \"from\" to \"to\" overflows single precision");
+  EXPECT_ERROR_CONTAINS(load_error(world + "LightSource \"point\" \"rgb I\" [ 3e38 1 1 ] \"float power\" [ 1e10 ]\n"),
+                        "bad.pbrt:4: the light's emission");
+  EXPECT_ERROR_CONTAINS(load_error(world + "AreaLightSource \"diffuse\" \"rgb L\" [ 1e30 1 1 ] \"float scale\" [ 1e30 ]\n"),
+                        "bad.pbrt:4: area light \"L\" times \"scale\" is not finite");
+  // Distant and infinite lights have no position; lights within the limits load.
+  EXPECT_NO_THROW(load_ok(world + "LightSource \"distant\" \"point3 from\" [ 0 0 -1e19 ]\n" + test::kTriangle));
+  EXPECT_NO_THROW(load_ok(world + "LightSource \"point\" \"point3 from\" [ 0 0 -1e18 ]\n" + test::kTriangle));
 }
 
 // Integers beyond int's range were converted with undefined behaviour (a huge

@@ -200,5 +200,15 @@ TEST(PbrtMotion, BadMotionDirectivesAreErrors) {
         "at the end of the motion");
 }
 
+// A last row of zeros maps every point to infinity (pbrt-v4 divides by w):
+// refused with the directive's line, not a shape moved onto the camera.
+TEST(PbrtTransform, ALastRowOfZerosIsRefused) {
+  for (const char* d : {"Transform", "ConcatTransform"}) {
+    const std::string e = test::load_error(std::string("WorldBegin\nAttributeBegin\n") + d +
+                                           " [ 1 0 0 0  0 1 0 0  0 0 1 0  5 5 5 0 ]\n" + kTriangle + "AttributeEnd\n");
+    EXPECT_NE(e.find(":3: " + std::string(d) + ": the matrix's last row"), std::string::npos) << e;
+  }
+}
+
 }  // namespace
 }  // namespace tessera

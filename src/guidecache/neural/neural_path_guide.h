@@ -15,8 +15,9 @@ namespace tessera {
 // vertex's sum over the candidates is capped at kNeuralMixVertexCap (its
 // candidates keep their proportions): a few fireflies do not decide the
 // scene's weight alone, and the integer sums stay far from overflow. A NaN
-// or an overflow is left out and counted.
-TESSERA_HOST_DEVICE inline void neural_record_mix(const NeuralGuideView& v, const GuideMixSample& m, Float target) {
+// or an overflow is left out and counted. Out of line on the GPU (learning only).
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline void neural_record_mix(const NeuralGuideView& v, const GuideMixSample& m,
+                                                                          Float target) {
   static_assert(kNeuralMixFirstCandidate + kNeuralMixCandidates <= kGuideMixEntries, "the table's candidates");
   NeuralSampleSink* sink = v.sink;
   if (!sink || !(m.mix_pdf > 0.f)) return;
@@ -155,7 +156,7 @@ struct NeuralPathGuide {
   // Expected SARSA's integral of Q f |cos| over y's bins (guide_bins_integral).
   // It is coef x one value of y's, which *boot records.
   template <class ToLocal>
-  TESSERA_HOST_DEVICE Float bins_integral(int32_t s, const BsdfParams& b, bool lambertian, const Vec3& wo_local,
+  TESSERA_HOST_DEVICE Float bins_integral(int32_t s, const BsdfParams& b, bool lambertian, Vec3 wo_local,
                                           const ToLocal& to_local, PixelSampler& rng, GuideBootstrap* boot) {
     NeuralSite& y = site[s];
     *boot = GuideBootstrap{};

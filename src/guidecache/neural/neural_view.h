@@ -431,8 +431,11 @@ TESSERA_LANES_FN void neural_output_blocks(const float* w3, const float* b3, uin
 }
 
 // Runs the network at a vertex (p on a surface whose normal on the path's
-// side is n) and builds the site's distributions.
-TESSERA_HOST_DEVICE inline void neural_infer(const NeuralGuideView& v, const Vec3& p, const Vec3& n, NeuralSite* site) {
+// side is n) and builds the site's distributions. Out of line on the GPU
+// (device.h): large, and its work dwarfs a call's; the path loop's
+// registers are then allocated without the network's.
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline void neural_infer(const NeuralGuideView& v, const Vec3& p, const Vec3& n,
+                                                                     NeuralSite* site) {
   const NeuralLayout L{v.width, v.table_log2, v.lights};
   Float in[kNeuralInputs], h1[kNeuralMaxWidth];
   Float* h2 = site->h2;
@@ -676,9 +679,11 @@ TESSERA_HOST_DEVICE inline void neural_sink_start_path(NeuralSampleSink* sink, u
 }
 
 // Records a learning target for the site's bin into the calling thread's
-// sink. Returns false (and counts it) when the target is rejected.
-TESSERA_HOST_DEVICE inline bool neural_record(const NeuralGuideView& v, const NeuralSite& site, uint32_t bin, Float target,
-                                              const NeuralBootstrap& boot = NeuralBootstrap{}) {
+// sink. Returns false (and counts it) when the target is rejected. Out of
+// line on the GPU (learning only).
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool neural_record(const NeuralGuideView& v, const NeuralSite& site,
+                                                                      uint32_t bin, Float target,
+                                                                      const NeuralBootstrap& boot = NeuralBootstrap{}) {
   NeuralSampleSink* sink = v.sink;
   if (!sink) return false;
   if (!(target >= 0.f) || !(target <= 3.4e38f)) {

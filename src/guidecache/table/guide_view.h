@@ -263,8 +263,10 @@ TESSERA_HOST_DEVICE inline void guide_acc_add(const GuideView& g, uint64_t* p, u
 }
 
 // Adds one learning target to entry (a bin, or bins + light) of a cell.
-// Returns false (and counts it) when the target is rejected.
-TESSERA_HOST_DEVICE inline bool guide_record(const GuideView& g, int32_t cell, uint32_t entry, Float target) {
+// Returns false (and counts it) when the target is rejected. Out of line on
+// the GPU: learning only, called from every learning hook.
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool guide_record(const GuideView& g, int32_t cell, uint32_t entry,
+                                                                     Float target) {
   if (!(target >= 0.f) || !(target <= 3.4e38f)) {  // NaN, negative or infinite
     guide_acc_add(g, &g.rejected[0], 1);
     return false;

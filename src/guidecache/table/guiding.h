@@ -138,9 +138,9 @@ TESSERA_HOST_DEVICE inline Float guide_mix_moment(const GuideMixSample& m, Float
 // took from the direct light the BSDF samples that its MIS with NEE needs
 // (material-testball's floor: 7x the variance of no guiding).
 // A sample too large for the fixed point is counted in rejected[2], for all
-// candidates alike.
-TESSERA_HOST_DEVICE inline void guide_record_mix(const GuideView& g, int32_t cell, const GuideMixSample& m,
-                                                 Float target) {
+// candidates alike. Out of line on the GPU (learning only).
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline void guide_record_mix(const GuideView& g, int32_t cell,
+                                                                         const GuideMixSample& m, Float target) {
   // The cell's scale: the radiance it reflects, learned indirect plus NEE's
   // direct share, so that cells lit mostly directly stay in range too.
   const Float direct = g.value[static_cast<size_t>(cell) * g.stride + g.nee_entry];
@@ -197,9 +197,10 @@ TESSERA_HOST_DEVICE inline Float guided_survival(const GuideView& g, int32_t cel
 //    Q_j f(w_j) |cos_j| dOmega / p_j, an unbiased estimate of the bin sum.
 // Delta BSDFs are handled by the caller with the direction actually sampled.
 // The BSDF is given in its local frame; w_j is taken to it by `to_local`.
+// wo_local by value: its address goes to the out-of-line BSDF code.
 template <class ToLocal>
 TESSERA_HOST_DEVICE inline Float guide_bins_integral(const GuideView& g, int32_t cell, const BsdfParams& b, bool lambertian,
-                                                     const Vec3& wo_local, const ToLocal& to_local, PixelSampler& rng) {
+                                                     Vec3 wo_local, const ToLocal& to_local, PixelSampler& rng) {
   if (lambertian) {
     Float rho = luminance(b.reflectance);
     return g.target == GuideTarget::QLearning ? rho * g.qmax[cell] : rho * kInvPi * g.irradiance[cell];

@@ -54,7 +54,7 @@ struct TablePathGuide {
     return guided_survival(g, cell, bin, throughput, path_expected, window);
   }
   template <class ToLocal>
-  TESSERA_HOST_DEVICE Float bins_integral(int32_t cell, const BsdfParams& b, bool lambertian, const Vec3& wo_local,
+  TESSERA_HOST_DEVICE Float bins_integral(int32_t cell, const BsdfParams& b, bool lambertian, Vec3 wo_local,
                                           const ToLocal& to_local, PixelSampler& rng, GuideBootstrap*) const {
     return guide_bins_integral(g, cell, b, lambertian, wo_local, to_local, rng);
   }
