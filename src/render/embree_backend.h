@@ -21,7 +21,9 @@ struct EmbreeTracer {
   uint64_t* untraceable = nullptr;
 
   // time: where in the transform interval, for moving shapes (0..1).
-  bool intersect(const Vec3& o, const Vec3& d, Float tmax, TraceHit* hit, Float time = 0.f) const {
+  // Always inline: a call would take the address of the path state's ray
+  // and keep the integrator's state out of registers (docs/development.md).
+  TESSERA_INLINE bool intersect(const Vec3& o, const Vec3& d, Float tmax, TraceHit* hit, Float time = 0.f) const {
     if (!ray_traceable(o, d, tmax)) return refuse_ray(untraceable, false);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -46,7 +48,7 @@ struct EmbreeTracer {
     return true;
   }
 
-  bool occluded(const Vec3& o, const Vec3& d, Float tmax, Float time = 0.f) const {
+  TESSERA_INLINE bool occluded(const Vec3& o, const Vec3& d, Float tmax, Float time = 0.f) const {
     if (!ray_traceable(o, d, tmax)) return refuse_ray(untraceable, true);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
