@@ -8,12 +8,17 @@
 #include <ImfInputFile.h>
 #include <ImfRgbaFile.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace tessera {
@@ -110,6 +115,30 @@ ImageDesc load_exr(const std::string& path) {
   }
 }
 
+// libpng prints its own "libpng error: ..." on stderr before OpenImageIO
+// reports the same problem, which becomes our one-line error: while a PNG
+// is read, stderr goes to /dev/null (scenes load on one thread).
+class QuietStderr {
+ public:
+  QuietStderr() {
+    std::fflush(stderr);
+    saved_ = dup(STDERR_FILENO);
+    const int null = open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) dup2(null, STDERR_FILENO);
+    if (null >= 0) close(null);
+  }
+  ~QuietStderr() {
+    if (saved_ < 0) return;
+    dup2(saved_, STDERR_FILENO);
+    close(saved_);
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
 // Every other format pbrt scenes use (PNG, TGA, JPEG, BMP, PFM, HDR...)
 // through OpenImageIO. 8- and 16-bit data are decoded with `encoding`;
 // floating-point data (PFM, HDR) is linear, as pbrt-v4 reads it.
@@ -117,6 +146,8 @@ ImageDesc load_with_oiio(const std::string& path, const ColorEncoding& encoding)
   // RGB as stored: OpenImageIO would otherwise premultiply PNG/TGA colour by alpha.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
+  std::optional<QuietStderr> quiet;
+  if (lower_extension(path) == "png") quiet.emplace();
   std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path, &config);
   if (!in) fail(path, first_line(OIIO::geterror()));
   const OIIO::ImageSpec spec = in->spec();

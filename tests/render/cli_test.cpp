@@ -538,6 +538,23 @@ TEST_F(CliTest, GzippedScenesAndIncludesRenderAsPlainOnes) {
   EXPECT_TRUE(plain == packed);
 }
 
+// A damaged PNG texture is our one line, without libpng's own
+// "libpng error: ..." line before it.
+TEST_F(CliTest, ADamagedPngTextureIsOneLine) {
+  const std::string good = (dir_ / "good.exr").string();
+  ASSERT_EQ(run("render -q --spp 1 --res 8x8 -o " + good).exit_code, 0);  // writes good.png beside it
+  std::ifstream in(dir_ / "good.png", std::ios::binary);
+  const std::string png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(png.size(), 80u);
+  std::ofstream(dir_ / "cut.png", std::ios::binary) << png.substr(0, 60);  // the header, then the data cut off
+  const std::string scene = write("png.pbrt", std::string(kHeader) +
+                                                  "Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"cut.png\"\n"
+                                                  "Material \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"\n");
+  const RunResult r = run("render -q --spp 1 -o " + (dir_ / "o.exr").string() + " " + scene);
+  expect_one_line_error(r, "png.pbrt:6: cannot read image");
+  EXPECT_EQ(r.output.find("libpng"), std::string::npos) << r.output;
+}
+
 }  // namespace
 TEST_F(CliTest, BackendsRenderOrRefuseInOneLine) {
   // The portable BVH and the emulated device render and say so in the
