@@ -58,9 +58,9 @@ struct RenderArgs {
 uint64_t parse_seed(const std::string& text) {
   static const std::regex re("^[0-9]{1,20}$");
   errno = 0;
-  char* end = nullptr;
-  const unsigned long long v = std::regex_match(text, re) ? std::strtoull(text.c_str(), &end, 10) : 0;
-  if (!std::regex_match(text, re) || errno == ERANGE)
+  const bool digits = std::regex_match(text, re);
+  const unsigned long long v = digits ? std::strtoull(text.c_str(), nullptr, 10) : 0;
+  if (!digits || errno == ERANGE)
     throw std::runtime_error("--seed: expected an integer from 0 to 18446744073709551615, got '" + text + "'");
   return static_cast<uint64_t>(v);
 }

@@ -1,8 +1,10 @@
 #include "app/scene_loading.h"
 
+#include <cctype>
 #include <cstdio>
 #include <map>
-#include <regex>
+#include <string>
+#include <vector>
 
 #include "scene/builtin_scenes.h"
 #include "scene/pbrt_loader.h"
@@ -15,14 +17,22 @@ namespace {
 constexpr int kShownPerWarning = 3;
 constexpr int kShownInAll = 50;
 
+// "file:line: message" -> "message" (w itself where it has no location).
+std::string without_location(const std::string& w) {
+  for (size_t at = w.find(": "); at != std::string::npos; at = w.find(": ", at + 1)) {
+    size_t digits = at;
+    while (digits > 0 && std::isdigit(static_cast<unsigned char>(w[digits - 1]))) --digits;
+    if (digits < at && digits > 0 && w[digits - 1] == ':') return w.substr(at + 2);
+  }
+  return w;
+}
+
 void print_warnings(const std::vector<std::string>& warnings) {
-  static const std::regex located("^(.*?:[0-9]+): (.*)$");
   std::map<std::string, int> seen;  // by message without its location
   std::vector<std::string> order;
   int shown = 0, hidden = 0;
   for (const std::string& w : warnings) {
-    std::smatch m;
-    const std::string message = std::regex_match(w, m, located) ? m[2].str() : w;
+    const std::string message = without_location(w);
     const int n = ++seen[message];
     if (n == 1) order.push_back(message);
     if (n <= kShownPerWarning && shown < kShownInAll) {
