@@ -26,6 +26,7 @@
 #include "scene/sampler_setup.h"
 #include "scene/scene_effects.h"
 #include "app/memory_check.h"
+#include "scene/object_instances.h"
 #include "scene/light_paths.h"
 #include "scene/spectral_choice.h"
 #include "render/backends.h"
@@ -187,12 +188,8 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   const PixelBounds crop = film_pixel_bounds(desc.film);
   check_film_memory(crop.width(), crop.height(), m.opt.light_paths, !a.checkpoint.empty(),
                     (a.resume.empty() ? 0u : 2u) + (a.guide.mode == "auto" ? 1u : 0u));
-  uint64_t triangles = 0, vertices = 0;
-  for (const MeshDesc& mesh : desc.meshes) {
-    triangles += mesh.indices.size() / 3;
-    vertices += mesh.p.size();
-  }
-  check_scene_memory(triangles, vertices);
+  const GeometryCount geometry = count_geometry(desc);
+  check_scene_memory(geometry.triangles, geometry.vertices, geometry.instances);
   if (!a.snapshot_every.empty()) m.snapshots = parse_snapshot_policy(a.snapshot_every);
   if (scene_bytes) *scene_bytes = encode_scene(desc);
   m.light_paths_obstacle = light_paths_obstacle(desc);  // reads the meshes, which SceneData empties

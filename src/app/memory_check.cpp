@@ -19,12 +19,15 @@ FilmMemory film_memory(int64_t width, int64_t height, bool light_paths, bool che
   return m;
 }
 
-uint64_t scene_build_memory(uint64_t triangles, uint64_t vertices) { return triangles * 128 + vertices * 32; }
+uint64_t scene_build_memory(uint64_t triangles, uint64_t vertices, uint64_t instances) {
+  return triangles * 128 + vertices * 32 + instances * kBytesPerInstance;
+}
 
-void check_scene_memory(uint64_t triangles, uint64_t vertices) {
-  const uint64_t need = scene_build_memory(triangles, vertices);
-  const std::string what = "the scene's " + std::to_string(triangles) + " triangles need about " + format_bytes(need) +
-                           " for their arrays and BVH";
+void check_scene_memory(uint64_t triangles, uint64_t vertices, uint64_t instances) {
+  const uint64_t need = scene_build_memory(triangles, vertices, instances);
+  const std::string what = "the scene's " + std::to_string(triangles) + " triangles" +
+                           (instances ? " and " + std::to_string(instances) + " instances" : std::string()) +
+                           " need about " + format_bytes(need) + " for their arrays and BVH";
   if (exceeds_memory_limit(need))
     throw std::runtime_error(what + ", more than the " + format_bytes(*memory_limit_bytes()) +
                              " of memory this process may use");

@@ -31,12 +31,15 @@ void check_film_memory(int64_t width, int64_t height, bool light_paths, bool che
 
 // What a loaded scene still needs before rendering: per triangle its flat
 // arrays (indices, face normal, material and light, media, alpha) and its
-// share of the BVH, per vertex its position, normal and uv, counted high
-// (scripts/bench_mesh_load.py measures what a mesh takes).
-uint64_t scene_build_memory(uint64_t triangles, uint64_t vertices);
+// share of the BVH, per vertex its position, normal and uv, per instance its
+// placement and its Embree instance and top-level BVH entry, counted high
+// (scripts/bench_mesh_load.py measures what a mesh takes). Instanced
+// geometry counts once, as it is stored once.
+constexpr uint64_t kBytesPerInstance = 2048;
+uint64_t scene_build_memory(uint64_t triangles, uint64_t vertices, uint64_t instances = 0);
 
 // The same refusal and warning as check_film_memory, for the scene's
-// triangles, before its arrays and BVH are built.
-void check_scene_memory(uint64_t triangles, uint64_t vertices);
+// triangles and instances, before their arrays and BVH are built.
+void check_scene_memory(uint64_t triangles, uint64_t vertices, uint64_t instances = 0);
 
 }  // namespace tessera

@@ -10,6 +10,14 @@ void serialize(Archive& ar, MeshDesc& m) {
      raw(m.p_end), raw(m.n_end), m.triangles_per_shape, m.shape_area, m.invisible_from_inside, m.where);
 }
 template <class Archive>
+void serialize(Archive& ar, ObjectDesc& o) {
+  ar(o.name, o.meshes);
+}
+template <class Archive>
+void serialize(Archive& ar, InstanceDesc& i) {
+  ar(i.object, raw_value(i.render_from_object), raw_value(i.render_from_object_end), i.where);
+}
+template <class Archive>
 void serialize(Archive& ar, ImageDesc& i) {
   ar(i.width, i.height, raw(i.texels), i.path);
 }
@@ -41,6 +49,7 @@ void serialize(Archive& ar, SceneDesc& d) {
   ar(d.camera.shutter_open, d.camera.shutter_close, d.camera.transform_start_time, d.camera.transform_end_time,
      raw_value(d.camera.world_from_camera_end));
   ar(d.spectral, d.spectra);
+  ar(d.objects, d.instances);
 }
 
 Bytes encode_scene(const SceneDesc& desc) { return encode(desc); }

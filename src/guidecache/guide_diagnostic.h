@@ -30,7 +30,7 @@ TESSERA_HOST_DEVICE Rgb trace_greedy_path(const SceneView& s, PathGuide& g, cons
       return beta * Le;
     }
     const RayPoint from_ray{ray.o, ray.d, hit.t};
-    SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, 0.f, &from_ray);
+    SurfaceHit h = make_surface_hit(s, hit, 0.f, &from_ray);
     Vec3 wo = -ray.d;
     const TriangleInfo& info = s.triangles[hit.triangle];
     if (info.light >= 0) {

@@ -39,7 +39,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceStep surface_interaction(Ctx& x, PathS
   SurfaceVertex& v = *out;
   ++x.c.vertices;
   const RayPoint from_ray{st.ray.o, st.ray.d, hit.t};
-  v.h = make_surface_hit(x.s, hit.triangle, hit.b1, hit.b2, st.ray.time, &from_ray);
+  v.h = make_surface_hit(x.s, hit, st.ray.time, &from_ray);
   const Vec3 wo = -st.ray.d;  // (a copy goes to the out-of-line material code, not v's address)
   v.wo = wo;
   const TriangleInfo& info = x.s.triangles[hit.triangle];

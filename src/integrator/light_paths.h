@@ -333,7 +333,7 @@ TESSERA_HOST_DEVICE void trace_caustic_light_path(const SceneView& s, const Trac
     }
     if (!found) return;
     const RayPoint from_ray{ray.o, ray.d, hit.t};
-    SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, 0.f, &from_ray);
+    SurfaceHit h = make_surface_hit(s, hit, 0.f, &from_ray);
     const Vec3 wo = -ray.d;  // towards the light
     BsdfParams bsdf;
     const int32_t single_before = wl ? wl->single : -1;

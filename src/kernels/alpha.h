@@ -11,12 +11,22 @@
 
 namespace tessera {
 
-// time: the ray's (a moving triangle's texture point is where it is then).
-TESSERA_HOST_DEVICE inline bool alpha_ignores_hit(const SceneView& s, uint32_t tri, Float b1, Float b2, const Vec3& o,
-                                                  const Vec3& d, Float time) {
+// time: the ray's (a moving triangle's texture point is where it is then);
+// instance: the candidate's (TraceHit::instance), whose texture point is in
+// render space like any other.
+TESSERA_HOST_DEVICE inline bool alpha_ignores_hit(const SceneView& s, uint32_t tri, int32_t instance, Float b1, Float b2,
+                                                  const Vec3& o, const Vec3& d, Float time) {
   const TextureSlot& slot = s.triangle_alpha[tri];
   Float a = slot.value.x;
-  if (slot.texture >= 0) a = eval_slot(s, slot, texture_point(make_surface_hit(s, tri, b1, b2, time))).x;
+  if (slot.texture >= 0) {
+    TraceHit at;
+    at.t = 0.f;
+    at.triangle = tri;
+    at.b1 = b1;
+    at.b2 = b2;
+    at.instance = instance;
+    a = eval_slot(s, slot, texture_point(make_surface_hit(s, at, time))).x;
+  }
   if (a >= 1.f) return false;
   if (!(a > 0.f)) return true;
   const uint64_t h = mix_bits(hash_vec3(o) ^ (hash_vec3(d) * 0xd1b54a32d192ed03ull) ^

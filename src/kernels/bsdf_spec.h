@@ -81,7 +81,7 @@ TESSERA_HOST_DEVICE inline Frame shading_frame(const SceneView& s, const BsdfPar
   }
   // Hair: x along the fibre (a curve's u).
   return (Spec & kSpecNonDiffuse) && (bsdf.alpha_x != bsdf.alpha_y || bsdf.type == BsdfType::Hair)
-             ? Frame::from_tangent(h.ns, surface_dpdu(s, h.triangle))
+             ? Frame::from_tangent(h.ns, surface_dpdu(s, h))
              : Frame::from_z(h.ns);
 }
 

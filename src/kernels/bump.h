@@ -16,8 +16,8 @@ namespace tessera {
 // pbrt-v4's shading dp/du, dp/dv at a hit: the triangle's, or with vertex
 // normals ts = ns x dpdu, ss = ts x ns.
 TESSERA_HOST_DEVICE inline void shading_derivatives(const SceneView& s, const SurfaceHit& h, Vec3* dpdu, Vec3* dpdv) {
-  *dpdu = surface_dpdu(s, h.triangle);
-  *dpdv = surface_dpdv(s, h.triangle);
+  *dpdu = surface_dpdu(s, h);
+  *dpdv = surface_dpdv(s, h);
   if (s.triangles[h.triangle].flags & kTriHasNormals) {
     const Vec3 ts = glm::cross(h.ns, *dpdu);
     if (glm::dot(ts, ts) > 0.f) {

@@ -17,7 +17,7 @@ namespace tessera {
 
 // 32 bytes. Inner nodes: the left child follows the node, `offset` is the
 // right child; `count_axis` is kBvhInner | the split axis. Leaves: `offset`
-// indexes BvhView::triangles, `count_axis` is the triangle count (>= 1).
+// indexes BvhView::triangles, `count_axis` is the item count (>= 1).
 struct BvhNode {
   Vec3 lo{0.f};
   uint32_t offset = 0;
@@ -26,14 +26,22 @@ struct BvhNode {
 };
 
 constexpr uint32_t kBvhInner = 0x80000000u;
-// The traversal stack; the builder keeps the tree shallower than this.
+// A leaf item of the top-level tree that is an instance (its index in the
+// low bits), not a triangle: two levels, as Embree's instances.
+constexpr uint32_t kBvhInstanceItem = 0x80000000u;
+constexpr uint32_t kBvhNoRoot = 0xffffffffu;
+// The traversal stack (one per level); the builder keeps each tree shallower than this.
 constexpr int kBvhStackSize = 64;
 
+// One node array holds the top-level tree (root 0: the world's triangles
+// and the instances) and each prototype's tree over its own triangles.
 struct BvhView {
   const BvhNode* nodes = nullptr;
-  const uint32_t* triangles = nullptr;  // triangle indices, leaf by leaf
+  const uint32_t* triangles = nullptr;  // leaf items, leaf by leaf
   uint32_t num_nodes = 0;
   uint32_t num_triangles = 0;  // entries of triangles (triangles with non-finite bounds are left out)
+  const uint32_t* prototype_roots = nullptr;  // per prototype, its root in nodes (kBvhNoRoot: nothing to hit)
+  uint32_t num_prototypes = 0;
 };
 
 namespace bvh_detail {
@@ -102,20 +110,45 @@ TESSERA_HOST_DEVICE inline bool hits_triangle(const Vec3& p0, const Vec3& p1, co
 
 }  // namespace bvh_detail
 
-// The closest hit in (0, tmax], or with any_hit the first one found (shadow
-// rays). Candidates the scene filters (alpha, one-way faces) are skipped.
-TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool bvh_trace(const BvhView& bvh, const SceneView& s, const Vec3& o, const Vec3& d,
-                                          Float tmax, Float time, bool any_hit, TraceHit* hit) {
-  if (bvh.num_nodes == 0 || !(tmax > 0.f)) return false;
+namespace bvh_detail {
+
+struct TreeRay {
+  Vec3 o, d;
+  int32_t instance;  // whose prototype's space o, d are in; -1: render space
+};
+
+// The closest hit in (0, *tmax] of one tree, or with any_hit the first one
+// found (shadow rays); *tmax shrinks to each closer hit. Candidates the
+// scene filters (alpha, one-way faces) are skipped. The top-level tree
+// (kTop) descends into the instances its leaves name.
+template <bool kTop>
+TESSERA_HOST_DEVICE inline bool trace_tree(const BvhView& bvh, const SceneView& s, uint32_t root, const TreeRay& r,
+                                           Float* tmax, Float time, bool any_hit, TraceHit* hit);
+
+// An instance's prototype, with the ray carried into its space (t unchanged).
+TESSERA_HOST_DEVICE inline bool trace_instance(const BvhView& bvh, const SceneView& s, uint32_t instance, const TreeRay& r,
+                                               Float* tmax, Float time, bool any_hit, TraceHit* hit) {
+  const ObjectInstance& inst = s.instances[instance];
+  const uint32_t root = bvh.prototype_roots[inst.prototype];
+  if (root == kBvhNoRoot) return false;
+  const Affine to_object = placement_at(inst, time).object_from_render;
+  const TreeRay local{apply_point(to_object, r.o), apply_vector(to_object, r.d), static_cast<int32_t>(instance)};
+  return trace_tree<false>(bvh, s, root, local, tmax, time, any_hit, hit);
+}
+
+template <bool kTop>
+TESSERA_HOST_DEVICE inline bool trace_tree(const BvhView& bvh, const SceneView& s, uint32_t root, const TreeRay& r,
+                                           Float* tmax, Float time, bool any_hit, TraceHit* hit) {
+  const Vec3 &o = r.o, &d = r.d;
   const Vec3 inv_d(1.f / d.x, 1.f / d.y, 1.f / d.z);
   const bool filtered = s.triangle_alpha || s.has_one_way_faces;
   uint32_t stack[kBvhStackSize];
   int top = 0;
-  uint32_t node = 0;
+  uint32_t node = root;
   bool found = false;
   for (;;) {
     const BvhNode& n = bvh.nodes[node];
-    if (bvh_detail::hits_box(n.lo, n.hi, o, inv_d, tmax)) {
+    if (hits_box(n.lo, n.hi, o, inv_d, *tmax)) {
       if (n.count_axis & kBvhInner) {
         // Nearer child first: the far one waits on the stack.
         const uint32_t axis = n.count_axis & 3u;
@@ -127,16 +160,26 @@ TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool bvh_trace(const BvhView&
       }
       for (uint32_t i = 0; i < n.count_axis; ++i) {
         const uint32_t tri = bvh.triangles[n.offset + i];
+        if constexpr (kTop) {
+          if (tri & kBvhInstanceItem) {
+            if (trace_instance(bvh, s, tri & ~kBvhInstanceItem, r, tmax, time, any_hit, hit)) {
+              found = true;
+              if (any_hit) return true;
+            }
+            continue;
+          }
+        }
         Vec3 p0, p1, p2;
         triangle_vertices_at(s, tri, time, &p0, &p1, &p2);
         Float t, b1, b2;
-        if (!bvh_detail::hits_triangle(p0, p1, p2, o, d, tmax, &t, &b1, &b2)) continue;
-        if (filtered && hit_ignored(s, tri, b1, b2, o, d, time)) continue;
-        tmax = t;
+        if (!hits_triangle(p0, p1, p2, o, d, *tmax, &t, &b1, &b2)) continue;
+        if (filtered && hit_ignored(s, tri, r.instance, b1, b2, o, d, time)) continue;
+        *tmax = t;
         hit->t = t;
         hit->triangle = tri;
         hit->b1 = b1;
         hit->b2 = b2;
+        hit->instance = r.instance;
         found = true;
         if (any_hit) return true;
       }
@@ -144,6 +187,16 @@ TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool bvh_trace(const BvhView&
     if (top == 0) return found;
     node = stack[--top];
   }
+}
+
+}  // namespace bvh_detail
+
+// The closest hit in (0, tmax], or with any_hit the first one found (shadow
+// rays), on the world's triangles and every instance's.
+TESSERA_HOST_DEVICE TESSERA_DEVICE_NOINLINE inline bool bvh_trace(const BvhView& bvh, const SceneView& s, const Vec3& o, const Vec3& d,
+                                          Float tmax, Float time, bool any_hit, TraceHit* hit) {
+  if (bvh.num_nodes == 0 || !(tmax > 0.f)) return false;
+  return bvh_detail::trace_tree<true>(bvh, s, 0, bvh_detail::TreeRay{o, d, -1}, &tmax, time, any_hit, hit);
 }
 
 // The ray query interface the integrator takes (EmbreeTracer's), over a

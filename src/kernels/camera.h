@@ -137,7 +137,7 @@ TESSERA_HOST_DEVICE inline CameraSample sample_camera_ray(const SceneView& s, in
   // Motion blur: a time in the shutter interval, as a fraction of the
   // transform interval (pbrt-v4's TransformTimes), drawn only where something moves.
   Float time = 0.f;
-  if (s.positions_end || s.camera.moves) {
+  if (s.positions_end || s.camera.moves || s.instances_move) {
     const Float t = s.camera.shutter_open + sampler.uniform() * (s.camera.shutter_close - s.camera.shutter_open);
     time = glm::clamp((t - s.camera.transform_start_time) /
                           (s.camera.transform_end_time - s.camera.transform_start_time), 0.f, 1.f);

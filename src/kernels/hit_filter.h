@@ -9,9 +9,11 @@ namespace tessera {
 // Whether a ray query skips this candidate hit: a one-way face met from
 // inside (along its outward normal, at the ray's time for a moving tube), or
 // an alpha cutout. Backends call it for every candidate when the scene has
-// either (SceneView::triangle_alpha, has_one_way_faces).
-TESSERA_HOST_DEVICE inline bool hit_ignored(const SceneView& s, uint32_t tri, Float b1, Float b2, const Vec3& o,
-                                            const Vec3& d, Float time) {
+// either (SceneView::triangle_alpha, has_one_way_faces). instance: the
+// candidate's (TraceHit::instance); o and d are then in its prototype's
+// space, where the face normal is (an affine map keeps the sign of d . n).
+TESSERA_HOST_DEVICE inline bool hit_ignored(const SceneView& s, uint32_t tri, int32_t instance, Float b1, Float b2,
+                                            const Vec3& o, const Vec3& d, Float time) {
   const TriangleInfo& info = s.triangles[tri];
   if (info.flags & kTriInvisibleFromInside) {
     Vec3 n = s.face_normals[tri];
@@ -22,7 +24,7 @@ TESSERA_HOST_DEVICE inline bool hit_ignored(const SceneView& s, uint32_t tri, Fl
     }
     if (glm::dot(d, n) > 0.f) return true;
   }
-  return s.triangle_alpha && alpha_ignores_hit(s, tri, b1, b2, o, d, time);
+  return s.triangle_alpha && alpha_ignores_hit(s, tri, instance, b1, b2, o, d, time);
 }
 
 }  // namespace tessera

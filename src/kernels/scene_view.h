@@ -7,6 +7,7 @@
 #include "light.h"
 #include "material.h"
 #include "grid_medium.h"
+#include "instance.h"
 #include "medium.h"
 #include "spectral.h"
 
@@ -98,6 +99,15 @@ struct SceneView {
   // Some triangle is kTriInvisibleFromInside: ray queries must filter hits
   // (hit_ignored in alpha.h), as for triangle_alpha.
   bool has_one_way_faces = false;
+  // Instanced geometry (instance.h): triangles [0, num_world_triangles) are
+  // in render space; the rest are the prototypes', each in its own space,
+  // reached only through the instances.
+  uint32_t num_world_triangles = 0;
+  const ObjectPrototype* prototypes = nullptr;
+  uint32_t num_prototypes = 0;
+  const ObjectInstance* instances = nullptr;
+  uint32_t num_instances = 0;
+  bool instances_move = false;  // some instance moves: rays need a time, as for positions_end
 
   const Material* materials = nullptr;
   uint32_t num_materials = 0;

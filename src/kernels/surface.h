@@ -11,6 +11,7 @@ struct TraceHit {
   Float t;
   uint32_t triangle;
   Float b1, b2;  // barycentrics of vertices 1 and 2
+  int32_t instance = -1;  // the ObjectInstance whose prototype holds the triangle; -1: the world's own
 };
 
 struct SurfaceHit {
@@ -20,6 +21,7 @@ struct SurfaceHit {
   Vec3 ns;     // unit shading normal (== ng without vertex normals)
   Vec2 uv;
   uint32_t triangle;
+  int32_t instance = -1;  // as TraceHit's: p, ng and ns are in render space either way
 };
 
 // The uv at barycentrics (b1, b2): interpolated, or pbrt's default
@@ -121,6 +123,41 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& 
   return h;
 }
 
+// A hit on an instance's prototype: reconstructed in the prototype's space
+// (where its vertices are), then carried into render space; the normals by
+// the inverse transpose, ng turned to ns's side again as make_surface_hit
+// does (a non-uniform scale can change which side that is).
+TESSERA_HOST_DEVICE inline SurfaceHit make_instanced_surface_hit(const SceneView& s, const TraceHit& hit, Float time,
+                                                                 const RayPoint* ray) {
+  const InstancePlacement place = placement_at(s.instances[hit.instance], time);
+  RayPoint local;
+  if (ray) local = RayPoint{apply_point(place.object_from_render, ray->o), apply_vector(place.object_from_render, ray->d), ray->t};
+  SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, time, ray ? &local : nullptr);
+  h.instance = hit.instance;
+  h.p_error = mapped_point_error(place.render_from_object, h.p, h.p_error);
+  h.p = apply_point(place.render_from_object, h.p);
+  const bool smooth = h.ns != h.ng;
+  Vec3 ng = apply_normal(place, h.ng);
+  const Float ng_len = glm::length(ng);
+  if (ng_len > 0.f) h.ng = ng / ng_len;
+  if (smooth) {
+    const Vec3 ns = apply_normal(place, h.ns);
+    const Float ns_len = glm::length(ns);
+    h.ns = ns_len > 0.f ? ns / ns_len : h.ng;
+    if (glm::dot(h.ng, h.ns) < 0.f) h.ng = -h.ng;
+  } else {
+    h.ns = h.ng;
+  }
+  return h;
+}
+
+// The surface at a ray query's hit, on the world's triangles or an instance's.
+TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& s, const TraceHit& hit, Float time = 0.f,
+                                                               const RayPoint* ray = nullptr) {
+  if (hit.instance >= 0) return make_instanced_surface_hit(s, hit, time, ray);
+  return make_surface_hit(s, hit.triangle, hit.b1, hit.b2, time, ray);
+}
+
 // Ray origin pushed off the surface along the geometric normal, towards w,
 // by the rounding-error bound of the hit point (pbrt-v4's OffsetRayOrigin),
 // with a safety factor for Embree's own intersection arithmetic. Scale-free:
@@ -178,7 +215,21 @@ TESSERA_HOST_DEVICE inline Vec3 surface_dp_duv(const SceneView& s, uint32_t tri,
   if (!(glm::dot(d, d) > 0.f) || !is_finite(d)) return axis == 0 ? fallback.s : fallback.t;
   return d;
 }
+// In the triangle's own space (render space, or its prototype's).
 TESSERA_HOST_DEVICE inline Vec3 surface_dpdu(const SceneView& s, uint32_t tri) { return surface_dp_duv(s, tri, 0); }
 TESSERA_HOST_DEVICE inline Vec3 surface_dpdv(const SceneView& s, uint32_t tri) { return surface_dp_duv(s, tri, 1); }
+
+// In render space: an instance's tangents carried out of its prototype's space.
+TESSERA_HOST_DEVICE inline Vec3 surface_dp_duv(const SceneView& s, const SurfaceHit& h, int axis, Float time) {
+  const Vec3 d = surface_dp_duv(s, h.triangle, axis);
+  if (h.instance < 0) return d;
+  return apply_vector(placement_at(s.instances[h.instance], time).render_from_object, d);
+}
+TESSERA_HOST_DEVICE inline Vec3 surface_dpdu(const SceneView& s, const SurfaceHit& h, Float time = 0.f) {
+  return surface_dp_duv(s, h, 0, time);
+}
+TESSERA_HOST_DEVICE inline Vec3 surface_dpdv(const SceneView& s, const SurfaceHit& h, Float time = 0.f) {
+  return surface_dp_duv(s, h, 1, time);
+}
 
 }  // namespace tessera

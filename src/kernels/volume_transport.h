@@ -73,7 +73,7 @@ TESSERA_HOST_DEVICE Rgb shadow_transmittance(const SceneView& s, const Tracer& t
       return tr;
     }
     const RayPoint from_ray{o, d, hit.t};
-    const SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, time, &from_ray);
+    const SurfaceHit h = make_surface_hit(s, hit, time, &from_ray);
     if (resolve_material<kSpecAll>(s, s.triangles[hit.triangle].material, h, -d)->type != MaterialType::Interface)
       return Rgb(0.f);
     if (medium >= 0) tr *= medium_transmittance(s, medium_at(s, medium, wl), o, d, hit.t, wl);

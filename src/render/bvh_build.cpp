@@ -140,11 +140,11 @@ class Builder {
 
 }  // namespace
 
-BvhBuild build_bvh(const SceneView& s) {
-  BvhBuild out;
-  std::vector<Prim> prims;
-  prims.reserve(s.num_triangles);
-  for (uint32_t t = 0; t < s.num_triangles; ++t) {
+namespace {
+
+// The leaf items of one tree: triangles [first, first + count) in their own space.
+void add_triangles(const SceneView& s, uint32_t first, uint32_t count, std::vector<Prim>& prims) {
+  for (uint32_t t = first; t < first + count; ++t) {
     Prim p;
     p.triangle = t;
     const uint32_t* idx = s.indices + 3 * static_cast<size_t>(t);
@@ -156,11 +156,69 @@ BvhBuild build_bvh(const SceneView& s) {
     if (!is_finite(p.centre)) continue;  // the loader refuses non-finite vertices; never bin one
     prims.push_back(p);
   }
-  if (prims.empty()) return out;
-  out.nodes.reserve(2 * prims.size());
-  out.triangles.reserve(prims.size());
+}
+
+// An instance as a top-level item: its prototype's box placed at both ends
+// of the transform interval (a vertex moves on a straight line between its
+// two placements, which the union of both boxes holds).
+bool add_instance(const ObjectInstance& inst, uint32_t index, const Box& object, std::vector<Prim>& prims) {
+  if (object.empty()) return false;
+  Prim p;
+  p.triangle = kBvhInstanceItem | index;
+  for (const Affine* a : {&inst.render_from_object, &inst.render_from_object_end})
+    for (int c = 0; c < 8; ++c)
+      p.box.grow(apply_point(*a, Vec3(c & 1 ? object.hi.x : object.lo.x, c & 2 ? object.hi.y : object.lo.y,
+                                      c & 4 ? object.hi.z : object.lo.z)));
+  p.centre = 0.5f * (p.box.lo + p.box.hi);
+  if (!is_finite(p.centre)) return false;
+  prims.push_back(p);
+  return true;
+}
+
+// Appends a tree over prims; its root's index, or kBvhNoRoot for none.
+uint32_t add_tree(std::vector<Prim>& prims, BvhBuild& out) {
+  if (prims.empty()) return kBvhNoRoot;
+  const uint32_t root = static_cast<uint32_t>(out.nodes.size());
   out.nodes.emplace_back();
-  Builder(prims, out).build(0, 0, prims.size(), 0);
+  Builder(prims, out).build(root, 0, prims.size(), 0);
+  return root;
+}
+
+}  // namespace
+
+BvhBuild build_bvh(const SceneView& s) {
+  BvhBuild out;
+  out.nodes.reserve(2 * static_cast<size_t>(s.num_triangles) + 2 * static_cast<size_t>(s.num_instances));
+  out.triangles.reserve(s.num_triangles + s.num_instances);
+  // The prototypes' trees first (their boxes bound the instances); the
+  // top-level tree then goes to the front, as the traversal starts at node 0.
+  std::vector<Box> object_boxes(s.num_prototypes);
+  std::vector<uint32_t> roots(s.num_prototypes, kBvhNoRoot);
+  BvhBuild objects;
+  for (uint32_t i = 0; i < s.num_prototypes; ++i) {
+    std::vector<Prim> prims;
+    add_triangles(s, s.prototypes[i].first_triangle, s.prototypes[i].num_triangles, prims);
+    for (const Prim& p : prims) object_boxes[i].grow(p.box);
+    roots[i] = add_tree(prims, objects);
+  }
+  std::vector<Prim> top;
+  top.reserve(s.num_world_triangles + s.num_instances);
+  add_triangles(s, 0, s.num_world_triangles, top);
+  for (uint32_t i = 0; i < s.num_instances; ++i) add_instance(s.instances[i], i, object_boxes[s.instances[i].prototype], top);
+  if (top.empty()) return out;
+  add_tree(top, out);
+  // Move the prototypes' trees behind it: node offsets and leaf offsets shift.
+  const uint32_t node_shift = static_cast<uint32_t>(out.nodes.size());
+  const uint32_t item_shift = static_cast<uint32_t>(out.triangles.size());
+  for (BvhNode n : objects.nodes) {
+    n.offset += (n.count_axis & kBvhInner) ? node_shift : item_shift;
+    out.nodes.push_back(n);
+  }
+  out.triangles.insert(out.triangles.end(), objects.triangles.begin(), objects.triangles.end());
+  for (uint32_t& r : roots)
+    if (r != kBvhNoRoot) r += node_shift;
+  out.prototype_roots = std::move(roots);
+  out.depth = std::max(out.depth, objects.depth);
   return out;
 }
 

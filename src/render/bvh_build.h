@@ -1,5 +1,7 @@
 // Builds the portable BVH (kernels/bvh.h) over a built scene's triangles on
-// the host: binned SAH (Wald 2007), flattened depth first.
+// the host: binned SAH (Wald 2007), flattened depth first; two levels where
+// the scene has instances (a tree per prototype, one over the world's
+// triangles and the instances).
 #pragma once
 
 #include <vector>
@@ -11,10 +13,12 @@ namespace tessera {
 struct BvhBuild {
   std::vector<BvhNode> nodes;
   std::vector<uint32_t> triangles;
-  int depth = 0;  // of the deepest leaf (root = 0), below kBvhStackSize
+  std::vector<uint32_t> prototype_roots;  // per prototype (kernels/instance.h)
+  int depth = 0;  // of the deepest leaf (root = 0) of any one tree, below kBvhStackSize
   BvhView view() const {
     return BvhView{nodes.data(), triangles.data(), static_cast<uint32_t>(nodes.size()),
-                   static_cast<uint32_t>(triangles.size())};
+                   static_cast<uint32_t>(triangles.size()), prototype_roots.data(),
+                   static_cast<uint32_t>(prototype_roots.size())};
   }
 };
 

@@ -1,4 +1,5 @@
-// The Embree backend: one Embree scene holding every triangle, traced by
+// The Embree backend: one Embree scene holding the world's triangles and an
+// Embree instance per object instance (one scene per prototype), traced by
 // this process's threads. Integrators only see EmbreeTracer's
 // intersect/occluded (see integrator/integrator.h); the pass loop only sees
 // EmbreeBackend as a TileBackend (render/tile_backend.h).
@@ -6,7 +7,9 @@
 
 #include <embree3/rtcore.h>
 
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "integrator/integrator.h"
 #include "kernels/ray_guard.h"
@@ -19,6 +22,8 @@ struct EmbreeTracer {
   RTCScene scene = nullptr;
   // Where rays this tracer refuses are counted (kernels/ray_guard.h); null: not counted.
   uint64_t* untraceable = nullptr;
+  // Per instance, its prototype's first triangle: a hit's primID counts from there.
+  const uint32_t* instance_first = nullptr;
 
   // time: where in the transform interval, for moving shapes (0..1).
   // Always inline: a call would take the address of the path state's ray
@@ -43,6 +48,11 @@ struct EmbreeTracer {
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     hit->t = rh.ray.tfar;
     hit->triangle = rh.hit.primID;
+    hit->instance = -1;
+    if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
+      hit->instance = static_cast<int32_t>(rh.hit.instID[0]) - 1;
+      hit->triangle += instance_first[hit->instance];
+    }
     hit->b1 = rh.hit.u;
     hit->b2 = rh.hit.v;
     return true;
@@ -74,14 +84,28 @@ class EmbreeScene {
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
-  EmbreeTracer tracer() const { return EmbreeTracer{scene_}; }
+  EmbreeTracer tracer() const { return EmbreeTracer{scene_, nullptr, instance_first_.data()}; }
+
+  // What the hit filter reads for one geometry: triangle primID of it is
+  // triangle first_triangle + primID of the view.
+  struct FilterData {
+    const SceneView* view;
+    uint32_t first_triangle;
+  };
 
  private:
   void build(const SceneData& data);
+  RTCScene new_scene();
+  void attach_triangles(const SceneData& data, RTCScene scene, uint32_t first, uint32_t count, unsigned id);
+  void attach_instance(const ObjectInstance& inst, unsigned id);
+  [[noreturn]] void fail(const std::string& what) const;
   void release();  // the Embree handles (constructor failure and destructor)
   std::string error_;  // first error Embree reported
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  std::vector<RTCScene> prototypes_;  // one per prototype (kernels/instance.h)
+  std::vector<uint32_t> instance_first_;
+  std::vector<std::unique_ptr<FilterData>> filters_;
 };
 
 // Adds samples [sample_begin, sample_end) of every pixel of the job to its

@@ -91,111 +91,164 @@ SceneData::SceneData(SceneDesc desc) : desc_(std::move(desc)) {
 }
 
 void SceneData::flatten_meshes() {
+  // Every mesh, the world's and the instanced objects': stored once each.
+  std::vector<MeshDesc*> all;
+  for (MeshDesc& m : desc_.meshes) all.push_back(&m);
+  for (ObjectDesc& o : desc_.objects)
+    for (MeshDesc& m : o.meshes) all.push_back(&m);
   // Per-triangle alpha only for scenes with cutouts.
-  for (const MeshDesc& m : desc_.meshes) {
-    has_alpha_ |= m.alpha.texture >= 0 || m.alpha.value.x < 1.f;
-    has_one_way_faces_ |= m.invisible_from_inside;
+  for (const MeshDesc* m : all) {
+    has_alpha_ |= m->alpha.texture >= 0 || m->alpha.value.x < 1.f;
+    has_one_way_faces_ |= m->invisible_from_inside;
   }
   // Per-triangle media only for scenes that have any (the camera's included).
   has_media_ = (effects_ & kEffectMedia) != 0;
-  bool moves = false, any_normals = false, any_uv = false;
+  MeshLayout layout;
   size_t vertices = 0, triangles = 0;
-  for (const MeshDesc& m : desc_.meshes) {
-    moves |= !m.p_end.empty();
-    any_normals |= !m.n.empty();
-    any_uv |= !m.uv.empty();
-    vertices += m.p.size();
-    triangles += m.indices.size() / 3;
+  for (const MeshDesc* m : all) {
+    layout.moves |= !m->p_end.empty();
+    layout.any_normals |= !m->n.empty();
+    layout.any_uv |= !m->uv.empty();
+    vertices += m->p.size();
+    triangles += m->indices.size() / 3;
   }
   // Sized once: grown by doubling, the arrays would hold up to twice their
   // size, and three times while they move. Per-vertex normals and uv only
   // when some mesh has them (a triangle's flags say whether it reads them).
   positions_.reserve(vertices);
-  if (any_normals) normals_.reserve(vertices);
-  if (any_uv) uvs_.reserve(vertices);
-  if (moves) {
+  if (layout.any_normals) normals_.reserve(vertices);
+  if (layout.any_uv) uvs_.reserve(vertices);
+  if (layout.moves) {
     positions_end_.reserve(vertices);
-    if (any_normals) normals_end_.reserve(vertices);
+    if (layout.any_normals) normals_end_.reserve(vertices);
   }
   indices_.reserve(3 * triangles);
   face_normals_.reserve(triangles);
   triangles_.reserve(triangles);
   if (has_alpha_) triangle_alpha_.reserve(triangles);
   if (has_media_) triangle_media_.reserve(triangles);
-  for (MeshDesc& m : desc_.meshes) {
-    const uint32_t base = static_cast<uint32_t>(positions_.size());
-    const bool has_n = !m.n.empty(), has_uv = !m.uv.empty();
-    for (size_t i = 0; i < m.p.size(); ++i) {
-      positions_.push_back(m.p[i]);
-      if (any_normals) normals_.push_back(has_n ? m.n[i] : Vec3(0.f));
-      if (moves) {
-        const bool moving = m.p_end.size() == m.p.size();
-        positions_end_.push_back(moving ? m.p_end[i] : m.p[i]);
-        if (any_normals)
-          normals_end_.push_back(has_n ? (moving && m.n_end.size() == m.n.size() ? m.n_end[i] : m.n[i]) : Vec3(0.f));
-        if (moving) {
-          bounds_.lo = glm::min(bounds_.lo, m.p_end[i]);
-          bounds_.hi = glm::max(bounds_.hi, m.p_end[i]);
-        }
+  for (MeshDesc& m : desc_.meshes) append_mesh(m, layout, &bounds_);
+  num_world_triangles_ = static_cast<uint32_t>(triangles_.size());
+  std::vector<Bounds> object_bounds(desc_.objects.size());
+  for (size_t i = 0; i < desc_.objects.size(); ++i) {
+    ObjectPrototype proto;
+    proto.first_triangle = static_cast<uint32_t>(triangles_.size());
+    for (MeshDesc& m : desc_.objects[i].meshes) append_mesh(m, layout, &object_bounds[i]);
+    proto.num_triangles = static_cast<uint32_t>(triangles_.size()) - proto.first_triangle;
+    prototypes_.push_back(proto);
+  }
+  place_instances(object_bounds);
+}
+
+namespace {
+
+Affine affine_of(const Mat4& m) { return Affine{Mat3(m), Vec3(m[3])}; }
+
+}  // namespace
+
+// Each instance's maps, and its box (the object's, placed at both ends of
+// the transform interval: a vertex moves on a straight line between its two
+// placements, which both boxes' union holds) in the scene's bounds.
+void SceneData::place_instances(const std::vector<Bounds>& object_bounds) {
+  instances_.reserve(desc_.instances.size());
+  for (const InstanceDesc& desc : desc_.instances) {
+    ObjectInstance inst;
+    inst.prototype = desc.object;
+    inst.render_from_object = affine_of(desc.render_from_object);
+    inst.render_from_object_end = affine_of(desc.render_from_object_end);
+    inst.object_from_render.linear = glm::inverse(inst.render_from_object.linear);
+    inst.object_from_render.offset = -(inst.object_from_render.linear * inst.render_from_object.offset);
+    inst.moves = desc.render_from_object_end != desc.render_from_object;
+    instances_.push_back(inst);
+    const Bounds& b = object_bounds[desc.object];
+    if (!(b.lo.x <= b.hi.x)) continue;
+    for (const Affine* a : {&inst.render_from_object, &inst.render_from_object_end})
+      for (int c = 0; c < 8; ++c) {
+        const Vec3 p = apply_point(*a, Vec3(c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z));
+        bounds_.lo = glm::min(bounds_.lo, p);
+        bounds_.hi = glm::max(bounds_.hi, p);
       }
-      if (any_uv) uvs_.push_back(has_uv ? m.uv[i] : Vec2(0.f));
-      bounds_.lo = glm::min(bounds_.lo, m.p[i]);
-      bounds_.hi = glm::max(bounds_.hi, m.p[i]);
+  }
+}
+
+void SceneData::append_mesh(MeshDesc& m, const MeshLayout& layout, Bounds* bounds) {
+  const uint32_t base = static_cast<uint32_t>(positions_.size());
+  const bool has_n = !m.n.empty(), has_uv = !m.uv.empty();
+  for (size_t i = 0; i < m.p.size(); ++i) {
+    positions_.push_back(m.p[i]);
+    if (layout.any_normals) normals_.push_back(has_n ? m.n[i] : Vec3(0.f));
+    if (layout.moves) {
+      const bool moving = m.p_end.size() == m.p.size();
+      positions_end_.push_back(moving ? m.p_end[i] : m.p[i]);
+      if (layout.any_normals)
+        normals_end_.push_back(has_n ? (moving && m.n_end.size() == m.n.size() ? m.n_end[i] : m.n[i]) : Vec3(0.f));
+      if (moving) {
+        bounds->lo = glm::min(bounds->lo, m.p_end[i]);
+        bounds->hi = glm::max(bounds->hi, m.p_end[i]);
+      }
     }
-    // An area light's "power": each shape's radiance scaled to emit it, as
-    // pbrt-v4 does (L / (pi area sides), over an image's mean luminance).
-    std::vector<double> power_area;
-    double power_per_area = 0.0;
-    if (m.area_light >= 0 && desc_.area_lights[m.area_light].power > 0.f) {
+    if (layout.any_uv) uvs_.push_back(has_uv ? m.uv[i] : Vec2(0.f));
+    bounds->lo = glm::min(bounds->lo, m.p[i]);
+    bounds->hi = glm::max(bounds->hi, m.p[i]);
+  }
+  append_triangles(m, base);
+  // The flat arrays now hold the mesh: its own are not kept for the render
+  // (swapped with empty ones: assigning {} would keep their capacity).
+  std::vector<Vec3>().swap(m.p);
+  std::vector<Vec3>().swap(m.n);
+  std::vector<Vec2>().swap(m.uv);
+  std::vector<uint32_t>().swap(m.indices);
+  std::vector<Vec3>().swap(m.p_end);
+  std::vector<Vec3>().swap(m.n_end);
+}
+
+void SceneData::append_triangles(const MeshDesc& m, uint32_t base) {
+  const bool has_n = !m.n.empty(), has_uv = !m.uv.empty();
+  // An area light's "power": each shape's radiance scaled to emit it, as
+  // pbrt-v4 does (L / (pi area sides), over an image's mean luminance).
+  std::vector<double> power_area;
+  double power_per_area = 0.0;
+  if (m.area_light >= 0 && desc_.area_lights[m.area_light].power > 0.f) {
+    const AreaLightDesc& al = desc_.area_lights[m.area_light];
+    const double k_e = al.image >= 0 ? mean_luminance(desc_.images[al.image]) : 1.0;
+    // A black image emits nothing however it is scaled.
+    power_per_area = k_e > 0.0 ? al.power / (k_e * kPi * (al.two_sided ? 2.0 : 1.0)) : 0.0;
+    power_area = shape_area_per_triangle(m);
+  }
+  TriangleInfo info;
+  info.material = m.material;
+  info.flags = (m.flip_normals ? kTriFlipNormal : 0u) | (has_n ? kTriHasNormals : 0u) | (has_uv ? kTriHasUv : 0u) |
+               (m.invisible_from_inside ? kTriInvisibleFromInside : 0u);
+  for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+    const Vec3 &a = m.p[m.indices[t]], &b = m.p[m.indices[t + 1]], &c = m.p[m.indices[t + 2]];
+    // Degenerate triangles can never be hit or sampled; dropping them keeps
+    // area-light pdfs finite.
+    Vec3 n;
+    double area = 0.0;
+    if (!triangle_normal(a, b, c, &n, &area)) continue;
+    face_normals_.push_back(m.flip_normals ? -n : n);
+    for (int k = 0; k < 3; ++k) indices_.push_back(base + m.indices[t + k]);
+    TriangleInfo ti = info;
+    if (!has_uv && m.triangles_per_shape == 2 && (t / 3) % 2 == 1) ti.flags |= kTriQuadSecondHalf;
+    if (m.area_light >= 0) {
       const AreaLightDesc& al = desc_.area_lights[m.area_light];
-      const double k_e = al.image >= 0 ? mean_luminance(desc_.images[al.image]) : 1.0;
-      // A black image emits nothing however it is scaled.
-      power_per_area = k_e > 0.0 ? al.power / (k_e * kPi * (al.two_sided ? 2.0 : 1.0)) : 0.0;
-      power_area = shape_area_per_triangle(m);
-    }
-    TriangleInfo info;
-    info.material = m.material;
-    info.flags = (m.flip_normals ? kTriFlipNormal : 0u) | (has_n ? kTriHasNormals : 0u) | (has_uv ? kTriHasUv : 0u) |
-                 (m.invisible_from_inside ? kTriInvisibleFromInside : 0u);
-    for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
-      const Vec3 &a = m.p[m.indices[t]], &b = m.p[m.indices[t + 1]], &c = m.p[m.indices[t + 2]];
-      // Degenerate triangles can never be hit or sampled; dropping them keeps
-      // area-light pdfs finite.
-      Vec3 n;
-      double area = 0.0;
-      if (!triangle_normal(a, b, c, &n, &area)) continue;
-      face_normals_.push_back(m.flip_normals ? -n : n);
-      for (int k = 0; k < 3; ++k) indices_.push_back(base + m.indices[t + k]);
-      TriangleInfo ti = info;
-      if (!has_uv && m.triangles_per_shape == 2 && (t / 3) % 2 == 1) ti.flags |= kTriQuadSecondHalf;
-      if (m.area_light >= 0) {
-        const AreaLightDesc& al = desc_.area_lights[m.area_light];
-        if (!is_black(al.L)) {
-          Light l;
-          l.type = LightType::Area;
-          l.L = al.L;
-          l.image = al.image;
-          if (!power_area.empty()) l.L *= static_cast<Float>(power_per_area / power_area[t / 3]);  // area > 0 here
-          l.blackbody_kelvin = al.blackbody_kelvin;
-          l.two_sided = al.two_sided;
-          l.triangle = static_cast<uint32_t>(triangles_.size());
-          l.area = static_cast<Float>(area);
-          ti.light = static_cast<int32_t>(lights_.size());
-          lights_.push_back(l);
-        }
+      if (!is_black(al.L)) {
+        Light l;
+        l.type = LightType::Area;
+        l.L = al.L;
+        l.image = al.image;
+        if (!power_area.empty()) l.L *= static_cast<Float>(power_per_area / power_area[t / 3]);  // area > 0 here
+        l.blackbody_kelvin = al.blackbody_kelvin;
+        l.two_sided = al.two_sided;
+        l.triangle = static_cast<uint32_t>(triangles_.size());
+        l.area = static_cast<Float>(area);
+        ti.light = static_cast<int32_t>(lights_.size());
+        lights_.push_back(l);
       }
-      triangles_.push_back(ti);
-      if (has_alpha_) triangle_alpha_.push_back(m.alpha);
-      if (has_media_) triangle_media_.push_back(m.media);
     }
-    // The flat arrays now hold the mesh: its own are not kept for the render
-    // (swapped with empty ones: assigning {} would keep their capacity).
-    std::vector<Vec3>().swap(m.p);
-    std::vector<Vec3>().swap(m.n);
-    std::vector<Vec2>().swap(m.uv);
-    std::vector<uint32_t>().swap(m.indices);
-    std::vector<Vec3>().swap(m.p_end);
-    std::vector<Vec3>().swap(m.n_end);
+    triangles_.push_back(ti);
+    if (has_alpha_) triangle_alpha_.push_back(m.alpha);
+    if (has_media_) triangle_media_.push_back(m.media);
   }
 }
 
@@ -376,6 +429,12 @@ void SceneData::build_view() {
   v.num_triangles = static_cast<uint32_t>(triangles_.size());
   v.triangle_alpha = has_alpha_ ? triangle_alpha_.data() : nullptr;
   v.has_one_way_faces = has_one_way_faces_;
+  v.num_world_triangles = num_world_triangles_;
+  v.prototypes = prototypes_.data();
+  v.num_prototypes = static_cast<uint32_t>(prototypes_.size());
+  v.instances = instances_.data();
+  v.num_instances = static_cast<uint32_t>(instances_.size());
+  for (const ObjectInstance& inst : instances_) v.instances_move |= inst.moves != 0;
   v.materials = desc_.materials.data();
   v.num_materials = static_cast<uint32_t>(desc_.materials.size());
   v.textures = desc_.textures.data();
@@ -449,6 +508,10 @@ uint64_t SceneData::fingerprint() const {
   }
   uint64_t materials = desc_.materials.size();
   f.add(&materials, sizeof materials);
+  if (!instances_.empty()) {  // only scenes with instances add bytes
+    f.add_vector(prototypes_);
+    f.add_vector(instances_);
+  }
   // Cutouts change what the guide sees (only scenes with them add bytes).
   if (has_alpha_) f.add_vector(triangle_alpha_);
   if (has_media_) {
@@ -484,11 +547,13 @@ uint64_t SceneData::fingerprint() const {
 }
 
 uint64_t SceneData::film_fingerprint() const {
+  bool shapes_move = !positions_end_.empty();
+  for (const ObjectInstance& inst : instances_) shapes_move |= inst.moves != 0;
   // pbrt's defaults give 0, so checkpoints of such scenes keep their fingerprint.
   const FilterDesc default_filter;
   const bool defaults = camera_.pixel_from_radiance == Mat3(1.f) && !std::isfinite(camera_.max_component_value) &&
                         camera_.lens_radius == 0.f && std::memcmp(&desc_.filter, &default_filter, sizeof default_filter) == 0 &&
-                        positions_end_.empty() && !camera_.moves && !desc_.spectral && camera_.film_x0 == 0 &&
+                        !shapes_move && !camera_.moves && !desc_.spectral && camera_.film_x0 == 0 &&
                         camera_.film_y0 == 0 && camera_.film_width == camera_.width && camera_.film_height == camera_.height &&
                         view_.layered_mis_balance && camera_.projection == CameraProjection::Perspective &&
                         !desc_.camera.has_screen_window && desc_.camera.frame_aspect_ratio == 0.f;
@@ -507,7 +572,7 @@ uint64_t SceneData::film_fingerprint() const {
   f.add(&camera_.screen_max, sizeof camera_.screen_max);
   if (!view_.layered_mis_balance) f.add("power-mis", 9);  // "path": the coated BSDFs' picture differs
   if (desc_.spectral) f.add("spectral", 8);  // only then: RGB checkpoints keep their fingerprints
-  if (!positions_end_.empty() || camera_.moves) {  // motion blur: the shutter, the transforms' times, the camera's end
+  if (shapes_move || camera_.moves) {  // motion blur: the shutter, the transforms' times, the camera's end
     f.add(&camera_.world_from_camera_linear_end, sizeof camera_.world_from_camera_linear_end);
     f.add(&camera_.origin_end, sizeof camera_.origin_end);
     const Float times[4] = {camera_.shutter_open, camera_.shutter_close, camera_.transform_start_time,

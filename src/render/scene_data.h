@@ -29,7 +29,7 @@ class SceneData {
   const SceneDesc& desc() const { return desc_; }
   uint32_t effects() const { return effects_; }
   const Bounds& bounds() const { return bounds_; }
-  size_t num_triangles() const { return triangles_.size(); }
+  size_t num_triangles() const { return triangles_.size(); }  // stored once each, instanced ones included
   const std::vector<Vec3>& positions() const { return positions_; }
   const std::vector<uint32_t>& indices() const { return indices_; }
   // A hash of geometry, materials and lights: ties a saved guide cache to its scene.
@@ -42,7 +42,13 @@ class SceneData {
   Float max_emitted_radiance() const;
 
  private:
+  struct MeshLayout {
+    bool moves = false, any_normals = false, any_uv = false;  // which per-vertex arrays exist
+  };
   void flatten_meshes();
+  void append_mesh(MeshDesc& m, const MeshLayout& layout, Bounds* bounds);
+  void append_triangles(const MeshDesc& m, uint32_t base);
+  void place_instances(const std::vector<Bounds>& object_bounds);
   void build_lights();
   void build_camera();
   void build_filter();
@@ -56,6 +62,9 @@ class SceneData {
   std::vector<uint32_t> indices_;
   std::vector<TriangleInfo> triangles_;
   std::vector<Vec3> face_normals_;
+  uint32_t num_world_triangles_ = 0;  // the rest are the prototypes' (kernels/instance.h)
+  std::vector<ObjectPrototype> prototypes_;
+  std::vector<ObjectInstance> instances_;
   std::vector<ImageView> image_views_;
   std::vector<Light> lights_;
   std::vector<int32_t> infinite_lights_;

@@ -12,8 +12,8 @@ namespace {
 
 // A new field in the views must be packed below (or shown not to need it):
 // this fails the build until someone looks.
-static_assert(sizeof(SceneView) == 712, "SceneView changed: pack its new arrays in scene_pack.cpp, then update this size");
-static_assert(sizeof(BvhView) == 24, "BvhView changed: pack its new arrays in scene_pack.cpp, then update this size");
+static_assert(sizeof(SceneView) == 744, "SceneView changed: pack its new arrays in scene_pack.cpp, then update this size");
+static_assert(sizeof(BvhView) == 40, "BvhView changed: pack its new arrays in scene_pack.cpp, then update this size");
 
 template <class S, class F>
 size_t offset_in(const S& object, const F& field) {
@@ -101,6 +101,8 @@ PackedScene::PackedScene(const SceneView& s, const BvhView& bvh) {
   point_view(v.triangles, s.triangles, tris);
   point_view(v.face_normals, s.face_normals, tris);
   point_view(v.triangle_alpha, s.triangle_alpha, tris);
+  point_view(v.prototypes, s.prototypes, s.num_prototypes);
+  point_view(v.instances, s.instances, s.num_instances);
   point_view(v.materials, s.materials, s.num_materials);
   point_view(v.textures, s.textures, s.num_textures);
   pack_images(s);
@@ -129,6 +131,7 @@ PackedScene::PackedScene(const SceneView& s, const BvhView& bvh) {
   point_view(v.spectra, s.spectra, static_cast<size_t>(s.num_spectra) * kSpectralSamples);
   point_view(views_.bvh.nodes, bvh.nodes, bvh.num_nodes);
   point_view(views_.bvh.triangles, bvh.triangles, bvh.num_triangles);
+  point_view(views_.bvh.prototype_roots, bvh.prototype_roots, bvh.num_prototypes);
   if (bytes_.empty()) bytes_.resize(16, 0);
 }
 

@@ -23,6 +23,11 @@ std::string light_paths_obstacle(const SceneDesc& desc) {
   if (desc.camera.world_from_camera_end != desc.camera.world_from_camera) return "the camera moves";
   for (const MeshDesc& m : desc.meshes)
     if (!m.p_end.empty()) return "a shape moves";
+  for (const InstanceDesc& inst : desc.instances)
+    if (inst.render_from_object_end != inst.render_from_object) return "a shape moves";
+  for (const ObjectDesc& o : desc.objects)
+    for (const MeshDesc& m : o.meshes)
+      if (!m.p_end.empty()) return "a shape moves";
   // Light paths connect to the camera through BSDFs evaluated the other way
   // round: the subsurface exit lobe and hair's offset from wo are not
   // reciprocal.

@@ -1,5 +1,7 @@
 #include "scene/pbrt_parser.h"
 
+#include "scene/object_instances.h"
+
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -399,10 +401,12 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
   } else if (d == "ObjectBegin") {
     std::string name = read_string(tokens, pos, at);
     if (!open_instance_.empty()) fail(at, "ObjectBegin \"" + name + "\" inside ObjectBegin \"" + open_instance_ + "\"");
-    if (instances_.count(name)) warn("object \"" + name + "\" redefined");
+    if (objects_.count(name)) warn("object \"" + name + "\" redefined");
     push('o', at);
     open_instance_ = name;
-    instances_[name].clear();
+    // A redefinition is a new object: instances made before it keep the old one.
+    objects_[name] = static_cast<uint32_t>(scene_.objects.size());
+    scene_.objects.push_back(ObjectDesc{name, {}});
   } else if (d == "ObjectEnd") {
     if (open_instance_.empty()) fail(at, "ObjectEnd without matching ObjectBegin");
     pop('o', at);
@@ -410,26 +414,9 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
   } else if (d == "ObjectInstance") {
     std::string name = read_string(tokens, pos, at);
     if (!open_instance_.empty()) fail(at, "ObjectInstance inside ObjectBegin \"" + open_instance_ + "\"");
-    auto it = instances_.find(name);
-    if (it == instances_.end()) fail(at, "unknown object \"" + name + "\"");
-    const bool moves = state_.ctm_end != state_.ctm;
-    for (const MeshDesc& def : it->second) {
-      MeshDesc copy = def;
-      // Definitions are stored in render space; the instance's transform is
-      // world-space, so it acts between world_from_render and render_from_world
-      // (pbrt-v4: RenderFromObject() * worldFromRender).
-      transform_mesh(copy, Mat4(state_.ctm * world_from_render_));
-      if (moves && copy.area_light < 0) {  // the instance moves: its end is the definition under the end transform
-        MeshDesc end = def;
-        if (end.p_end.empty()) end.p_end = end.p, end.n_end = end.n;
-        transform_mesh(end, Mat4(state_.ctm_end * world_from_render_));
-        copy.p_end = std::move(end.p_end);
-        copy.n_end = std::move(end.n_end);
-      }
-      copy.where = at.where();
-      check_coordinates(copy, at);
-      scene_.meshes.push_back(std::move(copy));
-    }
+    auto it = objects_.find(name);
+    if (it == objects_.end()) fail(at, "unknown object \"" + name + "\"");
+    object_instance(at, it->second);
   } else if (d == "ActiveTransform") {
     const Token& which = next_token(tokens, pos, at, "All, StartTime or EndTime");
     if (which.text == "All") state_.active_start = state_.active_end = true;
@@ -486,10 +473,52 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
   }
 }
 
+// The corners of the object's box, placed: within range, then so is every
+// vertex (the cheap test, once per instance, for scenes of many instances).
+bool PbrtParser::placed_within_range(const ObjectDesc& object, const InstanceDesc& inst) const {
+  Vec3 lo(INFINITY), hi(-INFINITY);
+  for (const MeshDesc& m : object.meshes)
+    for (const std::vector<Vec3>* points : {&m.p, &m.p_end})
+      for (const Vec3& p : *points) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  if (!(lo.x <= hi.x)) return true;
+  for (const Mat4* map : {&inst.render_from_object, &inst.render_from_object_end})
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 corner(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+      if (!representable(Vec3(*map * Vec4(corner, 1.f)))) return false;
+    }
+  return true;
+}
+
 void PbrtParser::check_coordinates(const MeshDesc& mesh, const Token& at) const {
   for (const std::vector<Vec3>* points : {&mesh.p, &mesh.p_end})
     for (const Vec3& p : *points)
       if (!representable(p)) fail(at, "a vertex of the shape is " + describe_far(p, scene_.render_origin));
+}
+
+// Definitions are stored in render space; the instance's transform is
+// world-space, so it acts between world_from_render and render_from_world
+// (pbrt-v4: RenderFromObject() * worldFromRender).
+void PbrtParser::object_instance(const Token& at, uint32_t object) {
+  InstanceDesc inst;
+  inst.object = object;
+  inst.render_from_object = Mat4(state_.ctm * world_from_render_);
+  inst.render_from_object_end = state_.ctm_end != state_.ctm ? Mat4(state_.ctm_end * world_from_render_)
+                                                             : inst.render_from_object;
+  inst.where = at.where();
+  inst.meshes_before = scene_.meshes.size();
+  const ObjectDesc& def = scene_.objects[object];
+  // A singular map flattens the object (into a plane, a line or a point):
+  // placed as ordinary meshes, as drawn without instancing.
+  const bool singular = glm::determinant(Mat3(inst.render_from_object)) == 0.f ||
+                        glm::determinant(Mat3(inst.render_from_object_end)) == 0.f;
+  if (singular || !placed_within_range(def, inst)) {
+    for (MeshDesc& m : placed_meshes(def, inst)) {
+      check_coordinates(m, at);
+      scene_.meshes.push_back(std::move(m));
+    }
+    return;
+  }
+  scene_.instances.push_back(std::move(inst));
 }
 
 void PbrtParser::camera(const Token& at, const std::string& type, const ParamSet& params) {
@@ -627,7 +656,7 @@ void PbrtParser::shape(const Token& at, const std::string& type, const ParamSet&
       scene_.warnings.push_back(at.where() + ": area lights inside ObjectBegin are not supported (as in pbrt-v4); not emissive");
       mesh->area_light = -1;
     }
-    instances_[open_instance_].push_back(std::move(*mesh));
+    scene_.objects[objects_.at(open_instance_)].meshes.push_back(std::move(*mesh));
   } else {
     check_coordinates(*mesh, at);
     scene_.meshes.push_back(std::move(*mesh));
@@ -642,10 +671,13 @@ void PbrtParser::resolve_media() {
     index[ref.code] = static_cast<int16_t>(it->second);
   }
   auto resolve = [&](int16_t code) -> int16_t { return code <= -2 ? index.at(code) : code; };
-  for (MeshDesc& m : scene_.meshes) {
+  auto resolve_mesh = [&](MeshDesc& m) {
     m.media.inside = resolve(m.media.inside);
     m.media.outside = resolve(m.media.outside);
-  }
+  };
+  for (MeshDesc& m : scene_.meshes) resolve_mesh(m);
+  for (ObjectDesc& o : scene_.objects)
+    for (MeshDesc& m : o.meshes) resolve_mesh(m);
   scene_.camera_medium = resolve(static_cast<int16_t>(scene_.camera_medium));
   for (Light& l : scene_.lights) l.medium = resolve(static_cast<int16_t>(l.medium));
 }
@@ -656,7 +688,9 @@ SceneDesc PbrtParser::finish(const std::string& file_name, int last_line) {
   if (!open_instance_.empty()) scene_.warnings.push_back(where + ": ObjectBegin \"" + open_instance_ + "\" not closed");
   for (const StackEntry& e : stack_)
     if (e.kind != 'o') scene_.warnings.push_back(e.where + ": block not closed before end of file");
-  if (scene_.meshes.empty() && scene_.lights.empty()) throw SceneError(where + ": empty scene (no shapes and no lights)");
+  settle_instances(scene_);
+  if (scene_.meshes.empty() && scene_.instances.empty() && scene_.lights.empty())
+    throw SceneError(where + ": empty scene (no shapes and no lights)");
   resolve_media();
   set_film_sensor(scene_.film, scene_.camera.exposure_time);
   return std::move(scene_);

@@ -52,6 +52,8 @@ class PbrtParser {
   // Fails unless every vertex (and its end position when it moves) is within
   // the range single-precision ray tracing represents.
   void check_coordinates(const MeshDesc& mesh, const Token& at) const;
+  bool placed_within_range(const ObjectDesc& object, const InstanceDesc& inst) const;
+  void object_instance(const Token& at, uint32_t object);
   void push(char kind, const Token& at);
   void pop(char kind, const Token& at);
   void require_world(const Token& at, bool inside) const;
@@ -74,7 +76,7 @@ class PbrtParser {
   // camera; SceneDesc::render_origin says where that origin is in the world.
   DMat4 render_from_world_{1.0};
   DMat4 world_from_render_{1.0};
-  std::map<std::string, std::vector<MeshDesc>> instances_;
+  std::map<std::string, uint32_t> objects_;  // ObjectBegin names -> SceneDesc::objects (the latest definition)
   std::string open_instance_;  // non-empty between ObjectBegin and ObjectEnd
   struct MediumRef {
     int16_t code;       // what MeshDesc::media holds until resolve_media(): -2 - k

@@ -55,6 +55,28 @@ struct MeshDesc {
   std::string where;            // "file:line" of the Shape directive, for messages
 };
 
+// An ObjectBegin / ObjectEnd definition used by more than one
+// ObjectInstance: its shapes stored once, in render space as the definition
+// placed them (never emissive: pbrt-v4 has no area lights in instances).
+struct ObjectDesc {
+  std::string name;
+  std::vector<MeshDesc> meshes;
+};
+
+// One ObjectInstance of an ObjectDesc (SceneDesc::objects): the object's
+// render space mapped into the scene's, at the start and at the end of the
+// transform interval (equal unless the instance moves). An object instanced
+// once, or an instance whose map is singular, is placed as ordinary meshes
+// instead (scene/object_instances.h).
+struct InstanceDesc {
+  uint32_t object = 0;
+  Mat4 render_from_object{1.f}, render_from_object_end{1.f};
+  std::string where;  // "file:line" of the ObjectInstance
+  // How many meshes preceded it in the file: flattened, it goes there, so
+  // that a scene reads into the same triangle order with or without instancing.
+  size_t meshes_before = 0;
+};
+
 struct AreaLightDesc {
   Rgb L{1.f};  // radiance with "scale" folded in; with an image, what multiplies its texels
   Float blackbody_kelvin = 0.f;  // "blackbody L": its temperature (spectral mode emits Planck's law)
@@ -183,6 +205,8 @@ struct SceneDesc {
   // each at 360, 365, ..., 830 nm: see add_sampled_spectrum().
   std::vector<Float> spectra;
   std::vector<MeshDesc> meshes;
+  std::vector<ObjectDesc> objects;      // instanced geometry (each used by two or more instances)
+  std::vector<InstanceDesc> instances;
   std::vector<Material> materials;  // never empty after loading (index 0 = pbrt's default diffuse 0.5)
   std::vector<Texture> textures;
   std::vector<ImageDesc> images;

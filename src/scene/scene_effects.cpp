@@ -70,8 +70,8 @@ void add_material_effects(const SceneDesc& scene, int32_t index, uint32_t& e, in
 uint32_t compute_effects(const SceneDesc& scene) {
   uint32_t e = 0;
   std::vector<bool> seen(scene.materials.size(), false);
-  for (const MeshDesc& m : scene.meshes) {
-    if (m.indices.empty()) continue;
+  auto add_mesh = [&](const MeshDesc& m) {
+    if (m.indices.empty()) return;
     if (m.material >= 0 && m.material < static_cast<int32_t>(seen.size()) && !seen[m.material]) {
       seen[m.material] = true;
       add_material_effects(scene, m.material, e, 0);
@@ -81,7 +81,12 @@ uint32_t compute_effects(const SceneDesc& scene) {
     if (m.alpha.texture >= 0 || m.alpha.value.x < 1.f) e |= kEffectAlpha;
     if (m.media.inside >= 0 || m.media.outside >= 0) e |= kEffectMedia;
     if (!m.p_end.empty()) e |= kEffectMotionBlur;
-  }
+  };
+  for (const MeshDesc& m : scene.meshes) add_mesh(m);
+  for (const ObjectDesc& o : scene.objects)
+    for (const MeshDesc& m : o.meshes) add_mesh(m);
+  for (const InstanceDesc& inst : scene.instances)
+    if (inst.render_from_object_end != inst.render_from_object) e |= kEffectMotionBlur;
   if (scene.camera_medium >= 0) e |= kEffectMedia;
   if (scene.camera.world_from_camera_end != scene.camera.world_from_camera) e |= kEffectMotionBlur;
   for (const Light& l : scene.lights) {

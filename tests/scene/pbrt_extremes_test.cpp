@@ -51,6 +51,10 @@ TEST(PbrtExtremes, FarVerticesAreAnError) {
                                "WorldBegin\nObjectBegin \"o\"\n" + test::kTriangle + "ObjectEnd\nTranslate 5e18 0 0\n"
                                "ObjectInstance \"o\"\n";
   EXPECT_ERROR_CONTAINS(load_error(instance), "a vertex of the shape is at (5e+18");
+  // One of several instances (kept instanced, checked by the object's box).
+  const std::string second = std::string(kCamera) + "WorldBegin\nObjectBegin \"o\"\n" + test::kTriangle +
+                             "ObjectEnd\nObjectInstance \"o\"\nTranslate 0 -5e18 0\nObjectInstance \"o\"\n";
+  EXPECT_ERROR_CONTAINS(load_error(second), "bad.pbrt:9: a vertex of the shape is at (0, -5e+18");
 }
 
 // Light paths start at a light's position, where Embree refuses rays past

@@ -1,5 +1,6 @@
 // Transform directives, graphics-state blocks, Include and object instancing.
 #include "scene_test_helpers.h"
+#include "scene/object_instances.h"
 
 namespace tessera {
 namespace {
@@ -121,15 +122,47 @@ TEST(PbrtTransform, IncludeIsRelativeToIncludingFileAndKeepsState) {
   EXPECT_NE(s.meshes[0].where.find("box.pbrt:2"), std::string::npos);
 }
 
-TEST(PbrtTransform, ObjectInstanceCopiesWithInstanceTransform) {
+TEST(PbrtTransform, ObjectInstancesPlaceTheDefinitionByTheirTransform) {
   SceneDesc s = load_world(std::string("ObjectBegin \"tri\"\nTranslate 0 0 1\n") + kTriangle +
                            "ObjectEnd\nTranslate 10 0 0\nObjectInstance \"tri\"\nScale -1 1 1\nObjectInstance \"tri\"\n");
-  ASSERT_EQ(s.meshes.size(), 2u);  // the definition itself is not rendered
-  EXPECT_VEC3_NEAR(s.meshes[0].p[1], Vec3(11, 0, 1), 1e-6f);
-  EXPECT_FALSE(s.meshes[0].flip_normals);
-  EXPECT_VEC3_NEAR(s.meshes[1].p[1], Vec3(9, 0, 1), 1e-6f);
-  EXPECT_TRUE(s.meshes[1].flip_normals);
-  EXPECT_EQ(s.meshes[1].where, "test.pbrt:9");
+  EXPECT_TRUE(s.meshes.empty());  // the definition itself is not rendered
+  ASSERT_EQ(s.objects.size(), 1u);
+  ASSERT_EQ(s.instances.size(), 2u);  // stored once, placed twice
+  const std::vector<MeshDesc> first = placed_meshes(s.objects[0], s.instances[0]);
+  const std::vector<MeshDesc> second = placed_meshes(s.objects[0], s.instances[1]);
+  EXPECT_VEC3_NEAR(first[0].p[1], Vec3(11, 0, 1), 1e-6f);
+  EXPECT_FALSE(first[0].flip_normals);
+  EXPECT_VEC3_NEAR(second[0].p[1], Vec3(9, 0, 1), 1e-6f);
+  EXPECT_TRUE(second[0].flip_normals);
+  EXPECT_EQ(second[0].where, "test.pbrt:9");
+}
+
+// An object instanced once is placed as ordinary meshes (nothing to share),
+// as is an instance whose transform is singular (it flattens the object).
+TEST(PbrtTransform, ObjectsUsedOnceAndSingularInstancesAreFlattened) {
+  SceneDesc once = load_world(std::string("ObjectBegin \"tri\"\n") + kTriangle +
+                              "ObjectEnd\nTranslate 10 0 0\nObjectInstance \"tri\"\n");
+  EXPECT_TRUE(once.objects.empty());
+  EXPECT_TRUE(once.instances.empty());
+  ASSERT_EQ(once.meshes.size(), 1u);
+  EXPECT_EQ(once.meshes[0].where, "test.pbrt:6");
+  SceneDesc flat = load_world(std::string("ObjectBegin \"tri\"\n") + kTriangle +
+                              "ObjectEnd\nObjectInstance \"tri\"\nScale 1 1 0\nObjectInstance \"tri\"\n");
+  EXPECT_TRUE(flat.objects.empty());  // the singular one is flattened; the other is then the only instance
+  EXPECT_TRUE(flat.instances.empty());
+  ASSERT_EQ(flat.meshes.size(), 2u);
+  for (const MeshDesc& m : flat.meshes) EXPECT_EQ(m.p.size(), 3u);
+}
+
+// A redefined object is a new one: instances made before keep the old shapes.
+TEST(PbrtTransform, RedefiningAnObjectKeepsEarlierInstances) {
+  const std::string tri = kTriangle;
+  SceneDesc s = load_world("ObjectBegin \"o\"\n" + tri + "ObjectEnd\nObjectInstance \"o\"\nObjectInstance \"o\"\n" +
+                           "ObjectBegin \"o\"\n" + tri + tri + "ObjectEnd\nObjectInstance \"o\"\nObjectInstance \"o\"\n");
+  ASSERT_EQ(s.objects.size(), 2u);
+  ASSERT_EQ(s.instances.size(), 4u);
+  EXPECT_EQ(s.objects[s.instances[0].object].meshes.size(), 1u);
+  EXPECT_EQ(s.objects[s.instances[3].object].meshes.size(), 2u);
 }
 
 // Transform numbers are read in double: an object at x = 1000000.3 seen from
