@@ -30,7 +30,10 @@ int run_info(const std::string& path) {
   std::printf("scene:          %s\n", scene.desc().source.c_str());
   std::printf("resolution:     %s, %d spp, max depth %d\n", describe_film_size(v.camera).c_str(), scene.desc().spp,
               scene.desc().max_depth);
-  std::printf("shapes:         %zu meshes, %zu triangles\n", meshes, scene.num_triangles());
+  std::printf("shapes:         %zu meshes, %zu triangles", meshes, scene.num_triangles());
+  if (v.num_instances > 0)
+    std::printf(" (%u instances of %u objects, whose triangles are counted once)", v.num_instances, v.num_prototypes);
+  std::printf("\n");
   std::printf("materials:      %zu\n", materials);
   std::printf("textures:       %zu (%zu images)\n", textures, scene.desc().images.size());
   uint32_t area = 0;

@@ -28,6 +28,7 @@
 #include "app/memory_check.h"
 #include "scene/object_instances.h"
 #include "scene/light_paths.h"
+#include "scene/load_stop.h"
 #include "scene/spectral_choice.h"
 #include "render/backends.h"
 #include "render/cpu_affinity.h"
@@ -514,8 +515,14 @@ int run_render(const RenderArgs& a) {
   // Open MPI's launcher (not srun) starts its kill sequence with SIGCONT.
   const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
   install_interrupt_handlers(std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr, rank == nullptr || std::string(rank) == "0");
-  const int rc = launched_by_mpirun() ? run_render_farm(a) : run_render_local(a);
-  return rc == 0 && interrupt_requested() ? 130 : rc;
+  set_load_stop_check(interrupt_requested);  // a signal while the scene loads stops the load
+  try {
+    const int rc = launched_by_mpirun() ? run_render_farm(a) : run_render_local(a);
+    return rc == 0 && interrupt_requested() ? 130 : rc;
+  } catch (const LoadInterrupted& e) {
+    std::fprintf(stderr, "tessera: %s\n", e.what());
+    return 130;
+  }
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include "kernels/hit_filter.h"
 #include "render/render_tile_impl.h"
+#include "scene/load_stop.h"
 
 #include <algorithm>
 #include <array>
@@ -71,8 +72,12 @@ void EmbreeScene::release() {
 // leave a closed albedo-1 sphere within 1000 bounces there
 // (tests/render/furnace_test.cpp). A closed mesh that leaks light is a wrong
 // picture; docs/backends.md gives robust mode's cost.
+// A large scene's build takes seconds: Ctrl-C stops it as it stops loading.
+static bool continue_build(void*, double) { return !load_stop_requested(); }
+
 RTCScene EmbreeScene::new_scene() {
   RTCScene scene = rtcNewScene(device_);
+  rtcSetSceneProgressMonitorFunction(scene, continue_build, nullptr);
   rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
   rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
   return scene;
@@ -142,6 +147,7 @@ void EmbreeScene::build(const SceneData& data) {
     prototypes_.push_back(new_scene());
     attach_triangles(data, prototypes_.back(), s.prototypes[i].first_triangle, s.prototypes[i].num_triangles, 0);
     rtcCommitScene(prototypes_.back());
+    check_load_stop();
   }
   scene_ = new_scene();
   attach_triangles(data, scene_, 0, s.num_world_triangles, 0);
@@ -151,6 +157,7 @@ void EmbreeScene::build(const SceneData& data) {
     instance_first_.push_back(s.prototypes[s.instances[i].prototype].first_triangle);
   }
   rtcCommitScene(scene_);
+  check_load_stop();  // a cancelled build is an interrupted load, not an error
   if (!error_.empty()) fail("building the scene failed");
 }
 

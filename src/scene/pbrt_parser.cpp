@@ -1,5 +1,6 @@
 #include "scene/pbrt_parser.h"
 
+#include "scene/load_stop.h"
 #include "scene/object_instances.h"
 
 #include <cmath>
@@ -157,7 +158,10 @@ int PbrtParser::parse_stream(std::istream& in, const std::string& file_name, con
 
 void PbrtParser::parse_tokens(TokenStream& tokens, const std::string& including_dir) {
   size_t pos = 0;
-  while (tokens.has(pos)) directive(tokens, pos, including_dir);
+  while (tokens.has(pos)) {
+    check_load_stop();
+    directive(tokens, pos, including_dir);
+  }
 }
 
 void PbrtParser::require_world(const Token& at, bool inside) const {

@@ -20,6 +20,7 @@
 #include <optional>
 #include <sstream>
 
+#include "scene/load_stop.h"
 #include "scene/scene_desc.h"
 #include "scene/system_memory.h"
 
@@ -364,6 +365,7 @@ void read_vertices(const PlyElement& e, BodyReader& in, PlyMesh& out, const PlyF
   if (has_normals) out.n.resize(e.count);
   if (has_uv) out.uv.resize(e.count);
   for (uint64_t v = 0; v < e.count; ++v) {
+    if ((v & 0xffff) == 0) check_load_stop();  // a large mesh takes seconds
     float values[8] = {0, 0, 0, 0, 0, 0, 0, 0};
     for (size_t k = 0; k < e.properties.size(); ++k) {
       const PlyProperty& p = e.properties[k];
@@ -391,6 +393,7 @@ void read_faces(const PlyElement& e, BodyReader& in, PlyMesh& out, uint64_t vert
   // triangle mesh. A triangle takes at least 4 bytes of the file.
   out.indices.reserve(3 * static_cast<size_t>(std::min<uint64_t>(e.count, in.bytes_left() / 4 + 1)));
   for (uint64_t f = 0; f < e.count; ++f) {
+    if ((f & 0xffff) == 0) check_load_stop();
     for (const PlyProperty& p : e.properties) {
       if (!p.is_list) {
         in.read(p.type);  // e.g. pbrt's face_indices (Ptex face ids): not used
