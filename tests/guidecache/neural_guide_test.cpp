@@ -7,6 +7,7 @@
 #include <random>
 #include <cstring>
 #include <sstream>
+#include <stdexcept>
 
 #include "guidecache/table/guide_field.h"
 #include "guidecache/neural/neural_guide.h"
@@ -14,6 +15,21 @@
 
 namespace tessera {
 namespace {
+
+// A saved network (version 6: the magic and cereal's endianness byte, the
+// version, the payload's size and checksum, then the payload with its own
+// endianness byte) rewritten as version 5, which had no checksum: raw damage
+// then reaches the range checks behind it.
+std::string as_version5(const std::string& file) {
+  constexpr size_t kVersionAt = sizeof "tessera-neural-guide" + 1, kPayloadAt = kVersionAt + 4 + 8 + 8;
+  uint32_t version = 0;
+  std::memcpy(&version, file.data() + kVersionAt, 4);
+  if (version != 6) throw std::logic_error("not the layout as_version5 knows");
+  std::string v5 = file.substr(0, kVersionAt);
+  version = 5;
+  v5.append(reinterpret_cast<const char*>(&version), 4);
+  return v5 + file.substr(kPayloadAt + 1);
+}
 
 NeuralGuideConfig small_config(uint32_t width = 8) {
   NeuralGuideConfig c;
@@ -383,7 +399,7 @@ TEST(NeuralGuide, HashTableSizeIsASettingThatRoundTrips) {
   EXPECT_THROW(make(c), std::runtime_error);
   c.table_log2 = kNeuralMinTableLog2 - 1;
   EXPECT_THROW(make(c), std::runtime_error);
-  std::string file = bytes.str();
+  std::string file = as_version5(bytes.str());
   // The config follows the magic, cereal's endianness byte, the version and
   // the scene fingerprint: width, steps, rate, mixture, floor, targets, table.
   const size_t at = sizeof "tessera-neural-guide" + 1 + 4 + 8 + 4 * 6;
@@ -396,7 +412,7 @@ TEST(NeuralGuide, HashTableSizeIsASettingThatRoundTrips) {
     EXPECT_THROW(NeuralGuide::load(damaged, 3), std::runtime_error) << bad;
   }
   // The learned light count follows the config (after its 64-bit seed).
-  file = bytes.str();
+  file = as_version5(bytes.str());
   std::memcpy(&word, file.data() + at + 4 + 8, 4);
   ASSERT_EQ(word, 0u) << "the file's layout changed: update the offset";
   for (uint32_t bad : {1u, kNeuralMinLights - 1, kNeuralMaxLights + 1}) {
@@ -417,6 +433,21 @@ TEST(NeuralGuide, LoadRejectsOtherScenesAndDamage) {
   EXPECT_THROW(NeuralGuide::load(cut, 7), std::runtime_error);
   std::stringstream junk(std::string("tessera-nothing-at-all-here"));
   EXPECT_THROW(load_guide(junk, 7), std::runtime_error);
+  // Any damaged byte of the payload fails its checksum before a field is read.
+  for (size_t at : {s.size() / 3, s.size() / 2, s.size() - 1}) {
+    std::string damaged = s;
+    damaged[at] = static_cast<char>(damaged[at] ^ 0x10);
+    std::stringstream in(damaged);
+    try {
+      NeuralGuide::load(in, 7);
+      ADD_FAILURE() << "a damaged byte at " << at << " was accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("checksum"), std::string::npos) << e.what();
+    }
+  }
+  // A version-5 file (no checksum) still loads.
+  std::stringstream v5(as_version5(s));
+  EXPECT_TRUE(*NeuralGuide::load(v5, 7) == g);
 }
 
 // Version 3 numbered the bins row-major, this version by tiles: a version-3
@@ -429,7 +460,7 @@ TEST(NeuralGuide, AVersion3FileIsReadWithItsBinsRenumbered) {
   g.train_on({{0, random_samples(200, 1, 2.f)}});
   std::stringstream bytes;
   g.save(bytes, 5);
-  std::string file = bytes.str();
+  std::string file = as_version5(bytes.str());
   const size_t at = sizeof "tessera-neural-guide" + 1;  // after the magic and cereal's endianness byte
   uint32_t version = 0;
   std::memcpy(&version, file.data() + at, 4);

@@ -153,6 +153,8 @@ class NeuralGuide final : public Guide {
 
   template <class Archive>
   void serialize(Archive& ar);
+  template <class Archive>
+  void read_fields(Archive& ar, uint32_t version, uint64_t scene_fingerprint);
 
  private:
   void init_params();

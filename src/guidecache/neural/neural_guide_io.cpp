@@ -8,8 +8,10 @@
 #include <new>
 #include <ostream>
 #include <stdexcept>
+#include <sstream>
 #include <string>
 
+#include "guidecache/guide_file.h"
 #include "guidecache/table/guide_field.h"
 #include "guidecache/neural/neural_guide.h"
 
@@ -33,20 +35,45 @@ constexpr char kTableMagic[] = "tessera-guide-cache";
 // 2: the hash table's size is a setting; 3: learned light selection; 4: bins
 // numbered by tiles (version 3's, numbered row-major, are read and
 // renumbered); 5: the learned mixture weight (versions 3 and 4 are read
-// with none chosen yet, learning it).
-constexpr uint32_t kNeuralVersion = 5;
+// with none chosen yet, learning it); 6: the payload's size and checksum
+// ahead of it (guide_file.h), the fingerprint and version 5's fields inside
+// it. Versions 3 to 5 are read with every range check, without a checksum.
+constexpr uint32_t kNeuralVersion = 6;
+constexpr uint32_t kNeuralUncheckedVersion = 5;
 constexpr uint32_t kNeuralRowMajorVersion = 3;
 }  // namespace
 
 void NeuralGuide::save(std::ostream& out, uint64_t scene_fingerprint) const {
+  std::ostringstream body(std::ios::binary);
+  {
+    cereal::PortableBinaryOutputArchive ar(body);
+    ar(scene_fingerprint);
+    const_cast<NeuralGuide*>(this)->serialize(ar);
+    // Version 5's fields, after version 4's.
+    const uint8_t learn_mix = config_.learn_mix ? 1 : 0;
+    ar(learn_mix, mix_candidate_, totals_.mix_vertices, totals_.mix_rejected);
+  }
+  const std::string payload = body.str();
   out.write(kNeuralMagic, sizeof kNeuralMagic);
   cereal::PortableBinaryOutputArchive ar(out);
-  ar(kNeuralVersion, scene_fingerprint);
-  const_cast<NeuralGuide*>(this)->serialize(ar);
-  // Version 5's fields, after version 4's.
-  const uint8_t learn_mix = config_.learn_mix ? 1 : 0;
-  ar(learn_mix, mix_candidate_, totals_.mix_vertices, totals_.mix_rejected);
+  ar(kNeuralVersion, static_cast<uint64_t>(payload.size()), guide_payload_checksum(payload));
+  out.write(payload.data(), static_cast<std::streamsize>(payload.size()));
   if (!out) throw std::runtime_error("write failed");
+}
+
+// The fingerprint and the fields (of `version`'s layout) from `ar`.
+template <class Archive>
+void NeuralGuide::read_fields(Archive& ar, uint32_t version, uint64_t scene_fingerprint) {
+  uint64_t fingerprint = 0;
+  ar(fingerprint);
+  if (fingerprint != scene_fingerprint) throw std::runtime_error("neural guide was learned on another scene");
+  serialize(ar);
+  if (version >= 5) {
+    uint8_t learn_mix = 0;
+    ar(learn_mix, mix_candidate_, totals_.mix_vertices, totals_.mix_rejected);
+    if (learn_mix > 1) throw std::runtime_error("corrupt neural guide (mixture setting)");
+    config_.learn_mix = learn_mix == 1;
+  }
 }
 
 std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_fingerprint) {
@@ -57,18 +84,20 @@ std::unique_ptr<NeuralGuide> NeuralGuide::load(std::istream& in, uint64_t scene_
   uint32_t version = 0;
   try {
     cereal::PortableBinaryInputArchive ar(in);
-    uint64_t fingerprint = 0;
-    ar(version, fingerprint);
+    ar(version);
     if (version < kNeuralRowMajorVersion || version > kNeuralVersion)
       throw std::runtime_error("neural guide version " + std::to_string(version) + ", this build reads versions " +
                                std::to_string(kNeuralRowMajorVersion) + " to " + std::to_string(kNeuralVersion));
-    if (fingerprint != scene_fingerprint) throw std::runtime_error("neural guide was learned on another scene");
-    g->serialize(ar);
-    if (version >= 5) {
-      uint8_t learn_mix = 0;
-      ar(learn_mix, g->mix_candidate_, g->totals_.mix_vertices, g->totals_.mix_rejected);
-      if (learn_mix > 1) throw std::runtime_error("corrupt neural guide (mixture setting)");
-      g->config_.learn_mix = learn_mix == 1;
+    if (version > kNeuralUncheckedVersion) {
+      uint64_t size = 0, checksum = 0;
+      ar(size, checksum);
+      std::istringstream payload(read_guide_payload(in, size, checksum, "neural guide"), std::ios::binary);
+      cereal::PortableBinaryInputArchive body(payload);
+      g->read_fields(body, version, scene_fingerprint);
+      if (payload.peek() != std::istream::traits_type::eof())
+        throw std::runtime_error("corrupt neural guide (bytes after its fields)");
+    } else {
+      g->read_fields(ar, version, scene_fingerprint);
     }
   } catch (const cereal::Exception& e) {
     throw std::runtime_error(std::string("corrupt or truncated neural guide (") + e.what() + ")");
