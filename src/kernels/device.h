@@ -18,11 +18,16 @@
 // always inline on the CPU, where a call would take the address of the
 // caller's path state and keep it out of registers (docs/development.md).
 #define TESSERA_COLD_STAGE __noinline__
+// Cold code taking only values (never the address of the caller's path
+// state): out of line on both, so the hot loop's registers are not
+// allocated around it.
+#define TESSERA_NOINLINE __noinline__
 #else
 #define TESSERA_HOST_DEVICE
 #define TESSERA_INLINE inline __attribute__((always_inline))
 #define TESSERA_DEVICE_NOINLINE
 #define TESSERA_COLD_STAGE inline __attribute__((always_inline))
+#define TESSERA_NOINLINE inline __attribute__((noinline))
 #endif
 
 // TESSERA_PREFETCH hints that memory will be read soon: a no-op on the GPU,

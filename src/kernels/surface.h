@@ -11,7 +11,10 @@ struct TraceHit {
   Float t;
   uint32_t triangle;
   Float b1, b2;  // barycentrics of vertices 1 and 2
-  int32_t instance = -1;  // the ObjectInstance whose prototype holds the triangle; -1: the world's own
+  // The ObjectInstance whose prototype holds the triangle; -1: the world's
+  // own. Set by every ray query that reports a hit (no initialiser: path
+  // state is not written twice per ray).
+  int32_t instance;
 };
 
 struct SurfaceHit {
@@ -21,7 +24,7 @@ struct SurfaceHit {
   Vec3 ns;     // unit shading normal (== ng without vertex normals)
   Vec2 uv;
   uint32_t triangle;
-  int32_t instance = -1;  // as TraceHit's: p, ng and ns are in render space either way
+  int32_t instance;  // as TraceHit's (set by make_surface_hit): p, ng and ns are in render space either way
 };
 
 // The uv at barycentrics (b1, b2): interpolated, or pbrt's default
@@ -98,6 +101,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& 
   const bool moving = s.positions_end && time > 0.f;
   SurfaceHit h;
   h.triangle = tri;
+  h.instance = -1;
   h.p = b0 * p0 + b1 * p1 + b2 * p2;
   // pbrt-v4: gamma(7) * sum |b_i p_i| bounds the rounding error of h.p.
   h.p_error = kGamma7 * (abs3(b0 * p0) + abs3(b1 * p1) + abs3(b2 * p2));
@@ -126,13 +130,14 @@ TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& 
 // A hit on an instance's prototype: reconstructed in the prototype's space
 // (where its vertices are), then carried into render space; the normals by
 // the inverse transpose, ng turned to ns's side again as make_surface_hit
-// does (a non-uniform scale can change which side that is).
-TESSERA_HOST_DEVICE inline SurfaceHit make_instanced_surface_hit(const SceneView& s, const TraceHit& hit, Float time,
-                                                                 const RayPoint* ray) {
+// does (a non-uniform scale can change which side that is). Out of line and
+// given values only, so that the world's hits do not pay for it in registers.
+TESSERA_HOST_DEVICE TESSERA_NOINLINE SurfaceHit make_instanced_surface_hit(const SceneView& s, TraceHit hit, Float time,
+                                                                           bool has_ray, RayPoint ray) {
   const InstancePlacement place = placement_at(s.instances[hit.instance], time);
   RayPoint local;
-  if (ray) local = RayPoint{apply_point(place.object_from_render, ray->o), apply_vector(place.object_from_render, ray->d), ray->t};
-  SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, time, ray ? &local : nullptr);
+  if (has_ray) local = RayPoint{apply_point(place.object_from_render, ray.o), apply_vector(place.object_from_render, ray.d), ray.t};
+  SurfaceHit h = make_surface_hit(s, hit.triangle, hit.b1, hit.b2, time, has_ray ? &local : nullptr);
   h.instance = hit.instance;
   h.p_error = mapped_point_error(place.render_from_object, h.p, h.p_error);
   h.p = apply_point(place.render_from_object, h.p);
@@ -154,7 +159,7 @@ TESSERA_HOST_DEVICE inline SurfaceHit make_instanced_surface_hit(const SceneView
 // The surface at a ray query's hit, on the world's triangles or an instance's.
 TESSERA_HOST_DEVICE TESSERA_INLINE SurfaceHit make_surface_hit(const SceneView& s, const TraceHit& hit, Float time = 0.f,
                                                                const RayPoint* ray = nullptr) {
-  if (hit.instance >= 0) return make_instanced_surface_hit(s, hit, time, ray);
+  if (hit.instance >= 0) return make_instanced_surface_hit(s, hit, time, ray != nullptr, ray ? *ray : RayPoint{});
   return make_surface_hit(s, hit.triangle, hit.b1, hit.b2, time, ray);
 }
 
@@ -219,11 +224,16 @@ TESSERA_HOST_DEVICE inline Vec3 surface_dp_duv(const SceneView& s, uint32_t tri,
 TESSERA_HOST_DEVICE inline Vec3 surface_dpdu(const SceneView& s, uint32_t tri) { return surface_dp_duv(s, tri, 0); }
 TESSERA_HOST_DEVICE inline Vec3 surface_dpdv(const SceneView& s, uint32_t tri) { return surface_dp_duv(s, tri, 1); }
 
+// A vector of an instance's prototype in render space (out of line: the
+// world's hits do not pay for it in code size where they are inlined).
+TESSERA_HOST_DEVICE TESSERA_NOINLINE Vec3 instance_vector_to_render(const SceneView& s, int32_t instance, Vec3 d, Float time) {
+  return apply_vector(placement_at(s.instances[instance], time).render_from_object, d);
+}
+
 // In render space: an instance's tangents carried out of its prototype's space.
 TESSERA_HOST_DEVICE inline Vec3 surface_dp_duv(const SceneView& s, const SurfaceHit& h, int axis, Float time) {
   const Vec3 d = surface_dp_duv(s, h.triangle, axis);
-  if (h.instance < 0) return d;
-  return apply_vector(placement_at(s.instances[h.instance], time).render_from_object, d);
+  return h.instance < 0 ? d : instance_vector_to_render(s, h.instance, d, time);
 }
 TESSERA_HOST_DEVICE inline Vec3 surface_dpdu(const SceneView& s, const SurfaceHit& h, Float time = 0.f) {
   return surface_dp_duv(s, h, 0, time);
