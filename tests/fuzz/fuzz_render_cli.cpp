@@ -133,6 +133,11 @@ const Sandbox& sandbox() {
     s.dev_entries = count_entries("/dev");
     return s;
   }();
+  static const bool cleaned_at_exit = std::atexit([] {
+    std::error_code ec;
+    fs::remove_all(sandbox().root, ec);
+  }) == 0;
+  (void)cleaned_at_exit;
   return s;
 }
 
