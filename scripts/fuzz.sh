@@ -22,7 +22,9 @@
 # inputs that crash, hang (over 10 s) or exceed 2 GB land in
 # out/fuzz/findings/, named <target>-crash-..., -timeout-..., -oom-... (copy
 # them to the matching tests/fuzz/ folder once fixed: the suite replays
-# those folders). Logs: out/fuzz/logs/<target>/.
+# those folders). Logs: out/fuzz/logs/<target>/. The summary gives the
+# wall time times the jobs (core-seconds) and the CPU time the fuzzers got,
+# which is less where other work shares the cores.
 # Exit status 0 when nothing was found, 1 when something was, 2 on setup errors.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -47,7 +49,13 @@ mkdir -p out/fuzz/"$corpus" out/fuzz/findings "$logs"
 if [ "$target" = scene ] || [ "$target" = render ]; then cp -n scenes/*.pbrt tests/data/*.pbrt out/fuzz/"$corpus"/ 2>/dev/null; fi
 cp -n tests/fuzz/"$corpus"/* out/fuzz/"$corpus"/ 2>/dev/null
 findings() { ls out/fuzz/findings | grep -c "^$target-"; }
+# CPU seconds used by this script's children (the second line of bash's
+# `times`, which must run in this shell: a $(...) subshell has its own):
+# the fuzzer's share, where other work competes for the cores.
+times_seconds() { awk 'NR == 2 { split($1, u, /[ms]/); split($2, s, /[ms]/); printf "%d", u[1] * 60 + u[2] + s[1] * 60 + s[2] }' "$logs/times"; }
 before=$(findings)
+times >"$logs/times"
+cpu_before=$(times_seconds)
 start=$(date +%s)
 rm -f "$logs"/fuzz-*.log
 # Absolute paths: the cli target runs its commands in a sandbox folder of
@@ -60,9 +68,11 @@ if [ "$target" = cli ] || [ "$target" = render ]; then quiet="-close_fd_mask=3";
   -jobs="$jobs" -workers="$jobs" -timeout=10 -rss_limit_mb=2048 -max_len="$max_len" $quiet \
   -artifact_prefix="$PWD/../../findings/$target-" >/dev/null 2>&1)
 end=$(date +%s)
+times >"$logs/times"
+cpu=$(( $(times_seconds) - cpu_before ))
 after=$(findings)
 execs=$(grep -h "DONE" "$logs"/fuzz-*.log 2>/dev/null | sed -n 's/^#\([0-9]*\).*/\1/p' | awk '{s+=$1} END {print s+0}')
-echo "fuzz.sh: $jobs jobs x ${secs} s ($(( (end - start) * jobs )) CPU-seconds), $execs inputs run," \
+echo "fuzz.sh: $jobs jobs x ${secs} s ($(( (end - start) * jobs )) core-seconds, $cpu CPU-seconds used), $execs inputs run," \
      "corpus $(ls out/fuzz/"$corpus" | wc -l) files, $((after - before)) new findings in out/fuzz/findings/$target-*"
 grep -h "ERROR: \|runtime error:" "$logs"/fuzz-*.log 2>/dev/null | sort | uniq -c | head -20
 [ "$after" -eq "$before" ]
