@@ -1,5 +1,7 @@
 #include "scene/pbrt_lights.h"
 
+#include <cstdio>
+
 #include <cmath>
 
 #include "kernels/equal_area.h"
@@ -80,12 +82,29 @@ void read_portal(Light& l, const std::vector<Vec3>& p, const Mat4& render_from_w
 // is placed as a vertex is (scene_limits.h). A direction from "from" to "to"
 // that overflows single precision, or an emission that does, gives nothing
 // meaningful in pbrt-v4 either.
+// The largest radiance a light may emit where a camera ray can see it: a
+// pixel sums samples and their squares in single precision, and the
+// sensor's matrix mixes the channels, so brighter ones make Inf pixels.
+// (Point-like lights are divided by the squared distance first: their
+// intensity is limited by what float holds.)
+constexpr Float kMaxRadiance = 1e18f;
+
+void check_radiance_limit(const Rgb& L, const char* what, const DirectiveContext& ctx) {
+  if (max_component(glm::abs(L)) > kMaxRadiance) {
+    char value[32];
+    std::snprintf(value, sizeof value, "%g", static_cast<double>(max_component(glm::abs(L))));
+    ctx.fail(std::string(what) + " is " + value + ", beyond 1e+18: a pixel's sums would overflow single precision");
+  }
+}
+
 void check_light_limits(const Light& l, const DirectiveContext& ctx) {
   if (l.type != LightType::Distant && l.type != LightType::Infinite && !representable(l.position))
     ctx.fail("the light is " + describe_far(l.position, ctx.scene.render_origin));
   if (!(glm::length(l.direction) > 0.5f))
     ctx.fail("the light's direction from \"from\" to \"to\" overflows single precision");
   if (!is_finite(l.L)) ctx.fail("the light's emission (times \"scale\" and \"power\") is not finite");
+  if (l.type == LightType::Infinite || l.type == LightType::Distant)
+    check_radiance_limit(l.L, "the light's radiance (times \"scale\" and \"power\")", ctx);
 }
 
 }  // namespace
@@ -234,6 +253,7 @@ AreaLightDesc make_area_light(const std::string& type, const ParamSet& params, c
     a.L = Rgb(scale);
   }
   if (!is_finite(a.L)) ctx.fail("area light \"L\" times \"scale\" is not finite");
+  check_radiance_limit(a.L, "area light \"L\" times \"scale\"", ctx);
   const Float power = params.get_float("power", -1.f);
   if (!std::isfinite(power)) ctx.fail("area light \"power\" must be finite");
   a.power = power > 0.f ? power : 0.f;  // pbrt-v4: only a positive power rescales

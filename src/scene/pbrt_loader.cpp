@@ -1,5 +1,7 @@
 #include "scene/pbrt_loader.h"
 
+#include <filesystem>
+
 #include <sstream>
 
 #include "scene/pbrt_parser.h"
@@ -25,6 +27,8 @@ SceneDesc load_pbrt_string(const std::string& text, const std::string& name_for_
 }
 
 SceneDesc load_pbrt_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw SceneError(path + ":1: a folder, not a scene file");
   std::unique_ptr<std::istream> in = open_scene_file(path);
   if (!in || !*in) throw SceneError(path + ":1: cannot open scene file");
   SceneDesc desc = load_pbrt_stream(*in, path, directory_of(path));

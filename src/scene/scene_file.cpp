@@ -2,6 +2,8 @@
 
 #include <zlib.h>
 
+#include <filesystem>
+
 #include <array>
 #include <streambuf>
 
@@ -42,6 +44,8 @@ class GzIStream : public std::istream {
 }  // namespace
 
 std::unique_ptr<std::istream> open_scene_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return nullptr;  // zlib opens a folder and reads nothing
   gzFile f = gzopen(path.c_str(), "rb");
   if (f == nullptr) return nullptr;
   return std::make_unique<GzIStream>(f);

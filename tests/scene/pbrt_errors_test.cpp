@@ -67,6 +67,8 @@ TEST(PbrtErrors, MissingFilesAreNamed) {
   e = world_error("Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\"\n", dir.path());
   EXPECT_ERROR_CONTAINS(e, "bad.pbrt:2: image file '");
   EXPECT_ERROR_CONTAINS(e, "wood.png' not found");
+  // A folder given as the scene (found by the cli fuzz target: it read as an empty scene).
+  EXPECT_ERROR_CONTAINS(test::load_file_error(dir.path()), ":1: a folder, not a scene file");
   // A file that exists but is not a PLY.
   dir.write("junk.ply", "not a ply file\n");
   EXPECT_ERROR_CONTAINS(world_error("Shape \"plymesh\" \"string filename\" \"junk.ply\"\n", dir.path()), "bad.pbrt:2: cannot read PLY");

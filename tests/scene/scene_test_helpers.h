@@ -51,6 +51,16 @@ inline std::string load_error(const std::string& text, const std::string& dir = 
   return "";
 }
 
+// The message of the SceneError that loading the file at `path` throws ("" if none).
+inline std::string load_file_error(const std::string& path) {
+  try {
+    load_pbrt_file(path);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 inline Vec3 geometric_normal(const MeshDesc& m, size_t tri) {
   Vec3 p0 = m.p[m.indices[3 * tri]], p1 = m.p[m.indices[3 * tri + 1]], p2 = m.p[m.indices[3 * tri + 2]];
   Vec3 n = glm::normalize(glm::cross(p0 - p2, p1 - p2));
