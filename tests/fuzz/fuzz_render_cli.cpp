@@ -33,6 +33,8 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -329,7 +331,9 @@ std::vector<std::vector<std::string>> parse_commands(const std::string& text) {
       if (commands.size() == kMaxCommands) break;
       commands.emplace_back();
     } else if (commands.back().size() < kMaxArgs) {
-      commands.back().push_back(line.substr(0, kMaxArgLength));
+      // An argument ends at its first NUL, as the command line exec hands
+      // over does: the caps below must see what tessera will read.
+      commands.back().push_back(line.substr(0, std::min(line.find('\0'), kMaxArgLength)));
     }
   }
   return commands;
