@@ -77,15 +77,13 @@ class MpiTransport : public Transport {
     return true;
   }
 
-  void allreduce_sum(std::vector<uint64_t>& data) override {
-    constexpr size_t kChunk = size_t(1) << 28;  // counts are int
-    for (size_t off = 0; off < data.size(); off += kChunk) {
-      const int n = static_cast<int>(std::min(kChunk, data.size() - off));
-      MPI_Request r;
-      check(MPI_Iallreduce(MPI_IN_PLACE, data.data() + off, n, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD, &r),
-            "MPI_Iallreduce");
-      wait(&r);
+  bool receive_within(Message* out, int32_t source, double seconds) override {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (!try_receive(out, source)) {
+      if (std::chrono::steady_clock::now() >= until) return false;
+      pause_briefly();
     }
+    return true;
   }
 
   void broadcast(Bytes& bytes, int32_t root) override {

@@ -1,8 +1,8 @@
-// The farm's messages byte for byte: a batch of jobs encodes to the bytes
-// that commit 4b06cf9 (before the schema stopped including the integrator)
-// recorded, a tile request to those recorded when its counters last grew
-// (PathCounters::untraceable_rays: 20 words), so ranks of one build agree
-// on them and on the counters inside a request.
+// The farm's messages byte for byte: a batch of jobs and a tile request
+// encode to the bytes recorded when they began to name their pass (farm
+// liveness: docs/farm.md, "A silent rank"; the counters inside a request
+// last grew with PathCounters::untraceable_rays: 20 words), so ranks of
+// one build agree on them and on the counters inside a request.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -48,19 +48,20 @@ TileCounters numbered_counters() {
 
 TEST(FarmMessages, TileRequestBytesAreUnchanged) {
   TileRequest req;
+  req.pass = 5;
   req.capacity = 3;
   req.results = {sample_work()};
   req.counters = WireCounters::to_wire(numbered_counters());
   req.interrupted = true;
   const Bytes b = encode(req);
-  EXPECT_EQ(b.size(), 489u);
-  EXPECT_EQ(fnv1a(b), 0xd3a67b79bf2f6e27ull);
+  EXPECT_EQ(b.size(), 493u);
+  EXPECT_EQ(fnv1a(b), 0xa5fe52f0d6dbe2f0ull);
 }
 
 TEST(FarmMessages, TileJobsBytesAreUnchanged) {
-  const Bytes b = encode(TileJobs{{sample_work()}});
-  EXPECT_EQ(b.size(), 324u);
-  EXPECT_EQ(fnv1a(b), 0xa844992d0530b34bull);
+  const Bytes b = encode(TileJobs{5, {sample_work()}});
+  EXPECT_EQ(b.size(), 328u);
+  EXPECT_EQ(fnv1a(b), 0x7aa3966175ede4c6ull);
 }
 
 TEST(FarmMessages, CountersComeBackFieldByField) {

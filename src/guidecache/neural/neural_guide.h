@@ -109,6 +109,7 @@ class NeuralGuide final : public Guide {
   void views(GuideViews* out) override;
   NeuralTrainingLog* training_log() override { return &log_; }
   uint32_t rounds() const override;
+  uint32_t max_rounds() const override { return 1 + config_.steps_per_pass; }
   std::vector<uint64_t>& round_accumulators(uint32_t round) override;
   void fold_round(uint32_t round) override;
   bool single_sample_learning_passes() const override { return true; }
