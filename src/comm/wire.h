@@ -70,16 +70,34 @@ class BytesOut : public std::streambuf {
     if (!traits_type::eq_int_type(c, traits_type::eof())) bytes_.push_back(static_cast<uint8_t>(c));
     return traits_type::not_eof(c);
   }
+  // tellp() only: the bytes only grow.
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which) override {
+    if (off != 0 || dir != std::ios_base::cur || !(which & std::ios_base::out)) return pos_type(off_type(-1));
+    return pos_type(static_cast<off_type>(bytes_.size()));
+  }
 
  private:
   Bytes& bytes_;
 };
 
+// Readers may look ahead and seek back (load_guide reads the magic first).
 class BytesIn : public std::streambuf {
  public:
   explicit BytesIn(const Bytes& bytes) {
     char* begin = const_cast<char*>(reinterpret_cast<const char*>(bytes.data()));
     setg(begin, begin, begin + bytes.size());
+  }
+
+ protected:
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which) override {
+    if (!(which & std::ios_base::in)) return pos_type(off_type(-1));
+    const off_type base = dir == std::ios_base::beg ? 0 : dir == std::ios_base::cur ? gptr() - eback() : egptr() - eback();
+    if (base + off < 0 || base + off > egptr() - eback()) return pos_type(off_type(-1));
+    setg(eback(), eback() + base + off, egptr());
+    return pos_type(base + off);
+  }
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override {
+    return seekoff(off_type(pos), std::ios_base::beg, which);
   }
 };
 
