@@ -360,7 +360,7 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
                    t.inefficiency[1], t.inefficiency[0],
                    t.state == GuideTrialState::Kept ? "kept" : "switched off for the rest of the render");
     if (r.stats.ranks > 1 && r.stats.guide_syncs > 0)
-      std::fprintf(stderr, "tessera: guide sync: %u all-reductions of %.2f MB, %.3fs (%.1f%% of the render)\n",
+      std::fprintf(stderr, "tessera: guide sync: %u reductions of %.2f MB, %.3fs (%.1f%% of the render)\n",
                    r.stats.guide_syncs, r.stats.guide_sync_bytes / 1048576.0, r.stats.guide_sync_seconds,
                    100.0 * r.stats.guide_sync_seconds / std::max(r.stats.seconds, 1e-9));
   }

@@ -185,7 +185,9 @@ void FarmMaster::admit_workers(const TileSettings& settings) {
     if (!w.joined || w.out) continue;
     FarmPassStart mine = start;
     if (w.stale_guide) mine.guide = pass_start_guide();
-    if (!w.active && pass_ > 1) farm_note("rank " + std::to_string(r) + " takes part again");
+    if (!w.active && pass_ > 1)
+      farm_note("rank " + std::to_string(r) + " takes part again from pass " + std::to_string(pass_) +
+                (mine.guide.empty() ? "" : ", with the master's guide"));
     transport_.send(r, kTagPassStart, encode(mine));
     w.active = true;
     w.stale_guide = false;
@@ -337,10 +339,11 @@ void FarmMaster::leave_out(int32_t r, double silent_s) {
   std::vector<TileJob> finished;
   if (pass_learns_)
     for (size_t i : ledger_->done_by(r)) finished.push_back(pass_jobs_[i]);
-  std::string note = "rank " + std::to_string(r) + " silent for " + seconds_text(silent_s) + "; its " +
-                     std::to_string(given_back) + " tiles re-issued";
+  std::string note = "rank " + std::to_string(r) + " silent for " + seconds_text(silent_s);
+  note += phase_ == Phase::Tiles ? "; its " + std::to_string(given_back) + " tiles re-issued"
+                                 : " during the guide's learning";
   if (!finished.empty()) {
-    note += "; rank 0 relearns from the " + std::to_string(finished.size()) + " it finished";
+    note += "; rank 0 relearns its " + std::to_string(finished.size()) + " finished tiles";
     if (phase_ == Phase::Tiles) relearn_.insert(relearn_.end(), finished.begin(), finished.end());
     else stand_ins_due_.emplace_back(r, std::move(finished));
   }

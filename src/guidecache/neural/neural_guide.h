@@ -37,7 +37,7 @@ struct NeuralGuideConfig {
   // not at equal time: the output layer (width x (144 + learned lights)) is
   // most of an inference's arithmetic (docs/neural-guide.md).
   uint32_t width = 8;
-  // Adam steps (gradient all-reductions) after each learning pass, each on
+  // Adam steps (gradient reductions) after each learning pass, each on
   // its share of the pass's targets. Many small steps at a high rate are
   // what lets the network follow what the table learns at once; with
   // tile_targets, of the settings measured the one with the lowest error
