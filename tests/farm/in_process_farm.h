@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <condition_variable>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -143,10 +144,17 @@ inline FarmRun render_farm(const FarmScene& fs, int32_t ranks, FarmGuide guide, 
   options.scene_fingerprint = fs.scene.fingerprint();
   options.pause = hooks.master_pause;
   FarmMaster master(*ends[0], *rank_backends[0], options);
-  run.result = render(fs.scene, master, fs.opt, run.guides[0].get());
+  // A failing render still stops and joins the workers, then fails the test.
+  std::exception_ptr failed;
+  try {
+    run.result = render(fs.scene, master, fs.opt, run.guides[0].get());
+  } catch (...) {
+    failed = std::current_exception();
+  }
   run.silent = master.finish();
   if (hooks.after_finish) hooks.after_finish();
   for (auto& w : workers) w.join();
+  if (failed) std::rethrow_exception(failed);
   return run;
 }
 
