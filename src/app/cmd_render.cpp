@@ -438,6 +438,13 @@ int run_render_local(const RenderArgs& a) {
   return 0;
 }
 
+// "30 s", "2.5 s".
+std::string seconds_text(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", s);
+  return text;
+}
+
 // Ends a finished farm whose silent ranks would hold it open: Open MPI's
 // abort kills them (a stopped process too) and makes mpirun exit with the
 // status given, the one the render earned. The kill sequence starts with
@@ -457,8 +464,8 @@ int run_render_local(const RenderArgs& a) {
 // the workers to stop. A worker that stays silent holds the job open
 // (mpirun waits for every rank), so the master ends the job without it,
 // with the status the render earned: the outputs are whole by then.
-int run_farm_master(const RenderArgs& a, MasterSetup& m, Transport& t, TileBackend& backend, int32_t threads,
-                    bool sync) {
+void run_farm_master(const RenderArgs& a, MasterSetup& m, Transport& t, TileBackend& backend, int32_t threads,
+                     bool sync) {
   FarmMasterOptions options;
   options.local_threads = std::max(1, threads);
   options.sync_guide = sync;
@@ -480,7 +487,6 @@ int run_farm_master(const RenderArgs& a, MasterSetup& m, Transport& t, TileBacke
   });
   const std::vector<SilentRank> silent = farm.finish();
   if (!silent.empty()) end_job_without(silent);
-  return 0;
 }
 
 // mpirun -np N tessera render ...: rank 0 parses the scene, sends it and the
@@ -531,7 +537,15 @@ int run_render_farm(const RenderArgs& a) {
     // Each rank renders with its own backend (a GPU where it has one).
     std::unique_ptr<TileBackend> backend = backend_for(a, m, master);
     const int32_t threads = render_threads(m.opt, t->ranks_on_this_machine());
-    if (master) return run_farm_master(a, m, *t, *backend, threads, sync);
+    if (master) {
+      run_farm_master(a, m, *t, *backend, threads, sync);
+      // Every worker that took part said bye, but one stopped before it is
+      // through MPI_Finalize would still hold the job.
+      mpi.end_within(a.farm_lease, interrupt_requested() ? 130 : 0,
+                     "tessera: farm: a rank did not end within " + seconds_text(a.farm_lease) +
+                         " of the render; ending the job without it (every output is written)");
+      return 0;
+    }
     const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide.get());
     FarmWorkerOptions options;
     options.sync_guide = sync;
@@ -540,6 +554,10 @@ int run_render_farm(const RenderArgs& a) {
     options.scene_fingerprint = m.scene->fingerprint();
     options.pause = farm_test_stop(t->rank());
     run_farm_worker(*t, *backend, make_tile_settings(m.opt, spec, m.guide != nullptr), m.guide, options);
+    // The master said stop once every output was written.
+    mpi.end_within(a.farm_timeout, interrupt_requested() ? 130 : 0,
+                   "tessera: farm: rank " + std::to_string(t->rank()) + ": the job did not end within " +
+                       seconds_text(a.farm_timeout) + " of the render; ending it (every output is written)");
     return 0;
   } catch (const std::exception& e) {
     // A rank that fails mid-render cannot be waited for: end the whole job.

@@ -3,7 +3,8 @@
 // N-th time (default: the first) it reaches POINT, as a hung or suspended
 // process would: "pass" (the master, as a pass begins), "tiles" (a worker,
 // before it renders a batch of tiles), "result" (a worker, after it sent
-// one back) or "round" (a worker, before it sends a round of learning). It
+// one back), "round" (a worker, before it sends a round of learning) or
+// "bye" (a worker, after it answered the master's stop, before MPI_Finalize). It
 // prints its pid first, so that a test can send it SIGCONT.
 #pragma once
 

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <climits>
+#include <cstdio>
 #include <cstdlib>
 #include <list>
 #include <stdexcept>
@@ -144,7 +145,29 @@ MpiSession::MpiSession() {
   }
 }
 
-MpiSession::~MpiSession() { MPI_Finalize(); }
+MpiSession::~MpiSession() {
+  MPI_Finalize();
+  if (!watchdog_.joinable()) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    done_ = true;
+  }
+  finalized_.notify_all();
+  watchdog_.join();
+}
+
+void MpiSession::end_within(double seconds, int code, std::string message) {
+  watchdog_ = std::thread([this, seconds, code, message = std::move(message)] {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (finalized_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return done_; })) return;
+    std::fprintf(stderr, "%s\n", message.c_str());
+    std::fflush(stderr);
+    // From this thread while the main one waits inside MPI: Open MPI's
+    // abort only asks mpirun to end the job (tried under 4.1.4).
+    MPI_Abort(MPI_COMM_WORLD, code);
+    std::_Exit(code);
+  });
+}
 
 std::unique_ptr<Transport> MpiSession::world() { return std::make_unique<MpiTransport>(); }
 

@@ -340,8 +340,9 @@ void FarmMaster::leave_out(int32_t r, double silent_s) {
   if (pass_learns_)
     for (size_t i : ledger_->done_by(r)) finished.push_back(pass_jobs_[i]);
   std::string note = "rank " + std::to_string(r) + " silent for " + seconds_text(silent_s);
-  note += phase_ == Phase::Tiles ? "; its " + std::to_string(given_back) + " tiles re-issued"
-                                 : " during the guide's learning";
+  if (phase_ == Phase::Rounds) note += " during the guide's learning";
+  else if (given_back == 0) note += "; it held no tiles";
+  else note += "; its " + std::to_string(given_back) + " tiles re-issued";
   if (!finished.empty()) {
     note += "; rank 0 relearns its " + std::to_string(finished.size()) + " finished tiles";
     if (phase_ == Phase::Tiles) relearn_.insert(relearn_.end(), finished.begin(), finished.end());

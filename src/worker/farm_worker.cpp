@@ -58,6 +58,7 @@ class FarmWorker {
       // Anything else is about a pass it was left out of.
     }
     t_.send(0, kTagBye, {});
+    pause("bye");
   }
 
   // After a failure: the master reports it and ends the job (MPI_Abort);

@@ -28,7 +28,8 @@ struct FarmWorkerOptions {
   double timeout_s = 600.0;
   uint64_t scene_fingerprint = 0;  // to read the guide the master sends
   // Test hook: called with "tiles" before it renders a batch, "result"
-  // after it returned one, and "round" before it sends a round of learning.
+  // after it returned one, "round" before it sends a round of learning, and
+  // "bye" after it answered Stop.
   std::function<void(const char*)> pause;
 };
 

@@ -101,6 +101,25 @@ TEST_F(FarmStallCli, StoppedWorkerLeavesTheLocalImage) {
   }
 }
 
+// A worker stopped after it answered the master's stop, before it is
+// through MPI_Finalize (which waits for every rank): the master gives it a
+// lease, then ends the job with status 0, every output written.
+TEST_F(FarmStallCli, WorkerStoppedAtTheVeryEndStillLetsTheJobEnd) {
+  const std::string args = kDoor + " -q --no-preview --res 64x48 --spp 8 --seed 3";
+  RunResult l = run("render " + args + " -o " + path("local.exr"));
+  ASSERT_EQ(l.exit_code, 0) << l.output;
+  RunResult farm = run_mpi_stopping(3, "2:bye", "render " + args + " --farm-lease 2 -o " + path("farm.exr"));
+  EXPECT_EQ(farm.exit_code, 0) << farm.output;
+  const int pid = stopped_pid(farm.output, 2);
+  ASSERT_GT(pid, 0) << "the worker did not stop\n" << farm.output;
+  EXPECT_TRUE(dies_soon(pid)) << "the stopped worker outlived the job";
+  EXPECT_NE(farm.output.find("tessera: farm: a rank did not end within 2 s of the render; ending the job without it"),
+            std::string::npos)
+      << farm.output;
+  ASSERT_TRUE(fs::exists(path("farm.exr"))) << farm.output;
+  EXPECT_TRUE(exr_channels(path("farm.exr")) == exr_channels(path("local.exr"))) << "the image differs";
+}
+
 // A stopped worker continued (SIGCONT) once its tiles were re-issued: what
 // it sends about that pass is ignored, it takes part again from a later
 // pass with the master's guide, the image is still the local one, and the
