@@ -152,6 +152,16 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
   relearn_.clear();
   ledger_ = std::make_unique<TileLedger>(jobs.size());
   PassTiles pass{settings, jobs, film, counters, on_tile_done, OrderedSplats(film, jobs.size())};
+  // Messages about the pass's tiles find them here until the pass is over,
+  // however it ends.
+  struct TilesOut {
+    FarmMaster& m;
+    ~TilesOut() {
+      std::lock_guard<std::mutex> lock(m.comm_mutex_);
+      m.tiles_ = nullptr;
+      m.phase_ = Phase::Idle;
+    }
+  } tiles_out{*this};
   {
     std::lock_guard<std::mutex> lock(comm_mutex_);
     tiles_ = &pass;
@@ -167,11 +177,6 @@ void FarmMaster::render_pass(const TileSettings& settings, const std::vector<Til
     relearn.swap(relearn_);
   }
   render_for_learning(backend_, relearn, options_.local_threads, [this] { serve(); });
-  {
-    std::lock_guard<std::mutex> lock(comm_mutex_);
-    tiles_ = nullptr;
-    phase_ = Phase::Idle;
-  }
   if (settings.path.light_traced_caustics) pass.splats.finish();
   backend_.end_pass();
 }
@@ -186,10 +191,11 @@ void FarmMaster::admit_workers(const TileSettings& settings) {
     FarmPassStart mine = start;
     if (w.stale_guide) mine.guide = pass_start_guide();
     if (!w.active && pass_ > 1)
-      farm_note("rank " + std::to_string(r) + " takes part again from pass " + std::to_string(pass_) +
-                (mine.guide.empty() ? "" : ", with the master's guide"));
+      farm_note("rank " + std::to_string(r) + (w.took_part ? " takes part again" : " takes part") + " from pass " +
+                std::to_string(pass_) + (mine.guide.empty() ? "" : ", with the master's guide"));
     transport_.send(r, kTagPassStart, encode(mine));
     w.active = true;
+    w.took_part = true;
     w.stale_guide = false;
     w.empty_replies = 0;
     w.heard = Clock::now();

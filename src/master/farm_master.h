@@ -81,6 +81,7 @@ class FarmMaster : public PassExecutor {
   struct Worker {
     bool joined = false;       // said hello
     bool active = false;       // takes part in the pass under way
+    bool took_part = false;    // in some pass
     bool out = false;          // left out, and not heard from since
     bool stale_guide = false;  // missed a fold: its next PassStart carries the guide
     bool stopped = false;      // answered Stop
