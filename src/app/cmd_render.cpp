@@ -464,8 +464,8 @@ std::string seconds_text(double s) {
 // the workers to stop. A worker that stays silent holds the job open
 // (mpirun waits for every rank), so the master ends the job without it,
 // with the status the render earned: the outputs are whole by then.
-void run_farm_master(const RenderArgs& a, MasterSetup& m, Transport& t, TileBackend& backend, int32_t threads,
-                     bool sync) {
+void run_farm_master(const RenderArgs& a, MasterSetup& m, MpiSession& mpi, Transport& t, TileBackend& backend,
+                     int32_t threads, bool sync) {
   FarmMasterOptions options;
   options.local_threads = std::max(1, threads);
   options.sync_guide = sync;
@@ -487,6 +487,28 @@ void run_farm_master(const RenderArgs& a, MasterSetup& m, Transport& t, TileBack
   });
   const std::vector<SilentRank> silent = farm.finish();
   if (!silent.empty()) end_job_without(silent);
+  // Every worker that took part said bye, but one stopped before it is
+  // through MPI_Finalize would still hold the job.
+  mpi.end_within(a.farm_lease, interrupt_requested() ? 130 : 0,
+                 "tessera: farm: a rank did not end within " + seconds_text(a.farm_lease) +
+                     " of the render; ending the job without it (every output is written)");
+}
+
+// A worker's part of a farm: renders tiles until the master says stop.
+void run_farm_worker_rank(const RenderArgs& a, MasterSetup& m, MpiSession& mpi, Transport& t, TileBackend& backend,
+                          int32_t threads, bool sync) {
+  const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide.get());
+  FarmWorkerOptions options;
+  options.sync_guide = sync;
+  options.threads = std::max(1, threads);
+  options.timeout_s = a.farm_timeout;
+  options.scene_fingerprint = m.scene->fingerprint();
+  options.pause = farm_test_stop(t.rank());
+  run_farm_worker(t, backend, make_tile_settings(m.opt, spec, m.guide != nullptr), m.guide, options);
+  // The master said stop once every output was written.
+  mpi.end_within(a.farm_timeout, interrupt_requested() ? 130 : 0,
+                 "tessera: farm: rank " + std::to_string(t.rank()) + ": the job did not end within " +
+                     seconds_text(a.farm_timeout) + " of the render; ending it (every output is written)");
 }
 
 // mpirun -np N tessera render ...: rank 0 parses the scene, sends it and the
@@ -537,27 +559,8 @@ int run_render_farm(const RenderArgs& a) {
     // Each rank renders with its own backend (a GPU where it has one).
     std::unique_ptr<TileBackend> backend = backend_for(a, m, master);
     const int32_t threads = render_threads(m.opt, t->ranks_on_this_machine());
-    if (master) {
-      run_farm_master(a, m, *t, *backend, threads, sync);
-      // Every worker that took part said bye, but one stopped before it is
-      // through MPI_Finalize would still hold the job.
-      mpi.end_within(a.farm_lease, interrupt_requested() ? 130 : 0,
-                     "tessera: farm: a rank did not end within " + seconds_text(a.farm_lease) +
-                         " of the render; ending the job without it (every output is written)");
-      return 0;
-    }
-    const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide.get());
-    FarmWorkerOptions options;
-    options.sync_guide = sync;
-    options.threads = std::max(1, threads);
-    options.timeout_s = a.farm_timeout;
-    options.scene_fingerprint = m.scene->fingerprint();
-    options.pause = farm_test_stop(t->rank());
-    run_farm_worker(*t, *backend, make_tile_settings(m.opt, spec, m.guide != nullptr), m.guide, options);
-    // The master said stop once every output was written.
-    mpi.end_within(a.farm_timeout, interrupt_requested() ? 130 : 0,
-                   "tessera: farm: rank " + std::to_string(t->rank()) + ": the job did not end within " +
-                       seconds_text(a.farm_timeout) + " of the render; ending it (every output is written)");
+    if (master) run_farm_master(a, m, mpi, *t, *backend, threads, sync);
+    else run_farm_worker_rank(a, m, mpi, *t, *backend, threads, sync);
     return 0;
   } catch (const std::exception& e) {
     // A rank that fails mid-render cannot be waited for: end the whole job.
