@@ -6,7 +6,7 @@ On one machine, with one rendering thread per rank (so ranks = cores used):
   weak     work proportional to ranks (--spp per rank): efficiency T1 / TN
   sync     equal wall-clock time, N ranks, --guide-sync pass versus off:
            relMSE against a reference, and the share of time spent in the
-           guide's all-reductions
+           guide's reductions
 N defaults to the machine's core count. Writes out/bench-farm/results.csv and
 out/bench-farm/scaling.png (matplotlib), and prints a table.
 The reference for the sync comparison comes from scripts/reference.py's

@@ -1,6 +1,7 @@
 // tessera render [SCENE.pbrt] ...
 // Runs locally, or as a farm when started by mpirun (rank 0 = master).
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/farm_test_stop.h"
 #include "app/guide_setup.h"
 #include "app/scene_loading.h"
 #include "comm/farm_protocol.h"
@@ -52,6 +54,7 @@ struct RenderArgs {
   std::string checkpoint, resume;
   double checkpoint_every = 60.0;
   std::string guide_sync = "pass";
+  double farm_lease = 30.0, farm_timeout = 600.0;
   GuideArgs guide;
 };
 
@@ -355,7 +358,7 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
                    t.inefficiency[1], t.inefficiency[0],
                    t.state == GuideTrialState::Kept ? "kept" : "switched off for the rest of the render");
     if (r.stats.ranks > 1 && r.stats.guide_syncs > 0)
-      std::fprintf(stderr, "tessera: guide sync: %u all-reductions of %.2f MB, %.3fs (%.1f%% of the render)\n",
+      std::fprintf(stderr, "tessera: guide sync: %u reductions of %.2f MB, %.3fs (%.1f%% of the render)\n",
                    r.stats.guide_syncs, r.stats.guide_sync_bytes / 1048576.0, r.stats.guide_sync_seconds,
                    100.0 * r.stats.guide_sync_seconds / std::max(r.stats.seconds, 1e-9));
   }
@@ -433,6 +436,79 @@ int run_render_local(const RenderArgs& a) {
   return 0;
 }
 
+// "30 s", "2.5 s".
+std::string seconds_text(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", s);
+  return text;
+}
+
+// Ends a finished farm whose silent ranks would hold it open: Open MPI's
+// abort kills them (a stopped process too) and makes mpirun exit with the
+// status given, the one the render earned. The kill sequence starts with
+// SIGCONT and SIGTERM to every rank, this one included, which are then no
+// longer requests to stop a render.
+[[noreturn]] void end_job_without(const std::vector<SilentRank>& silent) {
+  for (const SilentRank& r : silent)
+    std::fprintf(stderr, "tessera: farm: rank %d silent for %.0f s; ending the job without it (every output is written)\n",
+                 r.rank, r.silent_s);
+  std::fflush(stderr);
+  const int code = interrupt_requested() ? 130 : 0;
+  for (int sig : {SIGINT, SIGTERM, SIGCONT}) std::signal(sig, SIG_DFL);
+  MpiSession::abort(code);
+}
+
+// The master's part of a farm: renders and writes every output, then tells
+// the workers to stop. A worker that stays silent holds the job open
+// (mpirun waits for every rank), so the master ends the job without it,
+// with the status the render earned: the outputs are whole by then.
+void run_farm_master(const RenderArgs& a, MasterSetup& m, MpiSession& mpi, Transport& t, TileBackend& backend,
+                     int32_t threads, bool sync) {
+  FarmMasterOptions options;
+  options.local_threads = std::max(1, threads);
+  options.sync_guide = sync;
+  options.lease_s = a.farm_lease;
+  options.guide = m.guide.get();
+  options.scene_fingerprint = m.scene->fingerprint();
+  options.pause = farm_test_stop(0);
+  FarmMaster farm(t, backend, options);
+  if (!farm.backends_agree_bitwise())
+    std::fprintf(stderr,
+                 "tessera: farm: ranks render with %s: which rank renders a tile depends on timing, so the image is "
+                 "reproducible statistically, not bit for bit (docs/farm.md)\n",
+                 farm.backends().c_str());
+  render_and_write(a, m, farm, [&](RenderStats& s) {
+    s.guide_sync = a.guide_sync;
+    s.guide_sync_seconds = farm.sync_seconds();
+    s.guide_sync_bytes = farm.sync_bytes();
+    s.guide_syncs = farm.syncs();
+  });
+  const std::vector<SilentRank> silent = farm.finish();
+  if (!silent.empty()) end_job_without(silent);
+  // Every worker that took part said bye, but one stopped before it is
+  // through MPI_Finalize would still hold the job.
+  mpi.end_within(a.farm_lease, interrupt_requested() ? 130 : 0,
+                 "tessera: farm: a rank did not end within " + seconds_text(a.farm_lease) +
+                     " of the render; ending the job without it (every output is written)");
+}
+
+// A worker's part of a farm: renders tiles until the master says stop.
+void run_farm_worker_rank(const RenderArgs& a, MasterSetup& m, MpiSession& mpi, Transport& t, TileBackend& backend,
+                          int32_t threads, bool sync) {
+  const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide.get());
+  FarmWorkerOptions options;
+  options.sync_guide = sync;
+  options.threads = std::max(1, threads);
+  options.timeout_s = a.farm_timeout;
+  options.scene_fingerprint = m.scene->fingerprint();
+  options.pause = farm_test_stop(t.rank());
+  run_farm_worker(t, backend, make_tile_settings(m.opt, spec, m.guide != nullptr), m.guide, options);
+  // The master said stop once every output was written.
+  mpi.end_within(a.farm_timeout, interrupt_requested() ? 130 : 0,
+                 "tessera: farm: rank " + std::to_string(t.rank()) + ": the job did not end within " +
+                     seconds_text(a.farm_timeout) + " of the render; ending it (every output is written)");
+}
+
 // mpirun -np N tessera render ...: rank 0 parses the scene, sends it and the
 // starting guide to every rank, schedules tiles, renders too, and writes
 // all outputs; the other ranks render tiles.
@@ -481,25 +557,8 @@ int run_render_farm(const RenderArgs& a) {
     // Each rank renders with its own backend (a GPU where it has one).
     std::unique_ptr<TileBackend> backend = backend_for(a, m, master);
     const int32_t threads = render_threads(m.opt, t->ranks_on_this_machine());
-    if (!master) {
-      const uint32_t spec = effective_specialisation(*m.scene, m.opt, m.guide.get());
-      run_farm_worker(*t, *backend, make_tile_settings(m.opt, spec, m.guide != nullptr), m.guide.get(), sync,
-                      std::max(1, threads));
-      return 0;
-    }
-    FarmMaster farm(*t, *backend, std::max(1, threads), sync);
-    if (!farm.backends_agree_bitwise())
-      std::fprintf(stderr,
-                   "tessera: farm: ranks render with %s: which rank renders a tile depends on timing, so the image is "
-                   "reproducible statistically, not bit for bit (docs/farm.md)\n",
-                   farm.backends().c_str());
-    render_and_write(a, m, farm, [&](RenderStats& s) {
-      s.guide_sync = a.guide_sync;
-      s.guide_sync_seconds = farm.sync_seconds();
-      s.guide_sync_bytes = farm.sync_bytes();
-      s.guide_syncs = farm.syncs();
-    });
-    farm.stop();
+    if (master) run_farm_master(a, m, mpi, *t, *backend, threads, sync);
+    else run_farm_worker_rank(a, m, mpi, *t, *backend, threads, sync);
     return 0;
   } catch (const std::exception& e) {
     // A rank that fails mid-render cannot be waited for: end the whole job.
@@ -569,8 +628,16 @@ CommandRunner add_render_command(CLI::App& app) {
   c->add_option("--checkpoint", a->checkpoint, "Write the render's state to this file (atomically) every --checkpoint-every seconds and at the end");
   c->add_option("--checkpoint-every", a->checkpoint_every, "Seconds between checkpoints (0 = after every pass)")->check(CLI::NonNegativeNumber);
   c->add_option("--resume", a->resume, "Continue a render from a checkpoint (same scene and options; any number of ranks)");
-  c->add_option("--guide-sync", a->guide_sync, "Farm: all-reduce the guide's learning after every pass (pass) or let each rank learn alone (off)")
+  c->add_option("--guide-sync", a->guide_sync, "Farm: share the guide's learning among the ranks after every pass (pass) or let each rank learn alone (off)")
       ->check(CLI::IsMember({"pass", "off"}));
+  c->add_option("--farm-lease", a->farm_lease,
+                "Farm: seconds a worker may stay silent while the master waits for its tiles or learning; then its "
+                "tiles go to the other ranks (the image stays the same) and it rejoins when it is heard from (default 30)")
+      ->check(positive_number());
+  c->add_option("--farm-timeout", a->farm_timeout,
+                "Farm: seconds a worker waits for a silent master (rank 0, which holds the image) before it ends the "
+                "job, non-zero, for a --resume from the last checkpoint (default 600)")
+      ->check(positive_number());
   add_guide_options(c, a->guide);
   return [a] { return run_render(*a); };
 }

@@ -65,7 +65,7 @@ void add_guide_options(CLI::App* cmd, GuideArgs& a) {
       ->check(CLI::Range(int64_t{1}, int64_t{kNeuralMaxWidth}))
       ->each([&a](const std::string&) { a.neural_given.push_back("--neural-width"); });
   cmd->add_option("--neural-steps", a.neural_steps,
-                  "--guide neural: Adam steps after each learning pass (each all-reduces the gradients in a farm)")
+                  "--guide neural: Adam steps after each learning pass (in a farm, each sums the gradients of every rank)")
       ->check(CLI::Range(int64_t{1}, int64_t{1024}))
       ->each([&a](const std::string&) { a.neural_given.push_back("--neural-steps"); });
   cmd->add_option("--neural-lr", a.neural_lr, "--guide neural: Adam's learning rate")->check(finite_range(1e-6, 1.0))

@@ -3,9 +3,11 @@
 //   setup     master -> all (broadcast): the parsed scene and the guide
 //             cache every rank starts from, or the error that stops them.
 //   Hello     worker -> master: how many threads it renders with, and its backend.
-//   PassStart master -> worker: a pass begins (sample range is in the jobs),
-//             with the integrator specialisation it runs (--guide auto's
-//             trial renders some passes unguided).
+//   PassStart master -> worker: pass `pass` begins (sample range is in the
+//             jobs), with the integrator specialisation it runs (--guide
+//             auto's trial renders some passes unguided), and the master's
+//             guide for a rank that missed a fold (left out of a pass, or
+//             late to join).
 //   Request   worker -> master: the tiles it finished (pixel accumulators
 //             and counters) and a request for `capacity` more. A worker
 //             keeps kRequestsInFlight requests open so it never waits idle
@@ -14,13 +16,19 @@
 //   Jobs      master -> worker: tiles to render, each with its pixel
 //             accumulators so far (so samples add in the same order as in
 //             a local render: the image is bit-identical); empty = none
-//             left in this pass.
-//   Stop      master -> worker: the render is over.
+//             left for it in this pass.
+//   Round     worker -> master: after a guided pass, the rank's
+//             accumulators of one round of the guide's learning; master ->
+//             worker: their sum over every rank (the master's own, and its
+//             stand-ins for ranks left out), which every rank folds.
+//   Ping/Pong worker -> master -> worker: a worker that has waited a while
+//             asks whether the master is still there.
+//   Stop      master -> worker: the render is over; the worker answers Bye.
 //   Error     worker -> master: a worker failed (the master reports it and
 //             ends the job).
-// After a guided pass, every rank all-reduces the guide's accumulators
-// (--guide-sync pass) and folds them: identical sums, identical fields on
-// every rank. After an unguided pass, none does.
+// Every message but Hello, Ping/Pong, Stop, Bye and Error names its pass: a
+// rank that falls silent is left out of the pass (docs/farm.md, "A silent
+// rank"), and what it says about that pass when it wakes is ignored.
 //
 // The schema sees plain structs only (render/tile_job.h, render/film.h'
 // accumulators), never the integrator: scripts/check_layers.py holds it so.
@@ -38,7 +46,18 @@
 
 namespace tessera {
 
-enum FarmTag : int32_t { kTagHello = 1, kTagPassStart, kTagRequest, kTagJobs, kTagStop, kTagError };
+enum FarmTag : int32_t {
+  kTagHello = 1,
+  kTagPassStart,
+  kTagRequest,
+  kTagJobs,
+  kTagStop,
+  kTagError,
+  kTagRound,
+  kTagPing,
+  kTagPong,
+  kTagBye
+};
 
 constexpr uint32_t kRequestsInFlight = 2;
 
@@ -104,21 +123,34 @@ struct WireCounters {
 };
 
 struct TileRequest {
+  uint32_t pass = 0;
   uint32_t capacity = 0;
   std::vector<TileWork> results;
   WireCounters counters;  // of the results
   bool interrupted = false;
   template <class Archive>
   void serialize(Archive& ar) {
-    ar(capacity, results, raw_value(counters), interrupted);
+    ar(pass, capacity, results, raw_value(counters), interrupted);
   }
 };
 
 struct TileJobs {
+  uint32_t pass = 0;
   std::vector<TileWork> jobs;
   template <class Archive>
   void serialize(Archive& ar) {
-    ar(jobs);
+    ar(pass, jobs);
+  }
+};
+
+// One round of a guided pass's learning: a rank's accumulators, or their sum.
+struct GuideRound {
+  uint32_t pass = 0;
+  uint32_t round = 0;
+  std::vector<uint64_t> words;
+  template <class Archive>
+  void serialize(Archive& ar) {
+    ar(pass, round, raw(words));
   }
 };
 
@@ -131,11 +163,13 @@ struct FarmError {
 };
 
 struct FarmPassStart {
+  uint32_t pass = 0;
   uint32_t specialisation = 0;
   bool guided_roulette = false;
+  Bytes guide;  // Guide::save bytes for a rank whose guide missed a fold; else empty
   template <class Archive>
   void serialize(Archive& ar) {
-    ar(specialisation, guided_roulette);
+    ar(pass, specialisation, guided_roulette, raw(guide));
   }
 };
 

@@ -1,5 +1,6 @@
 #include "comm/inproc_transport.h"
 
+#include <chrono>
 #include <stdexcept>
 
 namespace tessera {
@@ -31,13 +32,9 @@ class InProcessTransport : public Transport {
     return take(source, out);
   }
 
-  void allreduce_sum(std::vector<uint64_t>& data) override {
+  bool receive_within(Message* out, int32_t source, double seconds) override {
     std::unique_lock<std::mutex> lock(hub_.mutex_);
-    if (hub_.arrived_ == 0) hub_.sum_.assign(data.size(), 0);
-    if (hub_.sum_.size() != data.size()) throw std::logic_error("allreduce_sum: ranks disagree on the size");
-    for (size_t i = 0; i < data.size(); ++i) hub_.sum_[i] += data[i];
-    collective_arrive(lock, [&] { hub_.sum_result_ = hub_.sum_; });
-    data = hub_.sum_result_;
+    return hub_.changed_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return take(source, out); });
   }
 
   void broadcast(Bytes& bytes, int32_t root) override {

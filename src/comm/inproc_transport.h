@@ -24,11 +24,10 @@ class InProcessHub {
   std::mutex mutex_;
   std::condition_variable changed_;
   std::vector<std::deque<Message>> inbox_;
-  // Collectives: ranks arrive, the last one publishes the result and
+  // The broadcast: ranks arrive, the last one publishes the result and
   // advances the generation the others wait on.
   int32_t arrived_ = 0;
   uint64_t generation_ = 0;
-  std::vector<uint64_t> sum_, sum_result_;
   Bytes broadcast_;
 };
 

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <climits>
+#include <cstdio>
 #include <cstdlib>
 #include <list>
 #include <stdexcept>
@@ -77,15 +78,13 @@ class MpiTransport : public Transport {
     return true;
   }
 
-  void allreduce_sum(std::vector<uint64_t>& data) override {
-    constexpr size_t kChunk = size_t(1) << 28;  // counts are int
-    for (size_t off = 0; off < data.size(); off += kChunk) {
-      const int n = static_cast<int>(std::min(kChunk, data.size() - off));
-      MPI_Request r;
-      check(MPI_Iallreduce(MPI_IN_PLACE, data.data() + off, n, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD, &r),
-            "MPI_Iallreduce");
-      wait(&r);
+  bool receive_within(Message* out, int32_t source, double seconds) override {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (!try_receive(out, source)) {
+      if (std::chrono::steady_clock::now() >= until) return false;
+      pause_briefly();
     }
+    return true;
   }
 
   void broadcast(Bytes& bytes, int32_t root) override {
@@ -146,7 +145,29 @@ MpiSession::MpiSession() {
   }
 }
 
-MpiSession::~MpiSession() { MPI_Finalize(); }
+MpiSession::~MpiSession() {
+  MPI_Finalize();
+  if (!watchdog_.joinable()) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    done_ = true;
+  }
+  finalized_.notify_all();
+  watchdog_.join();
+}
+
+void MpiSession::end_within(double seconds, int code, std::string message) {
+  watchdog_ = std::thread([this, seconds, code, message = std::move(message)] {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (finalized_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return done_; })) return;
+    std::fprintf(stderr, "%s\n", message.c_str());
+    std::fflush(stderr);
+    // From this thread while the main one waits inside MPI: Open MPI's
+    // abort only asks mpirun to end the job (tried under 4.1.4).
+    MPI_Abort(MPI_COMM_WORLD, code);
+    std::_Exit(code);
+  });
+}
 
 std::unique_ptr<Transport> MpiSession::world() { return std::make_unique<MpiTransport>(); }
 

@@ -5,7 +5,11 @@
 // docs/farm.md).
 #pragma once
 
+#include <condition_variable>
 #include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
 
 #include "comm/transport.h"
 
@@ -27,6 +31,17 @@ class MpiSession {
   std::unique_ptr<Transport> world();
   // Ends every rank of the job with this exit code (after an error on one).
   [[noreturn]] static void abort(int code);
+  // Once the farm's work is done: unless this process is through
+  // MPI_Finalize (which waits for every rank) within `seconds`, `message`
+  // goes to stderr and the job ends with `code`. A rank stopped at the very
+  // end would otherwise hold the job for ever. The countdown starts now.
+  void end_within(double seconds, int code, std::string message);
+
+ private:
+  std::thread watchdog_;
+  std::mutex mutex_;
+  std::condition_variable finalized_;
+  bool done_ = false;
 };
 
 }  // namespace tessera

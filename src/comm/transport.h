@@ -1,5 +1,7 @@
 // The farm's one communication layer: point-to-point messages between ranks
-// and the two collectives the farm needs. The master and workers speak only
+// and the one collective the farm needs (the setup broadcast). Everything
+// after the setup is point-to-point with timeouts, so that no rank ever
+// waits on a collective that a stalled rank would hold up (docs/farm.md). The master and workers speak only
 // through it; MpiTransport (the only code that includes <mpi.h>) carries it
 // over Open MPI, InProcessTransport over threads of one process (protocol
 // tests without mpirun).
@@ -39,9 +41,8 @@ class Transport {
   virtual Message receive(int32_t source = -1) = 0;
   // Like receive, but returns false at once when nothing has arrived.
   virtual bool try_receive(Message* out, int32_t source = -1) = 0;
-  // Element-wise sum over all ranks, in place; every rank gets the result.
-  // Integer sums: the result does not depend on the reduction order.
-  virtual void allreduce_sum(std::vector<uint64_t>& data) = 0;
+  // Like receive, but returns false when nothing has arrived within `seconds`.
+  virtual bool receive_within(Message* out, int32_t source, double seconds) = 0;
   // Root's bytes to every rank (others' input is replaced).
   virtual void broadcast(Bytes& bytes, int32_t root) = 0;
 };

@@ -41,6 +41,9 @@ class Guide {
   // Between passes: for each round r < rounds(), round_accumulators(r) is
   // summed across ranks (a single process: as it is), then fold_round(r).
   virtual uint32_t rounds() const = 0;
+  // The most rounds a pass can take (a farm keeps a copy of the guide as the
+  // pass began while later rounds may still need it: master/stand_in.h).
+  virtual uint32_t max_rounds() const { return 1; }
   virtual std::vector<uint64_t>& round_accumulators(uint32_t round) = 0;
   virtual void fold_round(uint32_t round) = 0;
 

@@ -6,7 +6,7 @@
 // per pixel, adding in sample order; no float atomics), whose pixel
 // accumulators and counters come back to the host; end_pass
 // adds the device's integer accumulators into the pass's block, for the
-// fold and the farm's all-reduction. With the neural guide, every pass
+// fold and the farm's sum over the ranks. With the neural guide, every pass
 // uploads the network's weights instead (frozen for the pass), and each
 // batch's learning targets come back to the pass's training log, tile by
 // tile, the same targets a CPU backend keeps (the host trains between

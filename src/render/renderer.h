@@ -81,8 +81,8 @@ struct RenderStats {
   GuideFieldStats guide;            // as the guide stood at the end (when guided; the network fills bytes, updates, rejections)
   NeuralGuideStats neural_guide;    // the network's own (--guide neural)
   double guide_fold_seconds = 0.0;  // all passes' PassStats::guide_seconds
-  double guide_sync_seconds = 0.0;  // farm: time in guide all-reductions (rank 0's view)
-  uint64_t guide_sync_bytes = 0;    // farm: bytes all-reduced per sync
+  double guide_sync_seconds = 0.0;  // farm: time summing the guide's learning over the ranks (rank 0's view)
+  uint64_t guide_sync_bytes = 0;    // farm: bytes of the largest round summed
   uint32_t guide_syncs = 0;
   std::string guide_sync = "pass";  // pass | off (each rank learns alone)
   GuideLearnSchedule guide_learn;  // the learning schedule the render ran with
@@ -133,7 +133,7 @@ class PassExecutor {
   virtual void render_pass(const TileSettings& settings, const std::vector<TileJob>& jobs, Film& film,
                            TileCounters* counters, const std::function<void(uint64_t)>& on_tile_done) = 0;
   // Before a fold: makes the pass's guide accumulators the sum over
-  // everything that rendered it (a farm all-reduces them; locally they are).
+  // everything that rendered it (a farm sums the ranks'; locally they are).
   virtual void reduce_guide(std::vector<uint64_t>& accumulators) {}
   // How many processes render (1 locally).
   virtual int32_t ranks() const { return 1; }

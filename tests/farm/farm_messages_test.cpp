@@ -1,13 +1,15 @@
-// The farm's messages byte for byte: a batch of jobs encodes to the bytes
-// that commit 4b06cf9 (before the schema stopped including the integrator)
-// recorded, a tile request to those recorded when its counters last grew
-// (PathCounters::untraceable_rays: 20 words), so ranks of one build agree
-// on them and on the counters inside a request.
+// The farm's messages byte for byte: a batch of jobs and a tile request
+// encode to the bytes recorded when they began to name their pass (farm
+// liveness: docs/farm.md, "A silent rank"; the counters inside a request
+// last grew with PathCounters::untraceable_rays: 20 words), so ranks of
+// one build agree on them and on the counters inside a request.
 #include <gtest/gtest.h>
 
 #include <cstring>
 
 #include "comm/farm_protocol.h"
+#include "comm/guide_wire.h"
+#include "guidecache/table/guide_field.h"
 #include "render/render_tile.h"
 
 namespace tessera {
@@ -48,19 +50,20 @@ TileCounters numbered_counters() {
 
 TEST(FarmMessages, TileRequestBytesAreUnchanged) {
   TileRequest req;
+  req.pass = 5;
   req.capacity = 3;
   req.results = {sample_work()};
   req.counters = WireCounters::to_wire(numbered_counters());
   req.interrupted = true;
   const Bytes b = encode(req);
-  EXPECT_EQ(b.size(), 489u);
-  EXPECT_EQ(fnv1a(b), 0xd3a67b79bf2f6e27ull);
+  EXPECT_EQ(b.size(), 493u);
+  EXPECT_EQ(fnv1a(b), 0xa5fe52f0d6dbe2f0ull);
 }
 
 TEST(FarmMessages, TileJobsBytesAreUnchanged) {
-  const Bytes b = encode(TileJobs{{sample_work()}});
-  EXPECT_EQ(b.size(), 324u);
-  EXPECT_EQ(fnv1a(b), 0xa844992d0530b34bull);
+  const Bytes b = encode(TileJobs{5, {sample_work()}});
+  EXPECT_EQ(b.size(), 328u);
+  EXPECT_EQ(fnv1a(b), 0x7aa3966175ede4c6ull);
 }
 
 TEST(FarmMessages, CountersComeBackFieldByField) {
@@ -72,6 +75,21 @@ TEST(FarmMessages, CountersComeBackFieldByField) {
   EXPECT_EQ(c.path.untraceable_rays, 1015u);
   EXPECT_EQ(c.samples, 1016u);
   EXPECT_EQ(c.rejected_negative, 1019u);
+}
+
+// Messages are read straight from their bytes, and a guide's reader seeks
+// back after its magic: the master's guide, as it sends it to a worker that
+// missed a fold, comes back the same.
+TEST(FarmMessages, GuideSurvivesTheWire) {
+  GuideField g(GuideConfig{}, Vec3(0.f), Vec3(1.f), 4, 10.f);
+  const Bytes b = guide_to_bytes(g, 77);
+  EXPECT_TRUE(guide_from_bytes(b, 77)->same_as(g));
+  EXPECT_THROW(guide_from_bytes(b, 78), std::runtime_error) << "another scene's";
+  EXPECT_THROW(guide_from_bytes(Bytes(b.begin(), b.begin() + b.size() / 2), 77), std::runtime_error);
+  const GuideRound round = decode<GuideRound>(encode(GuideRound{3, 4, {1, 2, ~0ull}}));
+  EXPECT_EQ(round.pass, 3u);
+  EXPECT_EQ(round.round, 4u);
+  EXPECT_EQ(round.words, (std::vector<uint64_t>{1, 2, ~0ull}));
 }
 
 }  // namespace

@@ -6,101 +6,26 @@
 #include <thread>
 
 #include "../render/guided_helpers.h"
-#include "guidecache/guide_kinds.h"
-#include "../render/render_helpers.h"
 #include "comm/farm_protocol.h"
-#include "comm/inproc_transport.h"
 #include "comm/scene_wire.h"
-#include "master/farm_master.h"
-#include "render/backends.h"
-#include "render/embree_backend.h"
-#include "worker/farm_worker.h"
+#include "in_process_farm.h"
 
 namespace tessera {
 namespace {
 
+using testing::FarmGuide;
+using testing::FarmRun;
+using testing::FarmScene;
+using testing::door_ajar;
+using testing::expect_same_counters;
 using testing::films_identical;
-
-struct FarmScene {
-  SceneData scene;
-  mutable EmbreeBackend embree;  // local renders (its per-pass state changes while it renders)
-  RenderOptions opt;
-  explicit FarmScene(SceneDesc d) : scene(std::move(d)), embree(scene) {
-    opt.progress = false;
-    opt.spp = 12;
-    opt.max_depth = scene.desc().max_depth;
-    opt.seed = 5;
-    opt.threads = 1;
-  }
-  std::unique_ptr<GuideField> make_guide() const {
-    return std::make_unique<GuideField>(GuideConfig{}, scene.bounds().lo, scene.bounds().hi, scene.view().num_lights,
-                                        scene.max_emitted_radiance());
-  }
-  std::unique_ptr<NeuralGuide> make_neural() const {
-    NeuralGuideConfig c;
-    c.width = 16;
-    c.steps_per_pass = 4;
-    return std::make_unique<NeuralGuide>(c, scene.bounds().lo, scene.bounds().hi, scene.max_emitted_radiance(),
-                                         scene.view().num_lights);
-  }
-};
-
-SceneDesc door_ajar() {
-  SceneDesc d = load_pbrt_file(testing::source_dir() + "/scenes/door-ajar.pbrt");
-  d.film.xres = 48;
-  d.film.yres = 36;
-  return d;
-}
-
-struct FarmRun {
-  RenderResult result;
-  std::vector<std::unique_ptr<Guide>> guides;  // every rank's guide at the end
-};
-
-// Rank 0 runs the master (1 rendering thread), ranks 1.. run workers, each
-// with its own backend: backends[r], or Embree where none is named.
-FarmRun render_farm(const FarmScene& fs, int32_t ranks, bool guided, bool sync,
-                    const std::vector<std::string>& backends = {}, bool neural = false) {
-  InProcessHub hub(ranks);
-  std::vector<std::unique_ptr<Transport>> ends;
-  FarmRun run;
-  for (int32_t r = 0; r < ranks; ++r) {
-    ends.push_back(hub.endpoint(r));
-    if (!guided) run.guides.push_back(nullptr);
-    else if (neural) run.guides.push_back(fs.make_neural());
-    else run.guides.push_back(fs.make_guide());
-  }
-  std::vector<std::unique_ptr<TileBackend>> rank_backends;
-  for (int32_t r = 0; r < ranks; ++r)
-    rank_backends.push_back(make_tile_backend(r < static_cast<int32_t>(backends.size()) ? backends[r] : "embree", fs.scene));
-  const uint32_t spec = effective_specialisation(fs.scene, fs.opt, run.guides[0].get());
-  std::vector<std::thread> workers;
-  for (int32_t r = 1; r < ranks; ++r) {
-    workers.emplace_back([&, r] {
-      run_farm_worker(*ends[r], *rank_backends[r], make_tile_settings(fs.opt, spec, guided), run.guides[r].get(), sync, 1);
-    });
-  }
-  FarmMaster master(*ends[0], *rank_backends[0], 1, sync);
-  run.result = render(fs.scene, master, fs.opt, run.guides[0].get());
-  master.stop();
-  for (auto& w : workers) w.join();
-  return run;
-}
-
-void expect_same_counters(const TileCounters& a, const TileCounters& b) {
-  EXPECT_EQ(a.samples, b.samples);
-  EXPECT_EQ(a.zero_radiance, b.zero_radiance);
-  EXPECT_EQ(a.path.rays, b.path.rays);
-  EXPECT_EQ(a.path.shadow_rays, b.path.shadow_rays);
-  EXPECT_EQ(a.path.guide_updates, b.path.guide_updates);
-  EXPECT_EQ(a.path.guided_samples, b.path.guided_samples);
-}
+using testing::render_farm;
 
 TEST(FarmProtocol, UnguidedImageIsBitIdenticalForAnyRankCount) {
   FarmScene fs(door_ajar());
   RenderResult local = render(fs.scene, fs.embree, fs.opt);
   for (int32_t ranks : {1, 2, 3}) {
-    FarmRun farm = render_farm(fs, ranks, false, true);
+    FarmRun farm = render_farm(fs, ranks, FarmGuide::None, true);
     EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
     expect_same_counters(farm.result.stats.counters, local.stats.counters);
     EXPECT_EQ(farm.result.stats.ranks, ranks);
@@ -117,7 +42,7 @@ TEST(FarmProtocol, LightPathSplatsAreBitIdenticalForAnyRankCount) {
   RenderResult local = render(fs.scene, fs.embree, fs.opt);
   ASSERT_FALSE(local.film.splats.empty());
   for (int32_t ranks : {1, 2, 3}) {
-    FarmRun farm = render_farm(fs, ranks, false, true);
+    FarmRun farm = render_farm(fs, ranks, FarmGuide::None, true);
     EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
     EXPECT_EQ(farm.result.stats.counters.path.light_splats, local.stats.counters.path.light_splats);
   }
@@ -129,7 +54,7 @@ TEST(FarmProtocol, SharedGuideGivesTheLocalImageAndFieldOnEveryRank) {
   RenderResult local = render(fs.scene, fs.embree, fs.opt, local_guide.get());
   ASSERT_GT(local.stats.counters.path.guided_samples, 0u);
   for (int32_t ranks : {2, 3}) {
-    FarmRun farm = render_farm(fs, ranks, true, true);
+    FarmRun farm = render_farm(fs, ranks, FarmGuide::Table, true);
     EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
     expect_same_counters(farm.result.stats.counters, local.stats.counters);
     for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(farm.guides[r]->same_as(*local_guide)) << "rank " << r;
@@ -147,7 +72,7 @@ TEST(FarmProtocol, GuideTrialGivesTheLocalImageAndDecisionForAnyRankCount) {
   RenderResult local = render(fs.scene, fs.embree, fs.opt, local_guide.get());
   ASSERT_NE(local.stats.guide_trial.state, GuideTrialState::Pending);
   for (int32_t ranks : {2, 3}) {
-    FarmRun farm = render_farm(fs, ranks, true, true);
+    FarmRun farm = render_farm(fs, ranks, FarmGuide::Table, true);
     EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
     expect_same_counters(farm.result.stats.counters, local.stats.counters);
     EXPECT_EQ(farm.result.stats.guide_trial.state, local.stats.guide_trial.state);
@@ -164,7 +89,7 @@ TEST(FarmProtocol, MixedBackendsAgreeWithTheLocalImage) {
   fs.opt.spp = 32;
   auto local_guide = fs.make_guide();
   RenderResult local = render(fs.scene, fs.embree, fs.opt, local_guide.get());
-  FarmRun farm = render_farm(fs, 3, true, true, {"bvh", "embree", "bvh"});
+  FarmRun farm = render_farm(fs, 3, FarmGuide::Table, true, {"bvh", "embree", "bvh"});
   EXPECT_EQ(farm.result.stats.backend, "bvh+embree");
   EXPECT_EQ(local.stats.backend, "embree");
   EXPECT_EQ(farm.result.stats.counters.samples, local.stats.counters.samples);
@@ -176,8 +101,8 @@ TEST(FarmProtocol, MixedBackendsAgreeWithTheLocalImage) {
 
 TEST(FarmProtocol, GuideSyncOffLetsEachRankLearnAlone) {
   FarmScene fs(door_ajar());
-  FarmRun shared = render_farm(fs, 3, true, true);
-  FarmRun alone = render_farm(fs, 3, true, false);
+  FarmRun shared = render_farm(fs, 3, FarmGuide::Table, true);
+  FarmRun alone = render_farm(fs, 3, FarmGuide::Table, false);
   // Every target reaches every field when shared; alone, a rank's field has
   // only its own tiles' targets.
   uint64_t alone_updates = 0;
@@ -197,7 +122,7 @@ TEST(FarmProtocol, GuideSyncOffLetsEachRankLearnAlone) {
 }
 
 // The network trained data-parallel: every rank computes fixed-point
-// gradients of its own tiles, the sums are all-reduced, and every rank takes
+// gradients of its own tiles, the master sums them, and every rank takes
 // the same Adam steps. The farm's image, and every rank's weights and Adam
 // state, equal the local render's bit for bit, for any rank count.
 TEST(FarmProtocol, NeuralGuideGivesTheLocalImageAndWeightsOnEveryRank) {
@@ -207,7 +132,7 @@ TEST(FarmProtocol, NeuralGuideGivesTheLocalImageAndWeightsOnEveryRank) {
   ASSERT_GT(local.stats.counters.path.guided_samples, 0u);
   ASSERT_GT(local_guide->stats().steps, 0u);
   for (int32_t ranks : {1, 2, 3}) {
-    FarmRun farm = render_farm(fs, ranks, true, true, {}, true);
+    FarmRun farm = render_farm(fs, ranks, FarmGuide::Neural, true);
     EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
     expect_same_counters(farm.result.stats.counters, local.stats.counters);
     for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(farm.guides[r]->same_as(*local_guide)) << "rank " << r;
@@ -219,8 +144,8 @@ TEST(FarmProtocol, NeuralGuideGivesTheLocalImageAndWeightsOnEveryRank) {
 // the image stays finite and every sample is rendered.
 TEST(FarmProtocol, NeuralGuideSyncOffLetsEachRankTrainAlone) {
   FarmScene fs(door_ajar());
-  FarmRun shared = render_farm(fs, 3, true, true, {}, true);
-  FarmRun alone = render_farm(fs, 3, true, false, {}, true);
+  FarmRun shared = render_farm(fs, 3, FarmGuide::Neural, true);
+  FarmRun alone = render_farm(fs, 3, FarmGuide::Neural, false);
   for (const auto& g : alone.guides) {
     const auto& n = dynamic_cast<const NeuralGuide&>(*g);
     EXPECT_GT(n.stats().steps, 0u);
@@ -293,15 +218,16 @@ TEST(FarmProtocol, WorkerFailureReachesTheMaster) {
     worker_end->send(0, kTagError, encode(FarmError{"out of device memory"}));
     while (worker_end->receive(0).tag != kTagStop) {
     }
+    worker_end->send(0, kTagBye, {});
   });
-  FarmMaster master(*master_end, fs.embree, 1, true);
+  FarmMaster master(*master_end, fs.embree, FarmMasterOptions{});
   try {
     render(fs.scene, master, fs.opt);
     ADD_FAILURE() << "the render should fail";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("rank 1: out of device memory"), std::string::npos) << e.what();
   }
-  master.stop();
+  EXPECT_TRUE(master.finish().empty());
   worker.join();
 }
 

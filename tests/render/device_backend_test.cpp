@@ -267,14 +267,24 @@ RenderResult render_farm(const SceneData& scene, const RenderOptions& opt, const
   for (int32_t r = 0; r < ranks; ++r) ends.push_back(hub.endpoint(r));
   const uint32_t spec = effective_specialisation(scene, opt, guides[0]);
   std::vector<std::thread> workers;
+  // The workers' guides, owned as the worker wants them (it would replace one
+  // that missed a fold; none does here): handed back when they are done.
+  std::vector<std::unique_ptr<Guide>> owned(static_cast<size_t>(ranks));
+  for (int32_t r = 1; r < ranks; ++r) owned[r].reset(guides[r]);
   for (int32_t r = 1; r < ranks; ++r)
     workers.emplace_back([&, r] {
-      run_farm_worker(*ends[r], *backends[r], make_tile_settings(opt, spec, true), guides[r], true, 1);
+      FarmWorkerOptions options;
+      options.scene_fingerprint = scene.fingerprint();
+      run_farm_worker(*ends[r], *backends[r], make_tile_settings(opt, spec, true), owned[r], options);
     });
-  FarmMaster master(*ends[0], *backends[0], 1, true);
+  FarmMasterOptions options;
+  options.guide = guides[0];
+  options.scene_fingerprint = scene.fingerprint();
+  FarmMaster master(*ends[0], *backends[0], options);
   RenderResult farm = render(scene, master, opt, guides[0]);
-  master.stop();
+  master.finish();
   for (auto& w : workers) w.join();
+  for (int32_t r = 1; r < ranks; ++r) owned[r].release();
   return farm;
 }
 

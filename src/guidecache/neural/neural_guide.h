@@ -37,7 +37,7 @@ struct NeuralGuideConfig {
   // not at equal time: the output layer (width x (144 + learned lights)) is
   // most of an inference's arithmetic (docs/neural-guide.md).
   uint32_t width = 8;
-  // Adam steps (gradient all-reductions) after each learning pass, each on
+  // Adam steps (gradient reductions) after each learning pass, each on
   // its share of the pass's targets. Many small steps at a high rate are
   // what lets the network follow what the table learns at once; with
   // tile_targets, of the settings measured the one with the lowest error
@@ -109,6 +109,7 @@ class NeuralGuide final : public Guide {
   void views(GuideViews* out) override;
   NeuralTrainingLog* training_log() override { return &log_; }
   uint32_t rounds() const override;
+  uint32_t max_rounds() const override { return 1 + config_.steps_per_pass; }
   std::vector<uint64_t>& round_accumulators(uint32_t round) override;
   void fold_round(uint32_t round) override;
   bool single_sample_learning_passes() const override { return true; }
