@@ -83,17 +83,18 @@ void read_portal(Light& l, const std::vector<Vec3>& p, const Mat4& render_from_w
 // that overflows single precision, or an emission that does, gives nothing
 // meaningful in pbrt-v4 either.
 // The largest radiance a light may emit where a camera ray can see it: a
-// pixel sums samples and their squares in single precision, and the
-// sensor's matrix mixes the channels, so brighter ones make Inf pixels.
+// pixel sums its samples in single precision and the sensor's matrix mixes
+// the channels, so brighter ones make Inf pixels (the variance layer
+// saturates well below that, by design).
 // (Point-like lights are divided by the squared distance first: their
 // intensity is limited by what float holds.)
-constexpr Float kMaxRadiance = 1e18f;
+constexpr Float kMaxRadiance = 1e32f;
 
 void check_radiance_limit(const Rgb& L, const char* what, const DirectiveContext& ctx) {
   if (max_component(glm::abs(L)) > kMaxRadiance) {
     char value[32];
     std::snprintf(value, sizeof value, "%g", static_cast<double>(max_component(glm::abs(L))));
-    ctx.fail(std::string(what) + " is " + value + ", beyond 1e+18: a pixel's sums would overflow single precision");
+    ctx.fail(std::string(what) + " is " + value + ", beyond 1e+32: a pixel's sums would overflow single precision");
   }
 }
 
