@@ -21,7 +21,7 @@
 // Cold code taking only values (never the address of the caller's path
 // state): out of line on both, so the hot loop's registers are not
 // allocated around it.
-#define TESSERA_NOINLINE __noinline__
+#define TESSERA_NOINLINE __noinline__ inline
 #else
 #define TESSERA_HOST_DEVICE
 #define TESSERA_INLINE inline __attribute__((always_inline))
