@@ -479,11 +479,18 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
 
 // The corners of the object's box, placed: within range, then so is every
 // vertex (the cheap test, once per instance, for scenes of many instances).
-bool PbrtParser::placed_within_range(const ObjectDesc& object, const InstanceDesc& inst) const {
-  Vec3 lo(INFINITY), hi(-INFINITY);
-  for (const MeshDesc& m : object.meshes)
-    for (const std::vector<Vec3>* points : {&m.p, &m.p_end})
-      for (const Vec3& p : *points) lo = glm::min(lo, p), hi = glm::max(hi, p);
+// The box is the object's, computed at its first instance (the object is
+// closed by then) and kept: a scene of many instances reads each vertex once.
+bool PbrtParser::placed_within_range(uint32_t object, const InstanceDesc& inst) {
+  if (object_boxes_.size() <= object) object_boxes_.resize(object + 1);
+  ObjectBox& box = object_boxes_[object];
+  if (!box.known) {
+    for (const MeshDesc& m : scene_.objects[object].meshes)
+      for (const std::vector<Vec3>* points : {&m.p, &m.p_end})
+        for (const Vec3& p : *points) box.lo = glm::min(box.lo, p), box.hi = glm::max(box.hi, p);
+    box.known = true;
+  }
+  const Vec3 &lo = box.lo, &hi = box.hi;
   if (!(lo.x <= hi.x)) return true;
   for (const Mat4* map : {&inst.render_from_object, &inst.render_from_object_end})
     for (int c = 0; c < 8; ++c) {
@@ -515,7 +522,7 @@ void PbrtParser::object_instance(const Token& at, uint32_t object) {
   // placed as ordinary meshes, as drawn without instancing.
   const bool singular = glm::determinant(Mat3(inst.render_from_object)) == 0.f ||
                         glm::determinant(Mat3(inst.render_from_object_end)) == 0.f;
-  if (singular || !placed_within_range(def, inst)) {
+  if (singular || !placed_within_range(object, inst)) {
     for (MeshDesc& m : placed_meshes(def, inst)) {
       check_coordinates(m, at);
       scene_.meshes.push_back(std::move(m));

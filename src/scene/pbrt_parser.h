@@ -52,7 +52,7 @@ class PbrtParser {
   // Fails unless every vertex (and its end position when it moves) is within
   // the range single-precision ray tracing represents.
   void check_coordinates(const MeshDesc& mesh, const Token& at) const;
-  bool placed_within_range(const ObjectDesc& object, const InstanceDesc& inst) const;
+  bool placed_within_range(uint32_t object, const InstanceDesc& inst);
   void object_instance(const Token& at, uint32_t object);
   void push(char kind, const Token& at);
   void pop(char kind, const Token& at);
@@ -78,6 +78,11 @@ class PbrtParser {
   DMat4 world_from_render_{1.0};
   std::map<std::string, uint32_t> objects_;  // ObjectBegin names -> SceneDesc::objects (the latest definition)
   std::string open_instance_;  // non-empty between ObjectBegin and ObjectEnd
+  struct ObjectBox {
+    Vec3 lo{INFINITY}, hi{-INFINITY};
+    bool known = false;
+  };
+  std::vector<ObjectBox> object_boxes_;  // per SceneDesc::objects entry, from its first instance
   struct MediumRef {
     int16_t code;       // what MeshDesc::media holds until resolve_media(): -2 - k
     std::string where;  // the first MediumInterface naming it
