@@ -135,8 +135,66 @@ def glossy():
     return s
 
 
+def small_emitter(c, n, half, L):
+    """A square emitter of side 2 half centred at c, emitting along the unit normal n."""
+    t = (1.0, 0.0, 0.0) if abs(n[0]) < 0.9 else (0.0, 1.0, 0.0)
+    d = sum(a * b for a, b in zip(t, n))
+    u = [a - d * b for a, b in zip(t, n)]
+    ul = math.sqrt(sum(a * a for a in u))
+    u = [half * a / ul for a in u]
+    v = [n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]]  # n x u: u x v = n
+    pts = []
+    for su, sv in [(-1, -1), (1, -1), (1, 1), (-1, 1)]:
+        pts += [c[k] + su * u[k] + sv * v[k] for k in range(3)]
+    return ("AttributeBegin\n"
+            f'  AreaLightSource "diffuse" "rgb L" [ {fmt(L)} ]\n'
+            '  Material "diffuse" "rgb reflectance" [ 0 0 0 ]\n'
+            f'  Shape "trianglemesh" "point3 P" [ {fmt(round(x, 4) for x in pts)} ] "integer indices" [ 0 1 2 0 2 3 ]\n'
+            "AttributeEnd\n")
+
+
+def lamp_gallery():
+    """176 small emitters whose power spans three decades: light selection decides the noise."""
+    s = header("Lamp gallery: a hall lit by 96 ceiling lamps and 80 wall sconces (176 small emitters, power "
+               "over three decades, tilted every way); none is seen directly.",
+               (8.0, 1.3, 0.3), (8.0, 0.0, 9.0), 50, (240, 160), 64, 8)
+    s += 'Material "diffuse" "rgb reflectance" [ 0.6 0.6 0.6 ]\n'
+    (x1, y1, z1) = (16.0, 3.5, 10.0)
+    s += sealed_room((0, 0, 0), (x1, y1, z1))
+    seed = [12345]
+
+    def rand():  # a fixed LCG: the scene must not depend on Python's random module
+        seed[0] = (seed[0] * 1103515245 + 12345) % (1 << 31)
+        return seed[0] / float(1 << 31)
+
+    def colour(power):
+        warm = 0.85 + 0.3 * rand()
+        return (round(power * warm, 4), round(power, 4), round(power / warm, 4))
+
+    def tilted(n, spread):
+        m = [a + spread * (2 * rand() - 1) for a in n]
+        ml = math.sqrt(sum(a * a for a in m))
+        return [a / ml for a in m]
+
+    for i in range(12):          # ceiling lamps, facing down, tilted up to ~30 degrees
+        for k in range(8):
+            c = (0.7 + i * 1.33, y1 - 0.02, 0.6 + k * 0.85)
+            s += small_emitter(c, tilted((0, -1, 0), 0.5), 0.07, colour(10 ** (3 * rand() - 1)))
+    for wall_x, inward in [(0.0, 1.0), (x1, -1.0)]:   # sconces on both long walls, facing up and into the hall
+        for k in range(40):
+            c = (wall_x + inward * 0.12, 2.4 + 0.6 * rand(), 0.3 + k * 0.24)
+            s += small_emitter(c, tilted((0.6 * inward, 1, 0), 0.4), 0.05, colour(10 ** (3 * rand() - 0.5)))
+    s += 'AttributeBegin\n  Material "diffuse" "rgb reflectance" [ 0.5 0.45 0.4 ]\n'
+    for i in range(6):           # pillars down the middle and low plinths: shadows from every lamp
+        s += "  " + box((2.0 + i * 2.4, 0, 4.6), (2.4 + i * 2.4, y1, 5.0))
+        s += "  " + box((1.2 + i * 2.4, 0, 2.0 + (i % 2)), (2.0 + i * 2.4, 0.6, 2.8 + (i % 2)))
+    s += "AttributeEnd\n"
+    return s
+
+
 def main():
-    for name, fn in [("door-ajar", door_ajar), ("shelter", shelter), ("pillars", pillars), ("glossy", glossy)]:
+    for name, fn in [("door-ajar", door_ajar), ("shelter", shelter), ("pillars", pillars), ("glossy", glossy),
+                     ("lamp-gallery", lamp_gallery)]:
         path = os.path.join(ROOT, "scenes", name + ".pbrt")
         with open(path, "w") as f:
             f.write(fn())

@@ -44,6 +44,7 @@ struct RenderArgs {
   int64_t spp = -1, max_depth = -1, threads = 0, tile = 16;
   std::string seed;  // "": the scene's; any 64-bit value (parse_seed)
   std::string sampler;  // "" = the scene's
+  std::string light_sampler;  // "" = the scene's
   std::string spectral = "auto";
   std::string backend = "auto";  // auto, embree, bvh, cuda
   std::string light_paths = "auto";
@@ -91,6 +92,9 @@ SceneDesc load_desc(const RenderArgs& a) {
   if (a.spp >= 0) desc.spp = static_cast<int32_t>(a.spp);
   if (!a.seed.empty()) desc.seed = parse_seed(a.seed);
   if (!a.sampler.empty()) desc.sampler = sampler_kind_named(a.sampler).value();  // CLI11 checked the name
+  if (a.light_sampler == "bvh") desc.light_sampler = LightSamplerKind::Bvh;
+  if (a.light_sampler == "power") desc.light_sampler = LightSamplerKind::Power;
+  if (a.light_sampler == "uniform") desc.light_sampler = LightSamplerKind::Uniform;
   desc.spectral = a.spectral == "on" || (a.spectral == "auto" && !spectral_reason(desc).empty());
   return desc;
 }
@@ -609,6 +613,9 @@ CommandRunner add_render_command(CLI::App& app) {
   c->add_option("--sampler", a->sampler,
                 "zsobol | paddedsobol | sobol | stratified | independent | halton (pbrt-v4's samplers; sobol is drawn as paddedsobol); default: the scene's Sampler")
       ->check(CLI::IsMember({"zsobol", "paddedsobol", "sobol", "stratified", "independent", "halton"}));
+  c->add_option("--light-sampler", a->light_sampler,
+                "bvh | power | uniform: how next-event estimation picks a light (pbrt-v4's lightsampler); default: the scene's Integrator, else bvh")
+      ->check(CLI::IsMember({"bvh", "power", "uniform"}));
   c->add_option("--spectral", a->spectral,
                 "on: paths carry sampled wavelengths and colours become pbrt-v4's spectra; off: paths carry RGB; "
                 "auto (default): spectral where it changes the picture (measured spectra, strongly coloured lights)")

@@ -42,7 +42,7 @@ void serialize(Archive& ar, SceneDesc& d) {
      d.camera.where, d.camera.projection, d.camera.has_screen_window, raw_value(d.camera.screen_window),
      d.camera.frame_aspect_ratio);
   ar(d.film.xres, d.film.yres, d.film.crop[0], d.film.crop[1], d.film.crop[2], d.film.crop[3], d.film.filename, raw_value(d.filter), d.spp, d.max_depth, d.seed);
-  ar(d.integrator, d.sampler, d.strata_x, d.strata_y, d.sampler_jitter, d.halton_randomize, d.sampler_spp, d.camera.exposure_time, d.film.iso, d.film.whitebalance, d.film.sensor, d.film.max_component_value,
+  ar(d.integrator, d.light_sampler, d.sampler, d.strata_x, d.strata_y, d.sampler_jitter, d.halton_randomize, d.sampler_spp, d.camera.exposure_time, d.film.iso, d.film.whitebalance, d.film.sensor, d.film.max_component_value,
      raw_value(d.film.pixel_from_radiance), raw_value(d.film.sensor_from_radiance), raw_value(d.film.pixel_from_sensor));
   ar(d.meshes, raw(d.materials), raw(d.textures), d.images, raw(d.area_lights), raw(d.lights), d.warnings, d.source);
   ar(raw(d.media), d.camera_medium, d.grids);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "integrator/integrator_context.h"
+#include "kernels/light_choice.h"
 #include "kernels/light_sampling.h"
 #include "kernels/volume_transport.h"
 
@@ -21,6 +22,7 @@ struct SurfaceScatter {
   int32_t medium;  // the medium the path is in
   static constexpr bool kInMedium = false;
   TESSERA_HOST_DEVICE Vec3 point() const { return h.p; }
+  TESSERA_HOST_DEVICE LightQuery light_query() const { return {h.p, h.ns}; }
   TESSERA_HOST_DEVICE Vec3 local(const Vec3& wi) const { return frame.to_local(wi); }
   // The BSDF times the cosine for a light sample's direction (and a scalar
   // factor of it: see PhaseScatter).
@@ -47,6 +49,7 @@ struct PhaseScatter {
   int32_t medium;
   static constexpr bool kInMedium = true;
   TESSERA_HOST_DEVICE Vec3 point() const { return p; }
+  TESSERA_HOST_DEVICE LightQuery light_query() const { return {p, Vec3(0.f)}; }
   TESSERA_HOST_DEVICE Float local(const Vec3& wi) const { return henyey_greenstein(glm::dot(wo, wi), g); }
   TESSERA_HOST_DEVICE Rgb f(Float) const { return Rgb(1.f); }
   TESSERA_HOST_DEVICE Float scale(Float phase) const { return phase; }
@@ -82,11 +85,11 @@ TESSERA_HOST_DEVICE TESSERA_INLINE DirectLight sample_direct(Ctx& x, PathState& 
   }
   Float pmf = 0.f;
   uint32_t li = 0;
-  if (traced) li = x.guide.pick_light(x.s, cell, u_select, &pmf);
+  if (traced) li = x.guide.pick_light(x.s, at.light_query(), cell, u_select, &pmf);
   else ++x.c.nee_skipped;
   LightSample ls;
   Float learned = 0.f;  // unoccluded contribution of the selected light, for the guide
-  if (pmf > 0.f && sample_light(x.s, li, at.point(), u_light, &ls, Scatter::kInMedium)) {
+  if (pmf > 0.f && sample_light(x.s, li, at.point(), u_light, &ls)) {
     ls.L = light_emission(x.s, st.wl, x.s.lights[li], ls.L);
     const auto wi_l = at.local(ls.wi);
     const Rgb f = at.f(wi_l);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "integrator/integrator_context.h"
+#include "kernels/light_choice.h"
 #include "kernels/light_sampling.h"
 
 namespace tessera {
@@ -37,7 +38,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE void add_found_emission(Ctx& x, PathState& st
     st.L += st.beta * Le;
     return;
   }
-  const Float light_pdf = x.guide.light_pmf(x.s, st.mis.cell, li) * light_pdf_of();
+  const Float light_pdf = x.guide.light_pmf(x.s, LightQuery{st.mis.p, st.mis.n}, st.mis.cell, li) * light_pdf_of();
   st.L += st.beta * Le * mis_weight(last_direction_mis_pdf<Ctx::kSpec>(st.mis), light_pdf, st.mis.balance);
   if constexpr (Ctx::kGuide) learning_note_emission(x.guide, luminance(Le), light_pdf);
 }
@@ -57,7 +58,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE Rgb add_area_emission(Ctx& x, PathState& st, 
   }
   const Rgb Le = light_emission(x.s, st.wl, l, area_light_radiance(x.s, l, h.uv));
   add_found_emission(x, st, static_cast<uint32_t>(light), Le,
-                     [&] { return area_light_pdf_from(x.s, l, st.mis.p, h.p, cos_l, st.mis.in_medium); });
+                     [&] { return area_light_pdf_from(x.s, l, st.mis.p, h.p, cos_l); });
   return Le;
 }
 

@@ -44,7 +44,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE MediumStep scatter_in_medium(Ctx& x, PathStat
   st.mis.pending = false;
   st.mis.cell = -1;
   st.mis.p = at.p;
-  st.mis.in_medium = true;
+  st.mis.n = Vec3(0.f);
   st.specular_bounce = false;
   st.ray.o = at.p;
   st.ray.d = wi;

@@ -91,7 +91,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE void move_past_surface(Ctx& x, PathState& st,
   st.ray.o = offset_ray_origin(v.h, wi);
   st.ray.d = wi;
   st.mis.p = v.h.p;
-  st.mis.in_medium = false;
+  st.mis.n = v.h.ns;
   if constexpr (Ctx::kMedia) st.medium = medium_after(x.s, v.h.triangle, v.h.ng, wi, st.medium);
 }
 

@@ -5,6 +5,7 @@
 #include "camera_projection.h"
 #include "distribution.h"
 #include "light.h"
+#include "light_bvh.h"
 #include "material.h"
 #include "grid_medium.h"
 #include "instance.h"
@@ -118,7 +119,9 @@ struct SceneView {
 
   const Light* lights = nullptr;
   uint32_t num_lights = 0;
-  Distribution1DView light_select;     // power-proportional light selection
+  Distribution1DView light_select;     // power-proportional light selection (light tracing; "power")
+  LightSamplerKind light_sampler = LightSamplerKind::Bvh;  // next-event estimation's choice (light_choice.h)
+  LightBvhView light_bvh;              // its tree ("bvh")
   const int32_t* infinite_lights = nullptr;  // indices of Infinite lights
   uint32_t num_infinite_lights = 0;
   const Distribution2DView* env_distributions = nullptr;  // per light index, valid for image infinite lights

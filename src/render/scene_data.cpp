@@ -322,8 +322,24 @@ void SceneData::build_lights() {
     }
   }
   light_select_ = Distribution1D(power);
+  build_light_tree();
   env_views_.resize(lights_.size());
   for (size_t i = 0; i < lights_.size(); ++i) env_views_[i] = env_storage_[i].view();
+}
+
+void SceneData::build_light_tree() {
+  LightGeometry g;
+  g.positions = positions_.data();
+  g.positions_end = positions_end_.empty() ? nullptr : positions_end_.data();
+  g.normals = normals_.data();
+  g.indices = indices_.data();
+  g.triangles = triangles_.data();
+  g.face_normals = face_normals_.data();
+  std::vector<LightBounds> bounds;
+  bounds.reserve(lights_.size());
+  for (const Light& l : lights_)
+    bounds.push_back(bounds_of_light(l, g, l.image >= 0 ? image_luminance_[static_cast<size_t>(l.image)].mean : 1.f));
+  light_bvh_ = build_light_bvh(bounds);
 }
 
 void SceneData::build_camera() {
@@ -444,6 +460,8 @@ void SceneData::build_view() {
   v.lights = lights_.data();
   v.num_lights = static_cast<uint32_t>(lights_.size());
   v.light_select = light_select_.view();
+  v.light_sampler = desc_.light_sampler;
+  v.light_bvh = light_bvh_.view();
   v.infinite_lights = infinite_lights_.data();
   v.num_infinite_lights = static_cast<uint32_t>(infinite_lights_.size());
   v.env_distributions = env_views_.data();

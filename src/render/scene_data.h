@@ -10,6 +10,7 @@
 #include "kernels/scene_view.h"
 #include "scene/scene_desc.h"
 #include "render/distribution_build.h"
+#include "render/light_bvh_build.h"
 
 namespace tessera {
 
@@ -50,6 +51,7 @@ class SceneData {
   void append_triangles(const MeshDesc& m, uint32_t base);
   void place_instances(const std::vector<Bounds>& object_bounds);
   void build_lights();
+  void build_light_tree();
   void build_camera();
   void build_filter();
   void build_view();
@@ -69,6 +71,7 @@ class SceneData {
   std::vector<Light> lights_;
   std::vector<int32_t> infinite_lights_;
   Distribution1D light_select_;
+  LightBvh light_bvh_;  // next-event estimation's light tree
   // Per image: the mean and largest luminance of its texels (only for
   // images that lights emit).
   struct ImageLuminance {

@@ -12,7 +12,7 @@ namespace {
 
 // A new field in the views must be packed below (or shown not to need it):
 // this fails the build until someone looks.
-static_assert(sizeof(SceneView) == 744, "SceneView changed: pack its new arrays in scene_pack.cpp, then update this size");
+static_assert(sizeof(SceneView) == 792, "SceneView changed: pack its new arrays in scene_pack.cpp, then update this size");
 static_assert(sizeof(BvhView) == 40, "BvhView changed: pack its new arrays in scene_pack.cpp, then update this size");
 
 template <class S, class F>
@@ -111,6 +111,9 @@ PackedScene::PackedScene(const SceneView& s, const BvhView& bvh) {
   point_view(v.light_select.func, s.light_select.func, light_bins);
   point_view(v.light_select.cdf, s.light_select.cdf, light_bins + (light_bins > 0));
   point_view(v.infinite_lights, s.infinite_lights, s.num_infinite_lights);
+  point_view(v.light_bvh.nodes, s.light_bvh.nodes, s.light_bvh.num_nodes);
+  point_view(v.light_bvh.leaf_of_light, s.light_bvh.leaf_of_light, s.light_bvh.leaf_of_light ? s.num_lights : 0);
+  point_view(v.light_bvh.unbounded, s.light_bvh.unbounded, s.light_bvh.num_unbounded);
   pack_env_distributions(s);
   point_view(v.media, s.media, s.num_media);
   point_view(v.triangle_media, s.triangle_media, s.triangle_media ? tris : 0);

@@ -31,6 +31,19 @@ constexpr int kMaxIncludeDepth = 32;
 
 [[noreturn]] void fail(const Token& at, const std::string& problem) { throw SceneError(at.where() + ": " + problem); }
 
+// The Integrator's "lightsampler" (pbrt-v4: bvh, power, uniform, exhaustive).
+LightSamplerKind light_sampler_of(const ParamSet& ps, const Token& at, std::vector<std::string>& warnings) {
+  const std::string name = ps.get_string("lightsampler", "bvh");
+  if (name == "bvh") return LightSamplerKind::Bvh;
+  if (name == "power") return LightSamplerKind::Power;
+  if (name == "uniform") return LightSamplerKind::Uniform;
+  if (name == "exhaustive") {
+    warnings.push_back(at.where() + ": light sampler \"exhaustive\" is drawn as \"bvh\" (the same image in expectation)");
+    return LightSamplerKind::Bvh;
+  }
+  fail(at, "unknown light sampler \"" + name + "\" (bvh, power, uniform or exhaustive)");
+}
+
 const Token& next_token(TokenStream& tokens, size_t& pos, const Token& at, const char* what) {
   if (!tokens.has(pos)) fail(at, std::string("missing ") + what + " after " + at.text);
   return tokens[pos++];
@@ -345,6 +358,7 @@ void PbrtParser::directive(TokenStream& tokens, size_t& pos, const std::string& 
       warn("integrator \"" + type + "\" is rendered with \"path\"");
     scene_.max_depth = ps.get_int("maxdepth", 5);
     if (scene_.max_depth < 0) fail(at, "maxdepth must not be negative");
+    scene_.light_sampler = light_sampler_of(ps, at, warnings);
     if (type != "path") ps.mark_all_used();
     ps.report_unused(warnings);
   } else if (d == "PixelFilter") {

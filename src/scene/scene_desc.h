@@ -9,6 +9,7 @@
 
 #include "kernels/camera_projection.h"
 #include "kernels/light.h"
+#include "kernels/light_bvh.h"
 #include "kernels/material.h"
 #include "kernels/medium.h"
 #include "kernels/sampler.h"
@@ -185,6 +186,9 @@ struct SceneDesc {
   FilterDesc filter;
   int32_t spp = 16;        // pbrt-v4 default pixelsamples
   int32_t max_depth = 5;   // pbrt-v4 default maxdepth
+  // The Integrator's "lightsampler": how next-event estimation picks a
+  // light (kernels/light_choice.h); pbrt-v4's default is "bvh".
+  LightSamplerKind light_sampler = LightSamplerKind::Bvh;
   std::string integrator = "volpath";  // the Integrator directive's type (scene/light_paths.h reads it)
   uint64_t seed = 0;       // Sampler "integer seed"
   // Sampler type (kernels/sampler.h): zsobol (pbrt-v4's default), paddedsobol

@@ -173,6 +173,9 @@ void expect_packed_completely(const SceneData& scene, const std::string& what) {
   c.expect(o.light_select.func, v.light_select.func, o.light_select.n, "light_select.func");
   c.expect(o.light_select.cdf, v.light_select.cdf, o.light_select.n + 1, "light_select.cdf");
   c.expect(o.infinite_lights, v.infinite_lights, o.num_infinite_lights, "infinite_lights");
+  c.expect(o.light_bvh.nodes, v.light_bvh.nodes, o.light_bvh.num_nodes, "light_bvh.nodes");
+  c.expect(o.light_bvh.leaf_of_light, v.light_bvh.leaf_of_light, o.num_lights, "light_bvh.leaf_of_light");
+  c.expect(o.light_bvh.unbounded, v.light_bvh.unbounded, o.light_bvh.num_unbounded, "light_bvh.unbounded");
   for (uint32_t i = 0; o.env_distributions && i < o.num_lights; ++i) {
     const Distribution2DView &e = o.env_distributions[i], &p = v.env_distributions[i];
     c.expect(e.func, p.func, size_t(e.width) * e.height, "env func");

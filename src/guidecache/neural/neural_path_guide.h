@@ -81,20 +81,23 @@ struct NeuralPathGuide {
   // Next-event estimation at every vertex (no table to learn its probability).
   TESSERA_HOST_DEVICE Float nee_probability(int32_t) const { return 1.f; }
   // Light selection as the table's (light_select_pmf, select_light), from
-  // the site's learned distribution where it has one, else by power.
-  TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, int32_t slot, uint32_t li) const {
-    const Float p_power = s.light_select.discrete_pmf(li);
-    if (slot < 0) return p_power;
+  // the site's learned distribution where it has one, else by the scene's
+  // light sampler.
+  TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, const LightQuery& q, int32_t slot, uint32_t li) const {
+    const Float p_base = light_choice_pmf(s, q, li);
+    if (slot < 0) return p_base;
     const NeuralSite& x = site[slot];
     const Float lp = x.light_prob;
-    if (!(lp > 0.f)) return p_power;
-    return mixed_light_pmf(lp, p_power, li < v.lights ? x.light_pmf[li] : 0.f);
+    if (!(lp > 0.f)) return p_base;
+    return mixed_light_pmf(lp, p_base, li < v.lights ? x.light_pmf[li] : 0.f);
   }
-  TESSERA_HOST_DEVICE uint32_t pick_light(const SceneView& s, int32_t slot, Float u, Float* pmf) const {
+  TESSERA_HOST_DEVICE uint32_t pick_light(const SceneView& s, const LightQuery& q, int32_t slot, Float u,
+                                          Float* pmf) const {
     const Float lp = slot >= 0 ? site[slot].light_prob : 0.f;
-    if (!(lp > 0.f)) return s.light_select.sample_discrete(u, pmf);
-    const uint32_t li = pick_mixed_light(s, lp, u, [&](Float ul) { return neural_sample_light(v, site[slot], ul); });
-    *pmf = light_pmf(s, slot, li);
+    if (!(lp > 0.f)) return choose_light(s, q, u, pmf);
+    const uint32_t li =
+        pick_mixed_light(s, q, lp, u, [&](Float ul) { return neural_sample_light(v, site[slot], ul); });
+    *pmf = light_pmf(s, q, slot, li);
     return li;
   }
 

@@ -6,15 +6,16 @@
 namespace tessera {
 
 // No guiding: every hook is the unguided integrator's choice (light
-// selection by power, next-event estimation everywhere, the BSDF alone).
+// selection by the scene's light sampler, next-event estimation everywhere,
+// the BSDF alone).
 struct NoPathGuide {
   PendingTarget pending;  // never filled
   TESSERA_HOST_DEVICE Float nee_probability(int32_t) const { return 1.f; }
-  TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, int32_t, uint32_t li) const {
-    return s.light_select.discrete_pmf(li);
+  TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, const LightQuery& q, int32_t, uint32_t li) const {
+    return light_choice_pmf(s, q, li);
   }
-  TESSERA_HOST_DEVICE uint32_t pick_light(const SceneView& s, int32_t, Float u, Float* pmf) const {
-    return s.light_select.sample_discrete(u, pmf);
+  TESSERA_HOST_DEVICE uint32_t pick_light(const SceneView& s, const LightQuery& q, int32_t, Float u, Float* pmf) const {
+    return choose_light(s, q, u, pmf);
   }
   TESSERA_HOST_DEVICE bool locates(int32_t, int32_t) const { return false; }
   TESSERA_HOST_DEVICE int32_t locate(const Vec3&, const Vec3&) { return -1; }

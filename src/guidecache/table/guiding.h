@@ -4,6 +4,7 @@
 #pragma once
 
 #include "kernels/bsdf.h"
+#include "kernels/light_choice.h"
 #include "guidecache/table/guide_view.h"
 #include "kernels/rng.h"
 #include "kernels/sampler.h"
@@ -18,46 +19,49 @@ TESSERA_HOST_DEVICE inline Float nee_probability(const GuideView* g, int32_t cel
 }
 
 // Learned light selection, shared by both guides: with probability lp a
-// light is drawn from the learned distribution, else by power. Its pmf for a
-// light of power-based pmf p_power and learned pmf p_learned:
-TESSERA_HOST_DEVICE inline Float mixed_light_pmf(Float lp, Float p_power, Float p_learned) {
-  return (1.f - lp) * p_power + lp * p_learned;
+// light is drawn from the learned distribution, else by the scene's light
+// sampler (light_choice.h). Its pmf for a light of sampler pmf p_base and
+// learned pmf p_learned:
+TESSERA_HOST_DEVICE inline Float mixed_light_pmf(Float lp, Float p_base, Float p_learned) {
+  return (1.f - lp) * p_base + lp * p_learned;
 }
 // ... and the draw with one uniform number u (lp > 0): the part of u below lp,
 // rescaled, picks from the learned distribution (sample_learned(u')).
 template <class SampleLearned>
-TESSERA_HOST_DEVICE inline uint32_t pick_mixed_light(const SceneView& s, Float lp, Float u,
+TESSERA_HOST_DEVICE inline uint32_t pick_mixed_light(const SceneView& s, const LightQuery& q, Float lp, Float u,
                                                      const SampleLearned& sample_learned) {
   if (u < lp) return sample_learned(glm::min(u / lp, 0x1.fffffep-1f));
-  return s.light_select.sample_discrete(glm::min((u - lp) / (1.f - lp), 0x1.fffffep-1f), nullptr);
+  Float pmf_base = 0.f;
+  return choose_light(s, q, glm::min((u - lp) / (1.f - lp), 0x1.fffffep-1f), &pmf_base);
 }
 
-// Probability that next-event estimation at a point in `cell` samples light
+// Probability that next-event estimation at point q in `cell` samples light
 // li: that it is traced at all, times the selection probability (cell < 0 or
-// no learned lights: the power-based distribution alone). The density of the
+// no learned lights: the light sampler's alone). The density of the
 // light-sampling strategy in every MIS weight carries it.
-TESSERA_HOST_DEVICE inline Float light_select_pmf(const SceneView& s, const GuideView* g, int32_t cell, uint32_t li) {
-  Float p_power = s.light_select.discrete_pmf(li);
-  if (!g || cell < 0) return p_power;
+TESSERA_HOST_DEVICE inline Float light_select_pmf(const SceneView& s, const LightQuery& q, const GuideView* g,
+                                                  int32_t cell, uint32_t li) {
+  const Float p_base = light_choice_pmf(s, q, li);
+  if (!g || cell < 0) return p_base;
   const Float p_nee = g->nee_prob[cell];
-  if (g->lights == 0) return p_nee * p_power;
+  if (g->lights == 0) return p_nee * p_base;
   const Float lp = g->cell_light_prob[cell];
-  return p_nee * mixed_light_pmf(lp, p_power, g->light_distribution(cell).discrete_pmf(li));
+  return p_nee * mixed_light_pmf(lp, p_base, g->light_distribution(cell).discrete_pmf(li));
 }
 
 // Selects a light with one uniform number, given that next-event estimation
 // is traced; *pmf is light_select_pmf (the traced probability included).
-TESSERA_HOST_DEVICE inline uint32_t select_light(const SceneView& s, const GuideView* g, int32_t cell, Float u,
-                                                 Float* pmf) {
+TESSERA_HOST_DEVICE inline uint32_t select_light(const SceneView& s, const LightQuery& q, const GuideView* g,
+                                                 int32_t cell, Float u, Float* pmf) {
   const Float lp = g && g->lights > 0 && cell >= 0 ? g->cell_light_prob[cell] : 0.f;
   if (lp <= 0.f) {
-    const uint32_t li = s.light_select.sample_discrete(u, pmf);
+    const uint32_t li = choose_light(s, q, u, pmf);
     *pmf *= nee_probability(g, cell);
     return li;
   }
   const uint32_t li = pick_mixed_light(
-      s, lp, u, [&](Float ul) { return g->light_distribution(cell).sample_discrete(ul, nullptr); });
-  *pmf = light_select_pmf(s, g, cell, li);
+      s, q, lp, u, [&](Float ul) { return g->light_distribution(cell).sample_discrete(ul, nullptr); });
+  *pmf = light_select_pmf(s, q, g, cell, li);
   return li;
 }
 

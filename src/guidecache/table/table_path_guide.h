@@ -15,11 +15,12 @@ struct TablePathGuide {
   TESSERA_HOST_DEVICE Float nee_probability(int32_t cell) const { return tessera::nee_probability(&g, cell); }
   // Probability that next-event estimation at `cell` (-1: none, as in a
   // medium) traces a shadow ray to light li, and the draw of that light.
-  TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, int32_t cell, uint32_t li) const {
-    return light_select_pmf(s, &g, cell, li);
+  TESSERA_HOST_DEVICE Float light_pmf(const SceneView& s, const LightQuery& q, int32_t cell, uint32_t li) const {
+    return light_select_pmf(s, q, &g, cell, li);
   }
-  TESSERA_HOST_DEVICE uint32_t pick_light(const SceneView& s, int32_t cell, Float u, Float* pmf) const {
-    return select_light(s, &g, cell, u, pmf);
+  TESSERA_HOST_DEVICE uint32_t pick_light(const SceneView& s, const LightQuery& q, int32_t cell, Float u,
+                                          Float* pmf) const {
+    return select_light(s, q, &g, cell, u, pmf);
   }
 
   TESSERA_HOST_DEVICE bool locates(int32_t, int32_t) const { return true; }
