@@ -89,7 +89,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE DirectLight sample_direct(Ctx& x, PathState& 
   else ++x.c.nee_skipped;
   LightSample ls;
   Float learned = 0.f;  // unoccluded contribution of the selected light, for the guide
-  if (pmf > 0.f && sample_light(x.s, li, at.point(), u_light, &ls)) {
+  if (pmf > 0.f && sample_light(x.s, li, at.point(), u_light, &ls, Scatter::kInMedium)) {
     ls.L = light_emission(x.s, st.wl, x.s.lights[li], ls.L);
     const auto wi_l = at.local(ls.wi);
     const Rgb f = at.f(wi_l);

@@ -58,7 +58,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE Rgb add_area_emission(Ctx& x, PathState& st, 
   }
   const Rgb Le = light_emission(x.s, st.wl, l, area_light_radiance(x.s, l, h.uv));
   add_found_emission(x, st, static_cast<uint32_t>(light), Le,
-                     [&] { return area_light_pdf_from(x.s, l, st.mis.p, h.p, cos_l); });
+                     [&] { return area_light_pdf_from(x.s, l, st.mis.p, h.p, cos_l, st.mis.in_medium); });
   return Le;
 }
 

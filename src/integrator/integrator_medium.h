@@ -45,6 +45,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE MediumStep scatter_in_medium(Ctx& x, PathStat
   st.mis.cell = -1;
   st.mis.p = at.p;
   st.mis.n = Vec3(0.f);
+  st.mis.in_medium = true;
   st.specular_bounce = false;
   st.ray.o = at.p;
   st.ray.d = wi;

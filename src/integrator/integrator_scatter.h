@@ -92,6 +92,7 @@ TESSERA_HOST_DEVICE TESSERA_INLINE void move_past_surface(Ctx& x, PathState& st,
   st.ray.d = wi;
   st.mis.p = v.h.p;
   st.mis.n = v.h.ns;
+  st.mis.in_medium = false;
   if constexpr (Ctx::kMedia) st.medium = medium_after(x.s, v.h.triangle, v.h.ng, wi, st.medium);
 }
 

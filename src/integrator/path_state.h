@@ -80,6 +80,7 @@ struct MisMemory {
   bool pending = false;
   Vec3 p{0.f};             // the vertex: MIS on emitter hits measures from it, as NEE does
   Vec3 n{0.f};             // its shading normal (zero in a medium): the light sampler's choice depends on it
+  bool in_medium = false;  // whether it was in a medium (sample_light's in_medium)
   int32_t cell = -1;       // its guide handle (its light selection)
 };
 

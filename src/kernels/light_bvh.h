@@ -48,6 +48,7 @@ TESSERA_HOST_DEVICE inline Float cos_sub_clamped(Float sin_a, Float cos_a, Float
 TESSERA_HOST_DEVICE inline Float sin_sub_clamped(Float sin_a, Float cos_a, Float sin_b, Float cos_b) {
   return cos_a > cos_b ? 0.f : sin_a * cos_b - cos_a * sin_b;
 }
+// (light_node_importance inlines both, to take each sine only where needed.)
 
 // The importance of a node's lights at point p with shading normal n (zero
 // in a medium): power over clamped squared distance, times the cosine bound
@@ -59,23 +60,28 @@ TESSERA_HOST_DEVICE inline Float light_node_importance(const LightBvhNode& b, co
   // pbrt-v4 clamps the squared distance by half the box's diagonal; the
   // floor keeps a point light's importance finite at its own position.
   const Float d2 = glm::max(glm::max(dist2, b.half_diagonal), 1e-12f);
-  const Vec3 wi = dist2 > 0.f ? to_p / glm::sqrt(dist2) : Vec3(0.f, 0.f, 1.f);
+  const Vec3 wi = dist2 > 0.f ? to_p * glm::inversesqrt(dist2) : Vec3(0.f, 0.f, 1.f);
   Float cos_w = glm::dot(b.w, wi);
   if (b.flags & kLightNodeTwoSided) cos_w = glm::abs(cos_w);
-  const Float sin_w = safe_sqrt(1.f - cos_w * cos_w);
   // The directions the box subtends from p (its bounding sphere's cone).
   const bool inside = dist2 <= b.radius2;
-  const Float cos_b = inside ? -1.f : safe_sqrt(1.f - b.radius2 / dist2);
-  const Float sin_b = inside ? 0.f : glm::sqrt(b.radius2 / dist2);
-  const Float cos_x = cos_sub_clamped(sin_w, cos_w, b.sin_o, b.cos_o);
-  const Float sin_x = sin_sub_clamped(sin_w, cos_w, b.sin_o, b.cos_o);
+  const Float sin2_b = inside ? 0.f : b.radius2 / dist2;
+  const Float cos_b = inside ? -1.f : safe_sqrt(1.f - sin2_b);
+  // cos_sub_clamped and sin_sub_clamped, each sine taken only where the
+  // clamp does not decide (the same values, fewer square roots).
+  Float cos_x = 1.f, sin_x = 0.f;
+  if (!(cos_w > b.cos_o)) {
+    const Float sin_w = safe_sqrt(1.f - cos_w * cos_w);
+    cos_x = cos_w * b.cos_o + sin_w * b.sin_o;
+    sin_x = sin_w * b.cos_o - cos_w * b.sin_o;
+  }
+  const Float sin_b = glm::sqrt(sin2_b);
   const Float cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
   if (cos_p <= b.cos_e) return 0.f;
   Float importance = b.phi * cos_p / d2;
   if (n.x != 0.f || n.y != 0.f || n.z != 0.f) {
     const Float cos_i = glm::abs(glm::dot(wi, n));
-    const Float sin_i = safe_sqrt(1.f - cos_i * cos_i);
-    importance *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
+    if (!(cos_i > cos_b)) importance *= cos_i * cos_b + safe_sqrt(1.f - cos_i * cos_i) * sin_b;
   }
   return importance > 0.f ? importance : 0.f;
 }

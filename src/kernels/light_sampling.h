@@ -76,26 +76,19 @@ TESSERA_HOST_DEVICE inline LightTriangle light_triangle(const SceneView& s, uint
   return {s.positions[idx[0]], s.positions[idx[1]], s.positions[idx[2]]};
 }
 
-// The solid angle triangle t (of area `area`) subtends from ref_p where
-// sample_light draws it by solid angle, else 0 (by area). By solid angle
-// where it looks large (spherical_triangle.h): an area sample's weight
-// A cos / d^2 grows without bound as ref_p nears the light (a wall beside a
-// lamp). The solid angle is only computed where the area over the squared
-// distance to the centroid says it may be large.
-TESSERA_HOST_DEVICE inline Float light_solid_angle_for_sampling(const LightTriangle& t, Float area, const Vec3& ref_p) {
-  const Vec3 d = (t.v0 + t.v1 + t.v2) * (1.f / 3.f) - ref_p;
-  if (!(area >= kSphericalSampleGate * glm::dot(d, d))) return 0.f;
-  const Float omega = triangle_solid_angle(ref_p, t.v0, t.v1, t.v2);
-  return samples_by_solid_angle(omega) ? omega : 0.f;
-}
-
 // The solid-angle pdf with which sample_light draws point p_light of area
-// light l from ref_p. For the MIS weights of directions that found the light.
+// light l from ref_p (with the same in_medium): uniform in solid angle from
+// points in media where the triangle looks large enough
+// (spherical_triangle.h), else by area. For the MIS weights of directions
+// that found the light.
 TESSERA_HOST_DEVICE inline Float area_light_pdf_from(const SceneView& s, const Light& l, const Vec3& ref_p,
-                                                     const Vec3& p_light, Float cos_l) {
+                                                     const Vec3& p_light, Float cos_l, bool in_medium) {
   if (!(fabsf(cos_l) > 0.f)) return 0.f;
-  const Float omega = light_solid_angle_for_sampling(light_triangle(s, l.triangle), l.area, ref_p);
-  if (omega > 0.f) return 1.f / omega;
+  if (in_medium) {
+    const LightTriangle t = light_triangle(s, l.triangle);
+    const Float omega = triangle_solid_angle(ref_p, t.v0, t.v1, t.v2);
+    if (samples_by_solid_angle(omega)) return 1.f / omega;
+  }
   return area_light_pdf(l.area, glm::length(p_light - ref_p), cos_l);
 }
 
@@ -158,22 +151,27 @@ TESSERA_HOST_DEVICE inline Rgb point_like_intensity(const SceneView& s, const Li
   }
 }
 
-// Area lights are sampled by solid angle where they look large from ref_p
-// (light_solid_angle_for_sampling), else by area.
+// in_medium: ref_p is a scattering point in a medium (area lights are then
+// sampled by solid angle where they look large: area_light_pdf_from).
 TESSERA_HOST_DEVICE TESSERA_INLINE bool sample_light(const SceneView& s, uint32_t light_index, const Vec3& ref_p, Vec2 u,
-                                             LightSample* out) {
+                                             LightSample* out, bool in_medium = false) {
   const Light& l = s.lights[light_index];
   LightSample ls;
   switch (l.type) {
     case LightType::Area: {
       Vec3 b = sample_uniform_triangle(u);
-      const LightTriangle t = light_triangle(s, l.triangle);
-      const Float omega = light_solid_angle_for_sampling(t, l.area, ref_p);
-      if (omega > 0.f) {
-        Vec3 w;
-        if (!sample_spherical_triangle(ref_p, t.v0, t.v1, t.v2, u, &w)) return false;
-        const Vec2 bary = triangle_barycentrics_along(ref_p, w, t.v0, t.v1, t.v2);
-        b = Vec3(1.f - bary.x - bary.y, bary.x, bary.y);
+      Float omega = 0.f;
+      if (in_medium) {
+        const LightTriangle t = light_triangle(s, l.triangle);
+        omega = triangle_solid_angle(ref_p, t.v0, t.v1, t.v2);
+        if (samples_by_solid_angle(omega)) {
+          Vec3 w;
+          if (!sample_spherical_triangle(ref_p, t.v0, t.v1, t.v2, u, &w)) return false;
+          const Vec2 bary = triangle_barycentrics_along(ref_p, w, t.v0, t.v1, t.v2);
+          b = Vec3(1.f - bary.x - bary.y, bary.x, bary.y);
+        } else {
+          omega = 0.f;
+        }
       }
       SurfaceHit h = make_surface_hit(s, l.triangle, b.y, b.z);
       const Vec3& p = h.p;
