@@ -24,6 +24,9 @@ TEST(PbrtOptions, Defaults) {
   EXPECT_EQ(s.max_depth, 5);
   EXPECT_EQ(s.filter.type, FilterType::Gaussian);
   EXPECT_FLOAT_EQ(s.filter.radius, 1.5f);
+  EXPECT_FLOAT_EQ(s.filter.sigma, 0.5f);
+  EXPECT_EQ(s.sampler, SamplerKind::ZSobol);
+  EXPECT_EQ(s.light_sampler, LightSamplerKind::Bvh);
   EXPECT_EQ(s.materials.size(), 1u);
   EXPECT_EQ(s.materials[0].type, MaterialType::Diffuse);
   EXPECT_FLOAT_EQ(s.materials[0].reflectance.value.x, 0.5f);
