@@ -92,9 +92,8 @@ SceneDesc load_desc(const RenderArgs& a) {
   if (a.spp >= 0) desc.spp = static_cast<int32_t>(a.spp);
   if (!a.seed.empty()) desc.seed = parse_seed(a.seed);
   if (!a.sampler.empty()) desc.sampler = sampler_kind_named(a.sampler).value();  // CLI11 checked the name
-  if (a.light_sampler == "bvh") desc.light_sampler = LightSamplerKind::Bvh;
-  if (a.light_sampler == "power") desc.light_sampler = LightSamplerKind::Power;
-  if (a.light_sampler == "uniform") desc.light_sampler = LightSamplerKind::Uniform;
+  for (LightSamplerKind k : {LightSamplerKind::Bvh, LightSamplerKind::Power, LightSamplerKind::Uniform})
+    if (a.light_sampler == light_sampler_name(k)) desc.light_sampler = k;  // CLI11 checked the name
   desc.spectral = a.spectral == "on" || (a.spectral == "auto" && !spectral_reason(desc).empty());
   return desc;
 }
@@ -276,6 +275,7 @@ ExrMetadata base_metadata(const MasterSetup& m, uint32_t spec) {
   meta.strings["sampler"] = sampler_name(m.opt.sampler.kind);
   meta.strings["effects"] = describe_effects(m.scene->effects());
   meta.strings["transport"] = m.scene->desc().spectral ? "spectral" : "rgb";
+  meta.strings["light_sampler"] = light_sampler_name(m.scene->desc().light_sampler);
   meta.strings["specialisation"] = describe_specialisation(spec);
   meta.strings["software"] = "tessera " TESSERA_VERSION;
   meta.strings["scene"] = m.scene->desc().source;

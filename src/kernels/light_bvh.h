@@ -13,6 +13,10 @@
 namespace tessera {
 
 enum class LightSamplerKind : uint32_t { Bvh = 0, Power, Uniform };
+// pbrt-v4's name of each ("lightsampler").
+inline const char* light_sampler_name(LightSamplerKind k) {
+  return k == LightSamplerKind::Power ? "power" : k == LightSamplerKind::Uniform ? "uniform" : "bvh";
+}
 
 // Node flags.
 constexpr uint32_t kLightNodeLeaf = 1u;

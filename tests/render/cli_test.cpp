@@ -203,6 +203,9 @@ TEST_F(CliTest, ExrHasVarianceLayerAndMetadata) {
   auto* transport = h.findTypedAttribute<Imf::StringAttribute>("transport");
   ASSERT_NE(transport, nullptr);
   EXPECT_EQ(transport->value(), "spectral");  // the built-in Cornell box's light is orange
+  auto* light_sampler = h.findTypedAttribute<Imf::StringAttribute>("light_sampler");
+  ASSERT_NE(light_sampler, nullptr);
+  EXPECT_EQ(light_sampler->value(), "bvh");  // pbrt-v4's default
   EXPECT_NE(h.findTypedAttribute<Imf::DoubleAttribute>("seconds"), nullptr);
   EXPECT_NE(h.findTypedAttribute<Imf::StringAttribute>("software"), nullptr);
 }
