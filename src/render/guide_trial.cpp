@@ -12,7 +12,7 @@ namespace {
 // group samples the whole image (bright and dark parts alike) and the groups'
 // means estimate the same quantity.
 uint32_t pixel_group(size_t i) {
-  return static_cast<uint32_t>((static_cast<uint64_t>(i) * 0x9E3779B97F4A7C15ull) >> 61) % kGuideTrialGroups;
+  return static_cast<uint32_t>((static_cast<uint64_t>(i) * 0x9E3779B97F4A7C15ull) >> 40) % kGuideTrialGroups;
 }
 
 // Guided inefficiency over unguided; a tie with no noise at all goes to the
@@ -105,6 +105,13 @@ int guide_trial_decide(GuideTrial& t) {
   w.start_spp = kGuideTrialStartSpp << k;
   for (int m = 0; m < 2; ++m) {
     w.rel_var[m] = guide_trial_median(t.estimates[m], kGuideTrialEstimates);
+    double sum = 0.0, n = 0.0;
+    for (double e : t.estimates[m]) {
+      if (!(e >= 0) || !std::isfinite(e)) continue;
+      sum += e;
+      n += 1.0;
+    }
+    w.mean_rel_var[m] = n > 0 ? sum / n : 0.0;
     w.cost[m] = t.queries[m] / static_cast<double>(std::max<uint64_t>(1, t.samples[m]));
     w.inefficiency[m] = w.rel_var[m] * w.cost[m];
     t.passes[m] = 0;
@@ -117,7 +124,7 @@ int guide_trial_decide(GuideTrial& t) {
   const bool mature = w.start_spp >= t.mature_spp;
   // Tentatively: a young guide keeps learning unless it loses by 2x; a mature one by its verdict.
   t.guiding = ratio < (mature ? 1.0 : kGuideTrialEarlyMargin) ? 1u : 0u;
-  bool final_now = t.windows_done >= kGuideTrialWindows;
+  bool final_now = t.windows_done >= kGuideTrialWindows || (mature && ratio < 1.0 / kGuideTrialEarlyMargin);
   if (k >= 1) {
     const double before = window_ratio(t.window[k - 1]);
     // Twice in a row far behind: off, young or not. Mature: two windows that
@@ -134,7 +141,8 @@ int guide_trial_decide(GuideTrial& t) {
   t.inefficiency[1] = w.inefficiency[1];
   // The loser's samples so far leave the image where they are much noisier than the winner's.
   const int loser = t.guiding ? 0 : 1;
-  const bool noisier = w.rel_var[loser] >= kGuideTrialDropRatio * w.rel_var[1 - loser] && w.rel_var[loser] > 0;
+  const bool noisier = (w.rel_var[loser] >= kGuideTrialDropRatio * w.rel_var[1 - loser] && w.rel_var[loser] > 0) ||
+                       (w.mean_rel_var[loser] >= kGuideTrialDropRatio * w.mean_rel_var[1 - loser] && w.mean_rel_var[loser] > 0);
   if (!noisier || t.method_spp[loser] == 0) return -1;
   t.dropped_method = loser;
   t.dropped_spp = t.method_spp[loser];

@@ -1,8 +1,9 @@
 // `--guide auto`'s trial: does the guide pay on this scene?
 //
 // Trial windows start once the guide has learned from the first
-// kGuideTrialStartSpp samples per pixel, at sample index 32, and then at
-// each doubling (64, 128, ... up to kGuideTrialWindows windows). In each
+// kGuideTrialStartSpp samples per pixel (every one of them learns: the
+// default --guide-learn-spp), at sample index 16, and then at each doubling
+// (32, 64, ... up to kGuideTrialWindows windows). In each
 // window guided and unguided passes alternate, and each method's relative
 // variance of one sample is measured from its passes' own per-pixel
 // variances, robustly: the pixels fall into kGuideTrialGroups interleaved
@@ -14,20 +15,23 @@
 // window's ratio.
 //
 // A guide is judged at matched learning: a window counts as mature once the
-// guide has learned from kGuideTrialMatureSamples paths (32 spp of 180x180
+// guide has learned from kGuideTrialMatureSamples paths (16 spp of 181x181
 // pixels; a small image needs more spp, up to kGuideTrialMatureSppCap).
 // Between windows the render goes on tentatively with the winner, except
 // that a young guide goes on unless it loses by kGuideTrialEarlyMargin.
 // The decision is final (guide_trial_decide) when two windows in a row put
 // the guide behind by kGuideTrialEarlyMargin, or at a mature window that
 // agrees with the window before, or else at the second mature window. No
-// single window decides.
+// single window switches the guide off; a mature guide ahead by
+// kGuideTrialEarlyMargin is kept at once (a guide that learns on only gets
+// better).
 //
 // Samples of the losing method do not keep full weight: when the decision
 // is final, the loser's passes so far (for a switched-off guide: the
 // learning passes too) are taken out of the image where its measured
-// relative variance per sample is at least kGuideTrialDropRatio times the
-// winner's: there they add more variance than their samples remove. Each
+// relative variance per sample, robust or plain (the plain mean counts the
+// fireflies the image will hold), is at least kGuideTrialDropRatio times
+// the winner's: there they add more variance than their samples remove. Each
 // pass is unbiased, and the weight (1 or 0) is one for the whole image,
 // from medians over thousands of pixels, so a pixel's own samples move it
 // negligibly; passes after the decision do not depend on it at all. The
@@ -48,17 +52,17 @@ namespace tessera {
 
 // Trial windows start when this many samples per pixel have trained the
 // guide, and then at each doubling of the sample index.
-constexpr uint32_t kGuideTrialStartSpp = 32;
+constexpr uint32_t kGuideTrialStartSpp = 16;
 // Guided and unguided passes per window, each, alternating (guided first).
-constexpr uint32_t kGuideTrialPassesPerMethod = 2;
-// Windows at most (at 32, 64, ... 512 spp): the last one's verdict is final.
-constexpr uint32_t kGuideTrialWindows = 5;
+constexpr uint32_t kGuideTrialPassesPerMethod = 1;
+// Windows at most (at 16, 32, ... 512 spp): the last one's verdict is final.
+constexpr uint32_t kGuideTrialWindows = 6;
 // Paths the guide has learned from when a window counts as mature, and the
 // most samples per pixel that takes.
-constexpr uint64_t kGuideTrialMatureSamples = uint64_t{1} << 20;
+constexpr uint64_t kGuideTrialMatureSamples = uint64_t{1} << 19;
 constexpr uint32_t kGuideTrialMatureSppCap = 256;
 // Interleaved pixel groups whose mean relative variances give the median.
-constexpr uint32_t kGuideTrialGroups = 8;
+constexpr uint32_t kGuideTrialGroups = 16;
 constexpr uint32_t kGuideTrialEstimates = kGuideTrialPassesPerMethod * kGuideTrialGroups;
 // Relative cost of a guided path's ray query (guide lookups, learning, the
 // mixture pdf) against an unguided one.
@@ -78,6 +82,7 @@ enum class GuideTrialState : uint32_t { Off = 0, Pending, Kept, SwitchedOff };
 struct GuideTrialWindow {
   uint32_t start_spp = 0;        // sample index at which the window started
   double rel_var[2] = {0, 0};    // robust relative variance of one sample
+  double mean_rel_var[2] = {0, 0};  // the plain mean over the groups (fireflies included)
   double cost[2] = {0, 0};       // weighted ray queries per sample
   double inefficiency[2] = {0, 0};  // rel_var x cost
 };

@@ -131,6 +131,8 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
         windows.push_back({{"start_spp", w.start_spp},
                            {"guided_rel_var", w.rel_var[1]},
                            {"unguided_rel_var", w.rel_var[0]},
+                           {"guided_mean_rel_var", w.mean_rel_var[1]},
+                           {"unguided_mean_rel_var", w.mean_rel_var[0]},
                            {"guided_cost", w.cost[1]},
                            {"unguided_cost", w.cost[0]},
                            {"guided_inefficiency", w.inefficiency[1]},

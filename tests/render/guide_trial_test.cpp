@@ -60,7 +60,7 @@ TEST(GuideTrial, WindowsStartAtDoublingsAndAlternateGuidedFirst) {
   GuideTrial t;
   EXPECT_EQ(guide_trial_next_pass(t, 100), TrialPass::None);  // no trial asked for
   EXPECT_TRUE(guide_trial_guiding(t));
-  guide_trial_start(t, 1u << 20);  // a guide mature at once
+  guide_trial_start(t, kGuideTrialMatureSamples);  // a guide mature at once
   EXPECT_EQ(guide_trial_next_pass(t, kGuideTrialStartSpp - 1), TrialPass::None);
   EXPECT_EQ(guide_trial_next_pass(t, kGuideTrialStartSpp), TrialPass::Guided);
   Film f = film_of(kGuideTrialStartSpp, 1.0, 0.1);
@@ -81,7 +81,7 @@ TEST(GuideTrial, WindowsStartAtDoublingsAndAlternateGuidedFirst) {
 
 TEST(GuideTrial, SmallImagesJudgeTheGuideAfterMoreSamplesPerPixel) {
   EXPECT_EQ(guide_trial_mature_spp(240 * 240), kGuideTrialStartSpp);
-  EXPECT_EQ(guide_trial_mature_spp(128 * 128), 64u);
+  EXPECT_EQ(guide_trial_mature_spp(128 * 128), 32u);
   EXPECT_EQ(guide_trial_mature_spp(40 * 30), kGuideTrialMatureSppCap);
   EXPECT_EQ(guide_trial_mature_spp(0), kGuideTrialMatureSppCap);
 }
@@ -147,13 +147,13 @@ GuideTrial synthetic_trial(const SyntheticWindow& w, double plain[2]) {
 }
 
 // A guide whose samples have a quarter of the unguided variance, but whose
-// passes each hold three samples 10^4 times the mean (a young guide's
+// passes each hold six samples 10^4 times the mean (a young guide's
 // fireflies): the plain mean over pixels puts it far behind; the median over
 // pixel groups sees the typical pixel, keeps the guide, and judges it mature
 // windows later the same way.
 TEST(GuideTrialEstimator, AFewHugeOutliersDoNotFlipTheDecision) {
   double plain[2];
-  const GuideTrial t = synthetic_trial({0.25, 0.5, 3, 1e4}, plain);
+  const GuideTrial t = synthetic_trial({0.2, 0.4, 6, 1e4}, plain);
   EXPECT_GT(plain[1] * kGuidedQueryCost, plain[0]) << "the outliers must put the guide behind on the plain mean";
   EXPECT_EQ(t.state, GuideTrialState::Kept);
   EXPECT_LT(t.window[0].inefficiency[1], t.window[0].inefficiency[0]);
@@ -193,7 +193,7 @@ TEST(GuideTrial, AYoungGuideSlightlyBehindKeepsLearningUntilMature) {
     }
     return guide_trial_decide(t);
   };
-  for (double ratio : {1.5, 1.3, 1.1}) {  // windows at 32, 64, 128 spp: young
+  for (double ratio : {1.5, 1.3, 1.1, 1.2}) {  // windows at 16, 32, 64, 128 spp: young
     window(ratio);
     EXPECT_EQ(t.state, GuideTrialState::Pending);
     EXPECT_TRUE(guide_trial_guiding(t));
@@ -202,7 +202,7 @@ TEST(GuideTrial, AYoungGuideSlightlyBehindKeepsLearningUntilMature) {
   EXPECT_EQ(t.state, GuideTrialState::Pending);
   window(0.5);  // the second mature window decides
   EXPECT_EQ(t.state, GuideTrialState::Kept);
-  EXPECT_EQ(t.windows_done, 5u);
+  EXPECT_EQ(t.windows_done, 6u);
 }
 
 RenderOptions trial_options(uint32_t spp) {
@@ -264,7 +264,7 @@ TEST(GuideTrial, KeepsGuidingWhereItPaysAndTheImageMatchesUnguided) {
 // all about 1001, guided ones scatter widely (a relative variance per sample
 // thousands of times higher). The trial switches the guide off after two
 // windows, takes every guided sample out of the image and renders them again
-// unguided: the image is as precise as --guide none's at the same spp.
+// unguided: the image holds no guided sample.
 TEST(GuideTrial, DepthThousandFurnaceKeepsNoGuidedSample) {
   GuidedScene s(load_pbrt_string(testing::furnace_scene(1.0, 1000, 8, 128), "<furnace>", "."));
   GuideField guide = s.make_guide();
@@ -276,10 +276,13 @@ TEST(GuideTrial, DepthThousandFurnaceKeepsNoGuidedSample) {
   EXPECT_EQ(t.dropped_spp, kGuideTrialStartSpp + 2 * kGuideTrialPassesPerMethod * 8);
   EXPECT_EQ(g.stats.spp, 128u);
   for (const PixelAccum& p : g.film.pixels) ASSERT_EQ(p.n, 128u);
-  RenderResult u = s.run(nullptr, testing::seeded(1000003));
-  const ErrorEstimate eg = estimate_rel_mse(g.film), eu = estimate_rel_mse(u.film);
-  ASSERT_TRUE(eg.valid && eu.valid);
-  EXPECT_LE(eg.rel_mse, 1.2 * eu.rel_mse);
+  // The 32 guided spp kept would leave a relMSE of about 32 x 2.6 / 128^2 = 5e-3
+  // (t.window[1].rel_var[1]); unguided samples are all but exact (a rare one
+  // differs: the sphere is tessellated).
+  EXPECT_GT(t.window[1].rel_var[1], 1.0);
+  const ErrorEstimate eg = estimate_rel_mse(g.film);
+  ASSERT_TRUE(eg.valid);
+  EXPECT_LT(eg.rel_mse, 1e-6);
   EXPECT_NEAR(channel_stats(g.film).mean[0], 1001.0, 1.0);
 }
 
@@ -307,7 +310,7 @@ TEST(GuideTrial, ResumedRenderEqualsTheUninterruptedOne) {
   GuideField whole_guide = f.make_guide();
   const RenderResult whole = render(f.scene, f.embree, opt, &whole_guide);
   RenderOptions part = opt;
-  part.spp = kGuideTrialStartSpp + 3 * 8;  // a guided, an unguided and a guided pass of the first window
+  part.spp = kGuideTrialStartSpp + 3 * 8;  // the first window (a guided and an unguided pass), the second's guided pass
   GuideField first_guide = f.make_guide();
   const RenderResult first = render(f.scene, f.embree, part, &first_guide);
   ASSERT_EQ(first.stats.guide_trial.state, GuideTrialState::Pending);
