@@ -23,6 +23,7 @@ default <= 1.05 x the better of none and qtable on every scene, and default
 
     nice -n 10 scripts/bench_default.py --times 20
     nice -n 10 scripts/bench_default.py --times 60 --scenes door-ajar pillars
+    scripts/bench_default.py --furnace    # the closed white furnace at 128 spp
 
 Each render's figures are cached in out/bench-default/runs/ (keyed by
 scene, method, time, seed and the binary's size and time), so an
@@ -57,8 +58,11 @@ def scene_list(a):
     log = os.path.join(a.public, "refs", "log.json")
     if os.path.exists(log):
         with open(log) as f:
+            shipped = {s[0] for s in scenes}
             for key, v in json.load(f).items():
-                scenes.append((os.path.splitext(v["file"])[0], os.path.join(a.public, v["scene"]), ["--res", v["res"]]))
+                name = os.path.splitext(v["file"])[0]
+                name = "public-" + name if name in shipped else name  # cornell-box is both
+                scenes.append((name, os.path.join(a.public, v["scene"]), ["--res", v["res"]]))
     for path in a.extra:
         scenes.append((os.path.splitext(os.path.basename(path))[0], os.path.abspath(path), []))
     if a.scenes:
@@ -98,7 +102,8 @@ def render(a, name, path, res, method, seconds, seed, ref):
     key = f"{name}-{method}-{seconds:g}s-seed{seed}"
     cache = os.path.join(a.out, "runs", key + ".json")
     binary = f"{stamp.st_size}-{int(stamp.st_mtime)}"
-    if os.path.exists(cache) and method not in a.fresh:
+    stale = method in a.fresh and (a.fresh_since <= 0 or not os.path.exists(cache) or os.stat(cache).st_mtime < a.fresh_since)
+    if os.path.exists(cache) and not stale:
         with open(cache) as f:
             row = json.load(f)
         if row.get("binary") == binary or method == "none" or not a.fresh_on_new_binary:
@@ -119,6 +124,53 @@ def render(a, name, path, res, method, seconds, seed, ref):
     return row
 
 
+# A closed white furnace: an albedo-1 diffuse box, one small black area light
+# inside, depth 1000 (paths run about 70 bounces); issue 49's second case.
+FURNACE = """LookAt 0 0 -0.9  0 0 1  0 1 0
+Camera "perspective" "float fov" [ 70 ]
+Film "rgb" "integer xresolution" [ 64 ] "integer yresolution" [ 64 ]
+Sampler "independent" "integer pixelsamples" [ 128 ]
+Integrator "path" "integer maxdepth" [ 1000 ]
+WorldBegin
+Material "diffuse" "rgb reflectance" [ 1 1 1 ]
+Shape "trianglemesh" "point3 P" [ -1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1  1 1 1  -1 1 1 ]
+  "integer indices" [ 0 2 3 0 1 2  4 7 6 4 6 5  0 3 7 0 7 4  1 5 6 1 6 2  0 4 5 0 5 1  3 2 6 3 6 7 ]
+AttributeBegin
+AreaLightSource "diffuse" "rgb L" [ 1 1 1 ]
+Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+Shape "trianglemesh" "point3 P" [ -0.3 0.999 0.2  0.3 0.999 0.2  0.3 0.999 0.8  -0.3 0.999 0.8 ] "integer indices" [ 0 1 2 0 2 3 ]
+AttributeEnd
+"""
+
+
+def furnace(a):
+    """The default against --guide none at equal spp (128) in the closed furnace: relMSE against
+    an unguided 1024-spp reference minus its noise; the acceptance is <= 1.2x."""
+    d = os.path.join(a.out, "furnace")
+    os.makedirs(d, exist_ok=True)
+    scene = os.path.join(d, "furnace-box.pbrt")
+    with open(scene, "w") as f:
+        f.write(FURNACE)
+    ref = os.path.join(d, "reference.exr")
+    if not os.path.exists(ref):
+        print("[furnace-box] reference: none, 1024 spp ...", flush=True)
+        run([a.tessera, "render", scene, "-q", "--no-preview", "--guide", "none", "--spp", "1024", "--seed", str(REF_SEED),
+             "--threads", str(a.threads), "-o", ref])
+    out = {}
+    for method in ("auto", "none"):
+        img = os.path.join(d, f"{method}.exr")
+        _, err = run([a.tessera, "render", scene, "-q", "--no-preview", "--guide", method, "--spp", "128", "--seed", "1",
+                      "--threads", str(a.threads), "-o", img, "--stats", img[:-4] + ".json"])
+        c = json.loads(run([a.tessera, "compare", img, ref, "--json"])[0])
+        out[method] = c["relmse"] - c["reference_estimated_relmse"]
+        for line in err.splitlines():
+            if "guide trial" in line:
+                print(f"[furnace-box] {line}")
+    print(f"[furnace-box] 128 spp, relMSE minus reference noise: auto {out['auto']:.4g}, none {out['none']:.4g}, "
+          f"auto/none {out['auto'] / max(out['none'], 1e-30):.2f} (acceptance <= 1.2)", flush=True)
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--tessera", default=os.path.join(ROOT, "build", "tessera"))
@@ -132,10 +184,16 @@ def main():
     ap.add_argument("--ref-time", type=float, default=60.0, help="seconds of each reference")
     ap.add_argument("--ref-guide", default="none", help="what renders the references")
     ap.add_argument("--fresh", nargs="*", default=[], help="render these methods again even when cached")
+    ap.add_argument("--fresh-since", type=float, default=0.0,
+                    help="with --fresh: only renders cached before this time (seconds since the epoch) are rendered again")
     ap.add_argument("--fresh-on-new-binary", action="store_true",
                     help="render guided methods again when the binary changed since they were cached")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench-default"))
+    ap.add_argument("--furnace", action="store_true", help="only the closed white furnace at 128 spp (auto against none)")
     a = ap.parse_args()
+    if a.furnace:
+        furnace(a)
+        return
     scenes = scene_list(a)
     for seconds in a.times:
         results = {"time_s": seconds, "threads": a.threads, "ref_time_s": a.ref_time, "seeds": a.seeds, "scenes": {}}
