@@ -15,12 +15,11 @@ uint32_t pixel_group(size_t i) {
   return static_cast<uint32_t>((static_cast<uint64_t>(i) * 0x9E3779B97F4A7C15ull) >> 40) % kGuideTrialGroups;
 }
 
-// Guided inefficiency over unguided; a tie with no noise at all goes to the
-// cheaper per sample (ratio just above or below 1).
+// Guided inefficiency over unguided; with no noise at all, the cost ratio.
 double window_ratio(const GuideTrialWindow& w) {
   if (w.inefficiency[0] > 0) return w.inefficiency[1] / w.inefficiency[0];
   if (w.inefficiency[1] > 0) return 1e30;
-  return w.cost[1] > w.cost[0] ? 1.0 + 1e-9 : 1.0 - 1e-9;
+  return w.cost[0] > 0 ? w.cost[1] / w.cost[0] : 1.0;
 }
 
 }  // namespace
@@ -123,19 +122,19 @@ int guide_trial_decide(GuideTrial& t) {
   const double ratio = window_ratio(w);
   const bool mature = w.start_spp >= t.mature_spp;
   // Tentatively: a young guide keeps learning unless it loses by 2x; a mature one by its verdict.
-  t.guiding = ratio < (mature ? 1.0 : kGuideTrialEarlyMargin) ? 1u : 0u;
+  t.guiding = ratio < (mature ? kGuideTrialTie : kGuideTrialEarlyMargin) ? 1u : 0u;
   bool final_now = t.windows_done >= kGuideTrialWindows || (mature && ratio < 1.0 / kGuideTrialEarlyMargin);
   if (k >= 1) {
     const double before = window_ratio(t.window[k - 1]);
     // Twice in a row far behind: off, young or not. Mature: two windows that
     // agree, or the second mature window's verdict.
     const bool far_behind = ratio > kGuideTrialEarlyMargin && before > kGuideTrialEarlyMargin;
-    const bool agree = (ratio < 1.0) == (before < 1.0);
+    const bool agree = (ratio < kGuideTrialTie) == (before < kGuideTrialTie);
     const bool second_mature = t.window[k - 1].start_spp >= t.mature_spp;
     final_now = final_now || far_behind || (mature && (agree || second_mature));
   }
   if (!final_now) return -1;
-  t.guiding = ratio < 1.0 ? 1u : 0u;
+  t.guiding = ratio < kGuideTrialTie ? 1u : 0u;
   t.state = t.guiding ? GuideTrialState::Kept : GuideTrialState::SwitchedOff;
   t.inefficiency[0] = w.inefficiency[0];
   t.inefficiency[1] = w.inefficiency[1];

@@ -17,8 +17,10 @@
 // A guide is judged at matched learning: a window counts as mature once the
 // guide has learned from kGuideTrialMatureSamples paths (16 spp of 181x181
 // pixels; a small image needs more spp, up to kGuideTrialMatureSppCap).
-// Between windows the render goes on tentatively with the winner, except
-// that a young guide goes on unless it loses by kGuideTrialEarlyMargin.
+// A window's verdict is for the guide where the ratio is below
+// kGuideTrialTie (a tie goes to the guide, which learns on). Between windows
+// the render goes on tentatively by the verdict, except that a young guide
+// goes on unless it loses by kGuideTrialEarlyMargin.
 // The decision is final (guide_trial_decide) when two windows in a row put
 // the guide behind by kGuideTrialEarlyMargin, or at a mature window that
 // agrees with the window before, or else at the second mature window. No
@@ -67,6 +69,10 @@ constexpr uint32_t kGuideTrialEstimates = kGuideTrialPassesPerMethod * kGuideTri
 // Relative cost of a guided path's ray query (guide lookups, learning, the
 // mixture pdf) against an unguided one.
 constexpr double kGuidedQueryCost = 1.45;
+// A window's verdict is for the guide below this ratio: a guide that learns
+// on only gets better, so a tie goes to it (at 20 s, four of the five scenes
+// whose windows measured 0.95-1.05 rendered better guided: docs/guiding.md).
+constexpr double kGuideTrialTie = 1.1;
 // A young guide goes on unless it loses by this factor; losing by it twice
 // in a row is final.
 constexpr double kGuideTrialEarlyMargin = 2.0;
