@@ -191,10 +191,11 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   check_output_path(a.checkpoint, "--checkpoint");
   check_output_path(a.guide.out, "--guide-out");
   check_outputs_apart(a, m.out, desc);
-  // A resume holds the checkpoint's film twice more; --guide auto's trial one more.
+  // A resume holds the checkpoint's film twice more; --guide auto's trial two more
+  // (the film before a pass, the unguided passes apart).
   const PixelBounds crop = film_pixel_bounds(desc.film);
   check_film_memory(crop.width(), crop.height(), m.opt.light_paths, !a.checkpoint.empty(),
-                    (a.resume.empty() ? 0u : 2u) + (a.guide.mode == "auto" ? 1u : 0u));
+                    (a.resume.empty() ? 0u : 2u) + (a.guide.mode == "auto" ? 2u : 0u));
   const GeometryCount geometry = count_geometry(desc);
   check_scene_memory(geometry.triangles, geometry.vertices, geometry.instances);
   if (!a.snapshot_every.empty()) m.snapshots = parse_snapshot_policy(a.snapshot_every);
@@ -309,6 +310,30 @@ std::string describe_stop(const RenderStats& s) {
   return b;
 }
 
+// --guide auto's trial: each window's figures, then the decision and what it took out of the image.
+void log_guide_trial(const GuideTrial& t) {
+  if (t.state == GuideTrialState::Off) return;
+  for (uint32_t k = 0; k < t.windows_done; ++k) {
+    const GuideTrialWindow& w = t.window[k];
+    std::fprintf(stderr,
+                 "tessera: guide trial: window at %u spp (%s guide): relative variance x cost per sample %.3g guided, "
+                 "%.3g unguided (relative variance %.3g and %.3g, cost %.3g and %.3g)\n",
+                 w.start_spp, w.start_spp >= t.mature_spp ? "mature" : "young", w.inefficiency[1], w.inefficiency[0],
+                 w.rel_var[1], w.rel_var[0], w.cost[1], w.cost[0]);
+  }
+  if (t.state == GuideTrialState::Pending) {
+    std::fprintf(stderr, "tessera: guide trial: undecided when the render ended (guide %s)\n", t.guiding ? "on" : "off");
+    return;
+  }
+  const bool kept = t.state == GuideTrialState::Kept;
+  std::fprintf(stderr, "tessera: guide trial: guiding %s", kept ? "kept" : "switched off for the rest of the render");
+  if (t.dropped_method >= 0)
+    std::fprintf(stderr, "; the %s passes (%u spp) left the image, rendered again %s\n",
+                 t.dropped_method == 1 ? "guided" : "unguided", t.dropped_spp, kept ? "guided" : "unguided");
+  else
+    std::fprintf(stderr, "; every sample stays in the image\n");
+}
+
 void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult& r, uint32_t spec,
                    const std::vector<SnapshotRecord>& snapshots) {
   const SceneData& scene = *m.scene;
@@ -353,14 +378,7 @@ void write_outputs(const RenderArgs& a, const MasterSetup& m, const RenderResult
                  static_cast<unsigned long long>(g.cells), g.bytes / 1048576.0, static_cast<unsigned long long>(g.updates),
                  static_cast<unsigned long long>(g.rejected_nonfinite + g.rejected_large),
                  g.budget_reached ? ", memory budget reached" : "");
-    const GuideTrial& t = r.stats.guide_trial;
-    if (t.state == GuideTrialState::Kept || t.state == GuideTrialState::SwitchedOff)
-      std::fprintf(stderr,
-                   "tessera: --guide auto trial (%llu guided and %llu unguided samples): relative variance x cost "
-                   "per sample %.3g guided, %.3g unguided: guiding %s\n",
-                   static_cast<unsigned long long>(t.samples[1]), static_cast<unsigned long long>(t.samples[0]),
-                   t.inefficiency[1], t.inefficiency[0],
-                   t.state == GuideTrialState::Kept ? "kept" : "switched off for the rest of the render");
+    log_guide_trial(r.stats.guide_trial);
     if (r.stats.ranks > 1 && r.stats.guide_syncs > 0)
       std::fprintf(stderr, "tessera: guide sync: %u reductions of %.2f MB, %.3fs (%.1f%% of the render)\n",
                    r.stats.guide_syncs, r.stats.guide_sync_bytes / 1048576.0, r.stats.guide_sync_seconds,

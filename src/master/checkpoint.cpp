@@ -15,8 +15,9 @@ constexpr char kMagic[] = "tessera-checkpoint";
 // 2: per-pass error estimates; 3: next-event skip counter, guide cache v2; 4: medium
 // vertex counter, --guide auto's trial; 5: guide cache v4; 6: light-path splats;
 // 7: splats summed per light path, lights in their own medium; 8: counter of
-// vertices the guide ratio left to the BSDF; 9: the guide's loss and learning time per pass
-constexpr uint32_t kVersion = 11;
+// vertices the guide ratio left to the BSDF; 9: the guide's loss and learning time per pass;
+// 12: --guide auto's trial windows and its unguided part of the film
+constexpr uint32_t kVersion = 12;
 
 // FNV-1a over the payload: any damaged byte is detected, not rendered.
 uint64_t fnv1a(const std::string& s) { return tessera::fnv1a(s.data(), s.size()); }
@@ -31,7 +32,7 @@ struct CheckpointBody {
     ar(s.spp, s.passes, s.seconds, raw_value(s.counters), raw(s.pass_stats), s.guide_fold_seconds, s.guide_sync_seconds,
        s.guide_syncs);
     ar(s.estimated_rel_mse, s.pass_end_seconds);
-    ar(raw_value(s.guide_trial));
+    ar(raw_value(s.guide_trial), raw(r.trial_unguided));
     ar(c->guide);
   }
 };
@@ -125,7 +126,8 @@ Checkpoint read_checkpoint(const std::string& path, uint64_t scene_fingerprint, 
   }
   const Film& film = c.so_far.film;
   if (film.width <= 0 || film.height <= 0 || film.pixels.size() != static_cast<size_t>(film.width) * film.height ||
-      (!film.splats.empty() && film.splats.size() != film.pixels.size()))
+      (!film.splats.empty() && film.splats.size() != film.pixels.size()) ||
+      (!c.so_far.trial_unguided.empty() && c.so_far.trial_unguided.size() != film.pixels.size()))
     throw fail("corrupt checkpoint (film size)");
   return c;
 }

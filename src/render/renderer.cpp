@@ -100,6 +100,43 @@ class FilmQueue : public TileQueue {
   std::atomic<size_t> next_{0};
 };
 
+// Records a pass rendered while --guide auto's trial is pending; keeps the
+// unguided passes' sums apart, and takes the loser's samples out of the
+// film where the final decision says so (render/guide_trial.h).
+void record_trial_pass(RenderResult& result, bool trial_pass, bool guided, const std::vector<PixelAccum>& before,
+                       uint32_t pass_spp, const TileCounters& counters_before) {
+  std::vector<PixelAccum>& pixels = result.film.pixels;
+  std::vector<PixelAccum>& unguided = result.trial_unguided;
+  if (!guided) {
+    if (unguided.size() != pixels.size()) unguided.assign(pixels.size(), PixelAccum{});
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        unguided[i].sum[c] += pixels[i].sum[c] - before[i].sum[c];
+        unguided[i].sum_sq[c] += pixels[i].sum_sq[c] - before[i].sum_sq[c];
+      }
+      unguided[i].n += pixels[i].n - before[i].n;
+    }
+  }
+  const TileCounters& now = result.stats.counters;
+  GuideTrial& t = result.stats.guide_trial;
+  const int drop = guide_trial_record(t, trial_pass, guided, result.film, before, pass_spp,
+                                      now.samples - counters_before.samples,
+                                      now.path.rays + now.path.shadow_rays - counters_before.path.rays -
+                                          counters_before.path.shadow_rays);
+  if (drop == 1) {
+    pixels = unguided;  // the unguided passes alone, exactly
+  } else if (drop == 0 && unguided.size() == pixels.size()) {
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        pixels[i].sum[c] -= unguided[i].sum[c];
+        pixels[i].sum_sq[c] = std::max(0.0, pixels[i].sum_sq[c] - unguided[i].sum_sq[c]);
+      }
+      pixels[i].n -= unguided[i].n;
+    }
+  }
+  if (t.state != GuideTrialState::Pending) std::vector<PixelAccum>().swap(unguided);
+}
+
 }  // namespace
 
 LocalPassExecutor::LocalPassExecutor(TileBackend& backend, int32_t threads)
@@ -166,7 +203,7 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
   stats.target_error = opt.target_error;
   if (guide) stats.guide_mode = guide->mode();
   if (guide && opt.guide_trial && stats.guide_trial.state == GuideTrialState::Off)
-    stats.guide_trial.state = GuideTrialState::Pending;
+    guide_trial_start(stats.guide_trial, static_cast<uint64_t>(w) * h);
   if (!stats.pass_stats.empty()) progress.set_error(stats.estimated_rel_mse, opt.target_error);
 
   // A guide that converges per pass learns in passes of one sample (each
@@ -192,7 +229,9 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     }
     uint32_t pass_spp = pass_spp_for(pass, opt.max_pass_spp, single_passes);
     if (opt.spp > 0) pass_spp = std::min(pass_spp, opt.spp - spp_done);
-    const TrialPass trial_pass = guide_trial_next_pass(stats.guide_trial, spp_done);
+    // Sample indices go on past the samples a trial took out of the image.
+    const uint32_t sample_index = spp_done + stats.guide_trial.dropped_spp;
+    const TrialPass trial_pass = guide_trial_next_pass(stats.guide_trial, sample_index);
     if (opt.time_budget_s > 0 && pass > 0) {
       const double left = opt.time_budget_s - elapsed();
       const uint32_t planned = pass_spp;
@@ -209,9 +248,10 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
     const double pass_start = elapsed();
     const TileCounters before = stats.counters;
     double pass_loss = -1.0, pass_guide_seconds = 0.0;
-    // Guided unless this is an unguided trial pass or the trial switched guiding off.
-    const bool guided = guide && trial_pass != TrialPass::Unguided &&
-                        stats.guide_trial.state != GuideTrialState::SwitchedOff;
+    // A trial pass's method, else what the trial has (tentatively) decided.
+    const bool guided = guide && (trial_pass == TrialPass::Guided ||
+                                  (trial_pass == TrialPass::None && guide_trial_guiding(stats.guide_trial)));
+    const bool trial_pending = stats.guide_trial.state == GuideTrialState::Pending;
     TileSettings pass_settings = settings;
     if (guided) {
       bind_guide(*guide, &pass_settings);
@@ -220,21 +260,16 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
       pass_settings.path.guided_roulette = false;
     }
     std::vector<PixelAccum> film_before;
-    if (trial_pass != TrialPass::None) film_before = result.film.pixels;
+    if (trial_pending && (trial_pass != TrialPass::None || !guided)) film_before = result.film.pixels;
     std::vector<TileJob> jobs = tiles;
     for (TileJob& job : jobs) {
-      job.sample_begin = spp_done;
-      job.sample_end = spp_done + pass_spp;
+      job.sample_begin = sample_index;
+      job.sample_end = sample_index + pass_spp;
     }
     executor->render_pass(pass_settings, jobs, result.film, &stats.counters, [&](uint64_t samples) {
       progress.advance(samples_done.fetch_add(samples) + samples, spp_done);
     });
-    if (trial_pass != TrialPass::None) {
-      const TileCounters& now = stats.counters;
-      guide_trial_record(stats.guide_trial, trial_pass == TrialPass::Guided, result.film, film_before,
-                         now.samples - before.samples,
-                         now.path.rays + now.path.shadow_rays - before.path.rays - before.path.shadow_rays);
-    }
+    if (trial_pending) record_trial_pass(result, trial_pass != TrialPass::None, guided, film_before, pass_spp, before);
     if (guided) {
       const double fold_start = elapsed();
       const size_t losses = stats.neural_guide.pass_loss.size();
@@ -246,7 +281,8 @@ RenderResult render(const SceneData& scene, PassExecutor& executor_ref, const Re
       stats.neural_guide = std::move(guide_stats.neural);
       if (stats.neural_guide.pass_loss.size() > losses) pass_loss = stats.neural_guide.pass_loss.back();
     }
-    spp_done += pass_spp;
+    // A final trial decision may have taken samples out of the image.
+    spp_done = sample_index + pass_spp - stats.guide_trial.dropped_spp;
     ++stats.passes;
     const double last_pass_s = elapsed() - pass_start;
     PassStats ps;

@@ -95,6 +95,10 @@ struct RenderStats {
 struct RenderResult {
   Film film;
   RenderStats stats;
+  // While --guide auto's trial is pending: the film's unguided passes alone
+  // (the rest are guided), so that the final decision can take either out
+  // of the image (render/guide_trial.h). Empty otherwise.
+  std::vector<PixelAccum> trial_unguided;
 };
 
 // The integrator specialisation a render with these options runs.

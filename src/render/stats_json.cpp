@@ -117,9 +117,28 @@ std::string stats_to_json(const RenderStats& s, const std::string& scene, int32_
     // --guide auto's trial: none | pending (not reached) | kept | switched-off
     static const char* trial_states[] = {"none", "pending", "kept", "switched-off"};
     j["guide_trial"] = (trial_states[static_cast<uint32_t>(s.guide_trial.state) & 3u]);
-    if (s.guide_trial.state == GuideTrialState::Kept || s.guide_trial.state == GuideTrialState::SwitchedOff) {
-      j["guide_trial_guided_inefficiency"] = (s.guide_trial.inefficiency[1]);
-      j["guide_trial_unguided_inefficiency"] = (s.guide_trial.inefficiency[0]);
+    const GuideTrial& t = s.guide_trial;
+    if (t.state == GuideTrialState::Kept || t.state == GuideTrialState::SwitchedOff) {
+      j["guide_trial_guided_inefficiency"] = (t.inefficiency[1]);
+      j["guide_trial_unguided_inefficiency"] = (t.inefficiency[0]);
+      j["guide_trial_dropped"] = t.dropped_method == 1 ? "guided" : t.dropped_method == 0 ? "unguided" : "none";
+      j["guide_trial_dropped_spp"] = uint64_t{t.dropped_spp};
+    }
+    if (t.state != GuideTrialState::Off) {
+      nlohmann::ordered_json windows = nlohmann::ordered_json::array();
+      for (uint32_t k = 0; k < t.windows_done && k < kGuideTrialWindows; ++k) {
+        const GuideTrialWindow& w = t.window[k];
+        windows.push_back({{"start_spp", w.start_spp},
+                           {"guided_rel_var", w.rel_var[1]},
+                           {"unguided_rel_var", w.rel_var[0]},
+                           {"guided_mean_rel_var", w.mean_rel_var[1]},
+                           {"unguided_mean_rel_var", w.mean_rel_var[0]},
+                           {"guided_cost", w.cost[1]},
+                           {"unguided_cost", w.cost[0]},
+                           {"guided_inefficiency", w.inefficiency[1]},
+                           {"unguided_inefficiency", w.inefficiency[0]}});
+      }
+      j["guide_trial_windows"] = windows;
     }
     j["nee_skipped_fraction"] = (
           c.path.vertices > 0 ? double(c.path.nee_skipped) / double(c.path.vertices) : 0.0);

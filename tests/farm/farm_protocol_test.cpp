@@ -66,16 +66,19 @@ TEST(FarmProtocol, SharedGuideGivesTheLocalImageAndFieldOnEveryRank) {
 // fold only after guided passes, so the farm still gives the local image.
 TEST(FarmProtocol, GuideTrialGivesTheLocalImageAndDecisionForAnyRankCount) {
   FarmScene fs(door_ajar());
-  fs.opt.spp = kGuideTrialStartSpp + 2 * kGuideTrialPassesPerMethod * 8 + 8;
+  // Two windows (at 32 and 64 spp) and a pass after them.
+  fs.opt.spp = 2 * kGuideTrialStartSpp + 2 * kGuideTrialPassesPerMethod * 8 + 8;
   fs.opt.guide_trial = true;
   auto local_guide = fs.make_guide();
   RenderResult local = render(fs.scene, fs.embree, fs.opt, local_guide.get());
-  ASSERT_NE(local.stats.guide_trial.state, GuideTrialState::Pending);
+  ASSERT_EQ(local.stats.guide_trial.windows_done, 2u);
   for (int32_t ranks : {2, 3}) {
     FarmRun farm = render_farm(fs, ranks, FarmGuide::Table, true);
     EXPECT_TRUE(films_identical(farm.result.film, local.film)) << ranks << " ranks";
     expect_same_counters(farm.result.stats.counters, local.stats.counters);
     EXPECT_EQ(farm.result.stats.guide_trial.state, local.stats.guide_trial.state);
+    EXPECT_EQ(farm.result.stats.guide_trial.windows_done, local.stats.guide_trial.windows_done);
+    EXPECT_EQ(farm.result.stats.guide_trial.guiding, local.stats.guide_trial.guiding);
     for (int32_t r = 0; r < ranks; ++r) EXPECT_TRUE(farm.guides[r]->same_as(*local_guide)) << "rank " << r;
   }
 }
