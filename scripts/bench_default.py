@@ -195,6 +195,9 @@ def main():
         furnace(a)
         return
     scenes = scene_list(a)
+    if not scenes:
+        sys.exit("bench_default.py: no scene matches --scenes (names as printed: door-ajar, cornell-box-silver, ...)")
+    os.makedirs(a.out, exist_ok=True)
     for seconds in a.times:
         results = {"time_s": seconds, "threads": a.threads, "ref_time_s": a.ref_time, "seeds": a.seeds, "scenes": {}}
         for name, path, res in scenes:
