@@ -613,7 +613,8 @@ CommandRunner add_render_command(CLI::App& app) {
       ->check(CLI::IsMember({"zsobol", "paddedsobol", "sobol", "stratified", "independent", "halton"}));
   c->add_option("--spectral", a->spectral,
                 "on: paths carry sampled wavelengths and colours become pbrt-v4's spectra; off: paths carry RGB; "
-                "auto (default): spectral where it changes the picture (measured spectra, strongly coloured lights)")
+                "auto (default): spectral where it changes the picture (measured spectra, strongly coloured lights, "
+                "saturated reflectances over several bounces; tessera info says which)")
       ->check(CLI::IsMember({"on", "off", "auto"}));
   c->add_option("--light-paths", a->light_paths,
                 "Trace caustics of small lights seen through glass or mirrors from the lights: on, off, or auto (default: "

@@ -189,94 +189,116 @@ constexpr int kLandingPoints = 128, kLandingRaysPerSide = 4;
 Landing landing_shares(const SceneDesc& s, const std::vector<char>& diffuse) {
   Landing out;
   out.share.assign(s.materials.size(), 0.0);
-  struct Tri {
-    glm::dvec3 p0, e1, e2;
-    int32_t material;
+  auto is_diffuse = [&](int32_t m) { return m >= 0 && static_cast<size_t>(m) < diffuse.size() && diffuse[m]; };
+  // Runs of up to kChunk consecutive triangles of one mesh (neighbours in
+  // most meshes), each in a box: a ray tests a run's triangles only when it
+  // enters the box. Nothing per triangle is stored (meshes can be huge).
+  constexpr uint32_t kChunk = 32;
+  struct Run {
+    uint32_t mesh, first, count;  // triangles first..first+count-1 of s.meshes[mesh]
+    glm::dvec3 lo, hi;
+    double diffuse_area;  // cumulative over the runs, for picking start points
   };
-  std::vector<Tri> tris;
-  std::vector<double> cdf;  // over the triangles of diffuse materials, by area
+  std::vector<Run> runs;
   double acc = 0.0;
-  for (const MeshDesc& m : s.meshes)
-    for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
-      const glm::dvec3 p0(m.p[m.indices[i]]), p1(m.p[m.indices[i + 1]]), p2(m.p[m.indices[i + 2]]);
-      tris.push_back({p0, p1 - p0, p2 - p0, m.material});
-      const bool d = m.material >= 0 && static_cast<size_t>(m.material) < diffuse.size() && diffuse[m.material];
-      const double a = d ? 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0)) : 0.0;
-      acc += std::isfinite(a) ? a : 0.0;
-      cdf.push_back(acc);
+  auto corner = [&](const MeshDesc& m, size_t tri, int v) { return glm::dvec3(m.p[m.indices[3 * tri + v]]); };
+  for (size_t mi = 0; mi < s.meshes.size(); ++mi) {
+    const MeshDesc& m = s.meshes[mi];
+    const size_t n = m.indices.size() / 3;
+    for (size_t first = 0; first < n; first += kChunk) {
+      Run r{static_cast<uint32_t>(mi), static_cast<uint32_t>(first),
+            static_cast<uint32_t>(std::min<size_t>(kChunk, n - first)), glm::dvec3(INFINITY), glm::dvec3(-INFINITY), 0.0};
+      for (size_t t = first; t < first + r.count; ++t) {
+        const glm::dvec3 p0 = corner(m, t, 0), p1 = corner(m, t, 1), p2 = corner(m, t, 2);
+        r.lo = glm::min(r.lo, glm::min(p0, glm::min(p1, p2)));
+        r.hi = glm::max(r.hi, glm::max(p0, glm::max(p1, p2)));
+        const double a = is_diffuse(m.material) ? 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0)) : 0.0;
+        acc += std::isfinite(a) ? a : 0.0;
+      }
+      r.diffuse_area = acc;
+      runs.push_back(r);
     }
-  if (!(acc > 0.0)) return out;
-  // Runs of kChunk consecutive triangles (neighbours in most meshes) in
-  // boxes: a ray tests a run's triangles only when it enters the run's box.
-  constexpr size_t kChunk = 32;
-  std::vector<glm::dvec3> box_lo, box_hi;
-  for (size_t c = 0; c < tris.size(); c += kChunk) {
-    glm::dvec3 lo(INFINITY), hi(-INFINITY);
-    for (size_t k = c; k < std::min(tris.size(), c + kChunk); ++k)
-      for (const glm::dvec3& q : {tris[k].p0, tris[k].p0 + tris[k].e1, tris[k].p0 + tris[k].e2})
-        lo = glm::min(lo, q), hi = glm::max(hi, q);
-    box_lo.push_back(lo), box_hi.push_back(hi);
   }
-  // The nearest hit along o + t d, t > eps: its triangle, or -1.
-  auto hit = [&](const glm::dvec3& o, const glm::dvec3& d, size_t self) {
+  if (!(acc > 0.0)) return out;
+  struct Hit {
+    uint32_t mesh = 0;
+    size_t tri = 0;
+    bool found = false;
+  };
+  // The nearest hit along o + t d, t > eps, other than triangle `self`.
+  auto hit = [&](const glm::dvec3& o, const glm::dvec3& d, uint32_t self_mesh, size_t self_tri) {
     double best = INFINITY;
-    int64_t which = -1;
+    Hit h;
     const glm::dvec3 inv_d = 1.0 / d;
-    for (size_t c = 0; c < box_lo.size(); ++c) {
-      const glm::dvec3 t0 = (box_lo[c] - o) * inv_d, t1 = (box_hi[c] - o) * inv_d;
+    for (const Run& r : runs) {
+      const glm::dvec3 t0 = (r.lo - o) * inv_d, t1 = (r.hi - o) * inv_d;
       const glm::dvec3 tn = glm::min(t0, t1), tf = glm::max(t0, t1);
       const double enter = std::max({tn.x, tn.y, tn.z}), leave = std::min({tf.x, tf.y, tf.z});
       // NaN (a flat box along an axis the ray runs in): test the run.
       if (enter > leave * (1.0 + 1e-9) + 1e-9 || leave < 0.0 || enter > best) continue;
-      for (size_t k = c * kChunk; k < std::min(tris.size(), (c + 1) * kChunk); ++k) {
-        if (k == self) continue;
-        const Tri& t = tris[k];
-        const glm::dvec3 pv = glm::cross(d, t.e2);
-        const double det = glm::dot(t.e1, pv);
+      const MeshDesc& m = s.meshes[r.mesh];
+      for (size_t t = r.first; t < r.first + r.count; ++t) {
+        if (r.mesh == self_mesh && t == self_tri) continue;
+        const glm::dvec3 p0 = corner(m, t, 0), e1 = corner(m, t, 1) - p0, e2 = corner(m, t, 2) - p0;
+        const glm::dvec3 pv = glm::cross(d, e2);
+        const double det = glm::dot(e1, pv);
         if (std::abs(det) < 1e-300) continue;
         const double inv = 1.0 / det;
-        const glm::dvec3 tv = o - t.p0;
+        const glm::dvec3 tv = o - p0;
         const double u = glm::dot(tv, pv) * inv;
         if (u < 0.0 || u > 1.0) continue;
-        const glm::dvec3 qv = glm::cross(tv, t.e1);
+        const glm::dvec3 qv = glm::cross(tv, e1);
         const double v = glm::dot(d, qv) * inv;
         if (v < 0.0 || u + v > 1.0) continue;
-        const double dist = glm::dot(t.e2, qv) * inv;
-        if (dist > 1e-9 && dist < best) best = dist, which = static_cast<int64_t>(k);
+        const double dist = glm::dot(e2, qv) * inv;
+        if (dist > 1e-9 && dist < best) best = dist, h = Hit{r.mesh, t, true};
       }
     }
-    return which;
+    return h;
   };
   Splitmix rng{0x5eed5eedull};
   double rays = 0.0;
-  std::vector<int64_t> side_hits[2];
+  std::vector<Hit> side_hits[2];
   for (int p = 0; p < kLandingPoints; ++p) {
-    const size_t k = static_cast<size_t>(std::upper_bound(cdf.begin(), cdf.end(), rng.next() * acc) - cdf.begin());
-    if (k >= tris.size()) continue;
-    const Tri& t = tris[k];
+    // A start point: a run by its diffuse area, then a triangle in it by area.
+    const double x = rng.next() * acc;
+    const size_t ri = static_cast<size_t>(
+        std::upper_bound(runs.begin(), runs.end(), x, [](double v, const Run& r) { return v < r.diffuse_area; }) -
+        runs.begin());
+    if (ri >= runs.size()) continue;
+    const Run& r = runs[ri];
+    const MeshDesc& m = s.meshes[r.mesh];
+    double y = x - (ri > 0 ? runs[ri - 1].diffuse_area : 0.0);
+    size_t tri = r.first;
+    for (size_t t = r.first; t < r.first + r.count; ++t) {
+      const double a = 0.5 * glm::length(glm::cross(corner(m, t, 1) - corner(m, t, 0), corner(m, t, 2) - corner(m, t, 0)));
+      tri = t;
+      if (std::isfinite(a) && (y -= a) <= 0.0) break;
+    }
+    const glm::dvec3 p0 = corner(m, tri, 0), e1 = corner(m, tri, 1) - p0, e2 = corner(m, tri, 2) - p0;
     double b1 = rng.next(), b2 = rng.next();
     if (b1 + b2 > 1.0) b1 = 1.0 - b1, b2 = 1.0 - b2;
-    const glm::dvec3 o = t.p0 + b1 * t.e1 + b2 * t.e2;
-    const glm::dvec3 n = glm::normalize(glm::cross(t.e1, t.e2));
+    const glm::dvec3 o = p0 + b1 * e1 + b2 * e2;
+    const glm::dvec3 n = glm::normalize(glm::cross(e1, e2));
+    if (!(n == n)) continue;
     const glm::dvec3 a = std::abs(n.x) > 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
     const glm::dvec3 u = glm::normalize(glm::cross(a, n)), v = glm::cross(n, u);
-    if (!(n == n)) continue;
     int counts[2] = {0, 0};
     for (int side = 0; side < 2; ++side) {
       side_hits[side].clear();
-      for (int r = 0; r < kLandingRaysPerSide; ++r) {
+      for (int k = 0; k < kLandingRaysPerSide; ++k) {
         const double r1 = rng.next(), phi = 2.0 * M_PI * rng.next();
         const double sr = std::sqrt(r1), z = std::sqrt(std::max(0.0, 1.0 - r1));
         const glm::dvec3 d = sr * std::cos(phi) * u + sr * std::sin(phi) * v + (side ? -z : z) * n;
-        side_hits[side].push_back(hit(o, d, k));
-        counts[side] += side_hits[side].back() >= 0;
+        side_hits[side].push_back(hit(o, d, r.mesh, tri));
+        counts[side] += side_hits[side].back().found;
       }
     }
-    for (const int64_t h : side_hits[counts[1] > counts[0] ? 1 : 0]) {
+    for (const Hit& h : side_hits[counts[1] > counts[0] ? 1 : 0]) {
       rays += 1.0;
-      if (h < 0) continue;
-      const int32_t m = tris[static_cast<size_t>(h)].material;
-      if (m >= 0 && static_cast<size_t>(m) < diffuse.size() && diffuse[m]) out.share[static_cast<size_t>(m)] += 1.0;
+      if (!h.found) continue;
+      const int32_t mat = s.meshes[h.mesh].material;
+      if (is_diffuse(mat)) out.share[static_cast<size_t>(mat)] += 1.0;
       else out.neutral += 1.0;
     }
   }
@@ -284,6 +306,23 @@ Landing landing_shares(const SceneDesc& s, const std::vector<char>& diffuse) {
   for (double& x : out.share) x /= rays;
   out.neutral /= rays;
   return out;
+}
+
+// shift_c over `bounces` bounces: the first off F (RGB f), the later ones off
+// N (RGB n) (see multibounce_colour_shift).
+Rgb bounce_shift(const SpectralTables& tables, const Spectrum& first, const glm::dvec3& first_rgb, const Spectrum& next,
+                 const glm::dvec3& next_rgb, int bounces) {
+  glm::dvec3 sum_rgb(0.0), sum_spectral(0.0), rgb_power = first_rgb;
+  Spectrum power = first;
+  for (int j = 1; j <= bounces; ++j) {
+    sum_rgb += rgb_power;
+    sum_spectral += rgb_under_d65(tables, power);
+    rgb_power *= next_rgb;
+    for (size_t k = 0; k < power.size(); ++k) power[k] *= next[k];
+  }
+  const double floor = 0.05 * std::max({sum_rgb.x, sum_rgb.y, sum_rgb.z});
+  if (!(floor > 0.0)) return Rgb(0.f);
+  return Rgb(glm::abs(sum_spectral - sum_rgb) / glm::max(sum_rgb, glm::dvec3(floor)));
 }
 
 }  // namespace
@@ -324,6 +363,12 @@ Rgb multibounce_colour_shift(const SceneDesc& s) {
   for (double& x : first) x /= total;
   first_rgb /= total;
   // The later bounces: where light leaving a diffuse surface lands next.
+  // Rays are cast only where a closed room of these surfaces, every bounce
+  // landing by area, would shift by a quarter of the threshold: grey scenes,
+  // however large, cost no rays.
+  const int bounces = s.max_depth < 0 ? 100 : std::clamp(s.max_depth, 1, 100);
+  const Rgb closed = bounce_shift(tables, first, first_rgb, first, first_rgb, bounces);
+  if (max_component(closed) < 0.25f * kMultibounceShiftThreshold) return closed;
   const Landing landing = landing_shares(s, diffuse);
   Spectrum next{};
   glm::dvec3 next_rgb(landing.neutral);
@@ -333,21 +378,7 @@ Rgb multibounce_colour_shift(const SceneDesc& s) {
     for (size_t k = 0; k < next.size(); ++k) next[k] += landing.share[i] * spectrum[i][k];
     next_rgb += landing.share[i] * rgb[i];
   }
-  // maxdepth bounces (pbrt-v4's -1, unlimited, and anything past 100: 100;
-  // the powers of a mean reflectance below 1 are negligible by then).
-  const int bounces = s.max_depth < 0 ? 100 : std::clamp(s.max_depth, 1, 100);
-  glm::dvec3 sum_rgb(0.0), sum_spectral(0.0), rgb_power = first_rgb;
-  Spectrum power = first;
-  for (int j = 1; j <= bounces; ++j) {
-    sum_rgb += rgb_power;
-    sum_spectral += rgb_under_d65(tables, power);
-    rgb_power *= next_rgb;
-    for (size_t k = 0; k < power.size(); ++k) power[k] *= next[k];
-  }
-  const double floor = 0.05 * std::max({sum_rgb.x, sum_rgb.y, sum_rgb.z});
-  if (!(floor > 0.0)) return Rgb(0.f);
-  const glm::dvec3 shift = glm::abs(sum_spectral - sum_rgb) / glm::max(sum_rgb, glm::dvec3(floor));
-  return Rgb(shift);
+  return bounce_shift(tables, first, first_rgb, next, next_rgb, bounces);
 }
 
 std::string spectral_reason(const SceneDesc& scene) {

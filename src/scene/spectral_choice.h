@@ -22,22 +22,28 @@ namespace tessera {
 std::string spectral_reason(const SceneDesc& scene);
 
 // Rule (d)'s estimate: by how much, relatively, each channel of the light that
-// diffuse surfaces reflect differs between RGB and spectral transport. The
-// scene is modelled as a closed room lit by white (D65) light in which every
-// bounce lands on a diffuse-family surface (diffuse, coateddiffuse,
-// diffusetransmission) picked at random by its share of their total area.
-// Bounces are then independent, so after j of them the spectral path carries
-// the j-th power of the area-weighted mean reflectance spectrum S, where RGB
-// carries the j-th power of the mean reflectance RGB a:
-//   shift_c = | sum_j rgb_c(D65 S^j) - sum_j a_c^j | / sum_j a_c^j,  j = 1..maxdepth,
-// each spectrum being the RGB-to-spectrum upsampling the renderer itself
-// uses (kernels/spectral.h). The denominator is at least 5 % of the brightest
+// diffuse surfaces reflect differs between RGB and spectral transport, under
+// white (D65) light. Light first bounces off a diffuse-family surface
+// (diffuse, coateddiffuse, diffusetransmission) picked by its share of their
+// area, then lands where light leaving such a surface lands: measured by 1024
+// rays from 128 points spread by area, cosine-distributed on the side that
+// sees more of the scene, against the scene's triangles (a ray that leaves
+// the scene lands nowhere; one that lands on glass or metal carries on
+// uncoloured; instanced geometry is not tested). With F the mean first-bounce
+// reflectance spectrum and N the landing-weighted one (RGB: f and n),
+//   shift_c = | sum_j rgb_c(D65 F N^(j-1)) - sum_j f_c n_c^(j-1) | / sum_j f_c n_c^(j-1),  j = 1..maxdepth,
+// each spectrum the RGB-to-spectrum upsampling the renderer itself uses
+// (kernels/spectral.h). The denominator is at least 5 % of the brightest
 // channel's, so that a nearly black channel does not dominate. Textured
-// reflectances enter through their texels (image textures, up to 4096 texels
-// evenly spread) or their constant parts (scale, mix, checkerboard of
-// constants); a material with other textures (noise, marble...) is left out
-// of the estimate. Other materials (glass, metal) only redirect light in this
-// model and are left out too. Zero when no diffuse surface has area.
+// reflectances enter through their texels (image textures: up to 4096
+// texels, evenly spread) or their constant parts (scale, mix, checkerboard,
+// dots, bilerp); a material with a noise texture (fbm, wrinkled, windy,
+// marble) is left out, as its colours are unknown without evaluating it.
+// Deterministic (a fixed seed); the rays cost about 0.05 s on 80,000
+// triangles. Zero when no diffuse surface has area. It overestimates: the
+// camera sees some surfaces more than their area says and light does not
+// reach every surface equally: tests/data/coloured-room.pbrt, estimated 1.7 %,
+// is 1.0 % off pbrt-v4 in RGB).
 Rgb multibounce_colour_shift(const SceneDesc& scene);
 
 // The estimated shift above which rule (d) picks spectral transport.
