@@ -24,6 +24,9 @@ int run_info(const std::string& path) {
     static const char* names[] = {"area", "point", "spot", "distant", "infinite"};
     ++light_kinds[names[static_cast<int>(l.type)]];
   }
+  // Before SceneData empties the meshes, whose areas --spectral auto weighs.
+  const std::string why = spectral_reason(desc);
+  const Rgb shift = multibounce_colour_shift(desc);
   SceneData scene(std::move(desc));
   const std::optional<uint64_t> built = resident_bytes();
   const SceneView& v = scene.view();
@@ -61,8 +64,9 @@ int run_info(const std::string& path) {
                 o.x + b.hi.x, o.y + b.hi.y, o.z + b.hi.z);
   std::printf("effects:        %s\n", describe_effects(scene.effects()).c_str());
   std::printf("specialisation: %s\n", describe_specialisation(specialisation_for(scene.effects())).c_str());
-  const std::string why = spectral_reason(scene.desc());
   std::printf("transport:      %s\n", why.empty() ? "rgb (--spectral auto)" : ("spectral (--spectral auto: " + why + ")").c_str());
+  std::printf("colour shift:   %.2f %.2f %.2f %% (RGB against spectral transport after maxdepth diffuse bounces, estimated)\n",
+              100.0 * shift.x, 100.0 * shift.y, 100.0 * shift.z);
   std::printf("warnings:       %zu\n", scene.desc().warnings.size());
   // Above what the process held before reading: what reading the files took
   // at its peak, and what the built scene keeps (its BVH comes on top when rendering).

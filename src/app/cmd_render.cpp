@@ -178,6 +178,7 @@ struct MasterSetup {
   uint64_t options_fingerprint = 0;
   SnapshotPolicy snapshots;
   std::string light_paths_obstacle;  // why a bidirectional integrator's light paths cannot be traced ("" if they can)
+  std::string spectral_why;          // spectral_reason of the scene ("" if RGB would do), before SceneData empties the meshes
 };
 
 MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
@@ -201,6 +202,7 @@ MasterSetup prepare_master(const RenderArgs& a, Bytes* scene_bytes) {
   if (!a.snapshot_every.empty()) m.snapshots = parse_snapshot_policy(a.snapshot_every);
   if (scene_bytes) *scene_bytes = encode_scene(desc);
   m.light_paths_obstacle = light_paths_obstacle(desc);  // reads the meshes, which SceneData empties
+  m.spectral_why = spectral_reason(desc);                // so does rule (d) of --spectral auto
   m.scene = std::make_unique<SceneData>(std::move(desc));
   m.guide = make_guide(a.guide, *m.scene, &m.guide_why);
   // The default must not cost: a trial decides whether the guide pays.
@@ -233,7 +235,7 @@ void log_setup(const MasterSetup& m, uint32_t spec, int32_t ranks, int32_t machi
                m.opt.spp > 0 ? (std::to_string(m.opt.spp) + " spp").c_str() : "unlimited spp", m.opt.max_depth);
   std::fprintf(stderr, "tessera: effects: %s; integrator specialisation: %s\n", describe_effects(scene.effects()).c_str(),
                describe_specialisation(spec).c_str());
-  const std::string why = spectral_reason(scene.desc());
+  const std::string& why = m.spectral_why;
   std::fprintf(stderr, "tessera: transport: %s\n",
                scene.desc().spectral ? ("spectral (" + (why.empty() ? std::string("--spectral on") : why) + ")").c_str()
                                      : (why.empty() ? "rgb" : ("rgb (--spectral off; " + why + ")").c_str()));
@@ -636,7 +638,8 @@ CommandRunner add_render_command(CLI::App& app) {
       ->check(CLI::IsMember({"bvh", "power", "uniform"}));
   c->add_option("--spectral", a->spectral,
                 "on: paths carry sampled wavelengths and colours become pbrt-v4's spectra; off: paths carry RGB; "
-                "auto (default): spectral where it changes the picture (measured spectra, strongly coloured lights)")
+                "auto (default): spectral where it changes the picture (measured spectra, strongly coloured lights, "
+                "saturated reflectances over several bounces; tessera info says which)")
       ->check(CLI::IsMember({"on", "off", "auto"}));
   c->add_option("--light-paths", a->light_paths,
                 "Trace caustics of small lights seen through glass or mirrors from the lights: on, off, or auto (default: "
