@@ -45,14 +45,10 @@ constexpr int32_t kLightUnbounded = -1;  // infinite and distant lights: chosen 
 constexpr int32_t kLightNeverChosen = -2;  // emits nothing
 
 // cos(a - b) for angles in [0, pi], clamped to 1 where a < b (pbrt-v4's
-// cosSubClamped), and its sine counterpart (0 there).
+// cosSubClamped).
 TESSERA_HOST_DEVICE inline Float cos_sub_clamped(Float sin_a, Float cos_a, Float sin_b, Float cos_b) {
   return cos_a > cos_b ? 1.f : cos_a * cos_b + sin_a * sin_b;
 }
-TESSERA_HOST_DEVICE inline Float sin_sub_clamped(Float sin_a, Float cos_a, Float sin_b, Float cos_b) {
-  return cos_a > cos_b ? 0.f : sin_a * cos_b - cos_a * sin_b;
-}
-// (light_node_importance inlines both, to take each sine only where needed.)
 
 // The importance of a node's lights at point p with shading normal n (zero
 // in a medium): power over clamped squared distance, times the cosine bound
@@ -71,8 +67,8 @@ TESSERA_HOST_DEVICE inline Float light_node_importance(const LightBvhNode& b, co
   const bool inside = dist2 <= b.radius2;
   const Float sin2_b = inside ? 0.f : b.radius2 / dist2;
   const Float cos_b = inside ? -1.f : safe_sqrt(1.f - sin2_b);
-  // cos_sub_clamped and sin_sub_clamped, each sine taken only where the
-  // clamp does not decide (the same values, fewer square roots).
+  // pbrt-v4's clamped differences of angles (cos_sub_clamped and its sine
+  // counterpart), each sine taken only where the clamp does not decide.
   Float cos_x = 1.f, sin_x = 0.f;
   if (!(cos_w > b.cos_o)) {
     const Float sin_w = safe_sqrt(1.f - cos_w * cos_w);

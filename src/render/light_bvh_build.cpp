@@ -80,18 +80,20 @@ struct Builder {
 
   // The split of order[start, end): the index where the second half starts.
   size_t split(size_t start, size_t end) {
-    Bound all;
-    DVec3 c_lo(std::numeric_limits<double>::max()), c_hi(-std::numeric_limits<double>::max());
+    // The boxes of the lights and of their centroids (the cones are not needed here).
+    DVec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    DVec3 c_lo = lo, c_hi = hi;
     for (size_t i = start; i < end; ++i) {
       const Bound& b = bounds[order[i]];
-      all = merge(all, b);
+      lo = glm::min(lo, b.lo);
+      hi = glm::max(hi, b.hi);
       c_lo = glm::min(c_lo, b.centroid());
       c_hi = glm::max(c_hi, b.centroid());
     }
     constexpr int kBuckets = 12;
     double best = std::numeric_limits<double>::infinity();
     int best_dim = -1, best_bucket = -1;
-    const DVec3 extent = all.hi - all.lo;
+    const DVec3 extent = hi - lo;
     auto bucket_of = [&](const Bound& b, int dim) {
       const int k = static_cast<int>(kBuckets * (b.centroid()[dim] - c_lo[dim]) / (c_hi[dim] - c_lo[dim]));
       return std::clamp(k, 0, kBuckets - 1);
@@ -104,9 +106,14 @@ struct Builder {
         const int k = bucket_of(b, dim);
         bucket[k] = merge(bucket[k], b);
       }
-      for (int s = 1; s < kBuckets - 1; ++s) {  // pbrt-v4 starts at 1
-        Bound below, above;
-        for (int j = 0; j <= s; ++j) below = merge(below, bucket[j]);
+      // The buckets below a split are merged in one sweep (the same unions in
+      // the same order as merging each range anew); those above each split
+      // left to right, as pbrt-v4 does (cone unions are not associative).
+      Bound below;
+      for (int s = 0; s < kBuckets - 1; ++s) {
+        below = merge(below, bucket[s]);
+        if (s == 0) continue;  // pbrt-v4 starts at 1
+        Bound above;
         for (int j = s + 1; j < kBuckets; ++j) above = merge(above, bucket[j]);
         const double cost = split_cost(below, extent, dim) + split_cost(above, extent, dim);
         if (cost > 0.0 && cost < best) {

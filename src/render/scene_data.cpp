@@ -322,7 +322,7 @@ void SceneData::build_lights() {
     }
   }
   light_select_ = Distribution1D(power);
-  build_light_tree();
+  if (desc_.light_sampler == LightSamplerKind::Bvh) build_light_tree();
   env_views_.resize(lights_.size());
   for (size_t i = 0; i < lights_.size(); ++i) env_views_[i] = env_storage_[i].view();
 }

@@ -71,7 +71,7 @@ class SceneData {
   std::vector<Light> lights_;
   std::vector<int32_t> infinite_lights_;
   Distribution1D light_select_;
-  LightBvh light_bvh_;  // next-event estimation's light tree
+  LightBvh light_bvh_;  // next-event estimation's light tree (empty unless the light sampler is bvh)
   // Per image: the mean and largest luminance of its texels (only for
   // images that lights emit).
   struct ImageLuminance {

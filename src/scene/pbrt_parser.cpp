@@ -34,9 +34,8 @@ constexpr int kMaxIncludeDepth = 32;
 // The Integrator's "lightsampler" (pbrt-v4: bvh, power, uniform, exhaustive).
 LightSamplerKind light_sampler_of(const ParamSet& ps, const Token& at, std::vector<std::string>& warnings) {
   const std::string name = ps.get_string("lightsampler", "bvh");
-  if (name == "bvh") return LightSamplerKind::Bvh;
-  if (name == "power") return LightSamplerKind::Power;
-  if (name == "uniform") return LightSamplerKind::Uniform;
+  for (LightSamplerKind k : {LightSamplerKind::Bvh, LightSamplerKind::Power, LightSamplerKind::Uniform})
+    if (name == light_sampler_name(k)) return k;
   if (name == "exhaustive") {
     warnings.push_back(at.where() + ": light sampler \"exhaustive\" is drawn as \"bvh\" (the same image in expectation)");
     return LightSamplerKind::Bvh;

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "kernels/rng.h"
 #include "kernels/spectral.h"
 #include "kernels/vecmath.h"
 #include "scene/named_spectra.h"
@@ -111,13 +112,19 @@ std::optional<Colours> material_colours(const SceneDesc& s, const Material& m) {
   }
 }
 
+glm::dvec3 corner(const MeshDesc& m, size_t tri, int v) { return glm::dvec3(m.p[m.indices[3 * tri + v]]); }
+
+// Triangle tri's area, 0 where it is not finite.
+double triangle_area(const MeshDesc& m, size_t tri) {
+  const glm::dvec3 p0 = corner(m, tri, 0);
+  const double a = 0.5 * glm::length(glm::cross(corner(m, tri, 1) - p0, corner(m, tri, 2) - p0));
+  return std::isfinite(a) ? a : 0.0;
+}
+
 double mesh_area(const MeshDesc& m) {
   double a = 0.0;
-  for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
-    const glm::dvec3 p0(m.p[m.indices[i]]), p1(m.p[m.indices[i + 1]]), p2(m.p[m.indices[i + 2]]);
-    a += 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
-  }
-  return std::isfinite(a) ? a : 0.0;
+  for (size_t t = 0; t < m.indices.size() / 3; ++t) a += triangle_area(m, t);
+  return a;
 }
 
 // Each material's share of the scene's surface area (instances included,
@@ -174,14 +181,10 @@ struct Landing {
   double neutral = 0.0;       // share landing on other materials (glass, metal): colourless here
 };
 
+// splitmix64: a counter through the finaliser (kernels/rng.h), in [0, 1).
 struct Splitmix {
   uint64_t x;
-  double next() {
-    uint64_t z = (x += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
-  }
+  double next() { return static_cast<double>(mix_bits(x += 0x9e3779b97f4a7c15ull) >> 11) * 0x1.0p-53; }
 };
 
 constexpr int kLandingPoints = 128, kLandingRaysPerSide = 4;
@@ -201,7 +204,6 @@ Landing landing_shares(const SceneDesc& s, const std::vector<char>& diffuse) {
   };
   std::vector<Run> runs;
   double acc = 0.0;
-  auto corner = [&](const MeshDesc& m, size_t tri, int v) { return glm::dvec3(m.p[m.indices[3 * tri + v]]); };
   for (size_t mi = 0; mi < s.meshes.size(); ++mi) {
     const MeshDesc& m = s.meshes[mi];
     const size_t n = m.indices.size() / 3;
@@ -212,8 +214,7 @@ Landing landing_shares(const SceneDesc& s, const std::vector<char>& diffuse) {
         const glm::dvec3 p0 = corner(m, t, 0), p1 = corner(m, t, 1), p2 = corner(m, t, 2);
         r.lo = glm::min(r.lo, glm::min(p0, glm::min(p1, p2)));
         r.hi = glm::max(r.hi, glm::max(p0, glm::max(p1, p2)));
-        const double a = is_diffuse(m.material) ? 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0)) : 0.0;
-        acc += std::isfinite(a) ? a : 0.0;
+        if (is_diffuse(m.material)) acc += triangle_area(m, t);
       }
       r.diffuse_area = acc;
       runs.push_back(r);
@@ -271,9 +272,8 @@ Landing landing_shares(const SceneDesc& s, const std::vector<char>& diffuse) {
     double y = x - (ri > 0 ? runs[ri - 1].diffuse_area : 0.0);
     size_t tri = r.first;
     for (size_t t = r.first; t < r.first + r.count; ++t) {
-      const double a = 0.5 * glm::length(glm::cross(corner(m, t, 1) - corner(m, t, 0), corner(m, t, 2) - corner(m, t, 0)));
       tri = t;
-      if (std::isfinite(a) && (y -= a) <= 0.0) break;
+      if ((y -= triangle_area(m, t)) <= 0.0) break;
     }
     const glm::dvec3 p0 = corner(m, tri, 0), e1 = corner(m, tri, 1) - p0, e2 = corner(m, tri, 2) - p0;
     double b1 = rng.next(), b2 = rng.next();
